@@ -1,0 +1,1 @@
+//! PLACEHOLDER: RON keyframe specs and frame generation — the pipeline helper writes this.

@@ -1,0 +1,109 @@
+//! Rays, bounding boxes, transforms and the one place where secondary rays are offset.
+
+pub(crate) mod aabb;
+mod transform;
+
+pub use aabb::Aabb;
+pub use transform::Transform;
+
+use glam::Vec3A;
+
+/// A ray `origin + t·dir`. `dir` is not necessarily unit length: rays moved into object space
+/// keep the world-space parameter `t`, so hits from differently transformed shapes compare.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    pub origin: Vec3A,
+    pub dir: Vec3A,
+}
+
+impl Ray {
+    pub fn new(origin: Vec3A, dir: Vec3A) -> Self {
+        Ray { origin, dir }
+    }
+
+    pub fn at(&self, t: f32) -> Vec3A {
+        self.origin + self.dir * t
+    }
+}
+
+/// Relative size of the offset that lifts a spawned ray's origin off the surface it leaves.
+/// Intersection arithmetic in f32 leaves a hit point within a few ulps of the true surface *in
+/// every coordinate*, so the error scales with the largest coordinate magnitude of the point
+/// (Wächter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing
+/// Gems ch. 6). Transformed shapes add the error of the matrix product, hence the margin.
+const ORIGIN_ERROR_SCALE: f32 = 1.0 / 4096.0 * (1.0 / 32.0);
+/// Floor for points near the origin, where a relative bound would collapse to nothing.
+const ORIGIN_ERROR_FLOOR: f32 = 1.0 / 65536.0 / 1024.0;
+
+/// Origin for a ray leaving surface point `p` with geometric normal `n` in direction `dir`:
+/// pushed to the side of the surface that `dir` points into. The only place in the renderer
+/// where ray origins are offset.
+#[inline]
+pub fn spawn_origin(p: Vec3A, n: Vec3A, dir: Vec3A) -> Vec3A {
+    let magnitude = p.abs().max_element();
+    let offset = ORIGIN_ERROR_FLOOR + magnitude * ORIGIN_ERROR_SCALE;
+    let side = if n.dot(dir) >= 0.0 { 1.0 } else { -1.0 };
+    p + n * (offset * side)
+}
+
+/// A ray from surface point `p` (geometric normal `n`) towards `dir`, offset off the surface.
+#[inline]
+pub fn spawn_ray(p: Vec3A, n: Vec3A, dir: Vec3A) -> Ray {
+    Ray::new(spawn_origin(p, n, dir), dir)
+}
+
+/// Mirror `d` about the plane with unit normal `n`.
+#[inline]
+pub fn reflect(d: Vec3A, n: Vec3A) -> Vec3A {
+    d - n * (2.0 * d.dot(n))
+}
+
+/// Solves `a·t² + b·t + c = 0` in f64 without catastrophic cancellation; roots ascending.
+/// Returns `None` when there is no real root. `a` must not be zero.
+#[inline]
+pub fn solve_quadratic(a: f64, b: f64, c: f64) -> Option<(f64, f64)> {
+    let disc = b * b - 4.0 * a * c;
+    if disc < 0.0 || !disc.is_finite() {
+        return None;
+    }
+    let q = -0.5 * (b + disc.sqrt().copysign(b));
+    let (t0, t1) = if q == 0.0 {
+        // b = 0 and c = 0: a double root at 0.
+        (0.0, 0.0)
+    } else {
+        (q / a, c / q)
+    };
+    Some(if t0 <= t1 { (t0, t1) } else { (t1, t0) })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quadratic_is_stable_when_b_dominates() {
+        // Roots 1e-8 and 1e8: the naive formula loses the small root entirely in f64.
+        let (t0, t1) = solve_quadratic(1.0, -(1e8 + 1e-8), 1.0).unwrap();
+        assert!((t0 - 1e-8).abs() / 1e-8 < 1e-12, "{t0}");
+        assert!((t1 - 1e8).abs() / 1e8 < 1e-12, "{t1}");
+    }
+
+    #[test]
+    fn quadratic_without_real_roots() {
+        assert!(solve_quadratic(1.0, 0.0, 1.0).is_none());
+    }
+
+    #[test]
+    fn spawn_origin_moves_to_the_side_of_the_direction() {
+        let p = Vec3A::new(1000.0, 0.0, 0.0);
+        let n = Vec3A::X;
+        assert!(spawn_origin(p, n, Vec3A::X).x > 1000.0);
+        assert!(spawn_origin(p, n, -Vec3A::X).x < 1000.0);
+    }
+
+    #[test]
+    fn reflect_about_normal() {
+        let r = reflect(Vec3A::new(1.0, -1.0, 0.0), Vec3A::Y);
+        assert_eq!(r, Vec3A::new(1.0, 1.0, 0.0));
+    }
+}

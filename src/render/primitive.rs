@@ -1,0 +1,263 @@
+//! A shape placed in the world: either baked into world space (no matrix work per ray) or
+//! kept in object space with its transform.
+
+use crate::math::{Aabb, Ray, Transform};
+use crate::scene::Geometry;
+use crate::shape::{AaBox, Cone, Cylinder, Plane, Shape, ShapeHit, Sphere, Triangle};
+use glam::{Affine3A, DMat3, DVec3, Mat3A, Vec3A};
+
+/// The kept hit of a closest-hit query, in world space.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    pub t: f32,
+    pub point: Vec3A,
+    /// Unit geometric normal, outward for closed shapes (not flipped towards the ray).
+    pub normal: Vec3A,
+}
+
+#[derive(Clone, Debug)]
+struct ObjectSpace {
+    object_from_world: Affine3A,
+    world_from_object: Affine3A,
+    normal_to_world: Mat3A,
+}
+
+#[derive(Clone, Debug)]
+pub struct Primitive {
+    pub shape: Shape,
+    object: Option<Box<ObjectSpace>>,
+    pub material: u32,
+    pub bounds: Aabb,
+}
+
+/// Why a geometry cannot become a primitive (degenerate input); the reader reports these
+/// before the renderer ever sees them, so here they only guard against misuse.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Degenerate;
+
+fn f(v: DVec3) -> Vec3A {
+    v.as_vec3().into()
+}
+
+/// Whether `m` is a rotation times a uniform scale (keeps spheres spheres, circles circles).
+fn similarity_scale(m: DMat3) -> Option<f64> {
+    let gram = m.transpose() * m;
+    let s2 = gram.x_axis.x;
+    let tol = 1e-9 * s2;
+    let uniform = (gram.y_axis.y - s2).abs() <= tol
+        && (gram.z_axis.z - s2).abs() <= tol
+        && gram.x_axis.y.abs() <= tol
+        && gram.x_axis.z.abs() <= tol
+        && gram.y_axis.z.abs() <= tol;
+    uniform.then(|| s2.sqrt())
+}
+
+/// Whether `m` is diagonal (an axis-aligned box stays axis-aligned).
+fn is_diagonal(m: DMat3) -> bool {
+    m.x_axis.y == 0.0
+        && m.x_axis.z == 0.0
+        && m.y_axis.x == 0.0
+        && m.y_axis.z == 0.0
+        && m.z_axis.x == 0.0
+        && m.z_axis.y == 0.0
+}
+
+impl Primitive {
+    /// Places `geometry` with world transform `xf`. Shapes whose class survives the
+    /// transform are baked into world space; the rest keep the matrix.
+    pub fn new(
+        geometry: &Geometry,
+        xf: &Transform,
+        material: u32,
+    ) -> Result<Primitive, Degenerate> {
+        let lin = xf.linear();
+        let baked: Option<Shape> = if xf.is_identity() {
+            Some(make_shape(geometry, &Transform::IDENTITY)?)
+        } else {
+            match geometry {
+                Geometry::Sphere { .. } | Geometry::Cylinder { .. } | Geometry::Cone { .. } => {
+                    similarity_scale(lin)
+                        .map(|_| make_shape(geometry, xf))
+                        .transpose()?
+                }
+                Geometry::Box { .. } => is_diagonal(lin)
+                    .then(|| make_shape(geometry, xf))
+                    .transpose()?,
+                Geometry::Plane { .. } | Geometry::Triangle { .. } => {
+                    Some(make_shape(geometry, xf)?)
+                }
+            }
+        };
+        let (shape, object) = match baked {
+            Some(shape) => (shape, None),
+            None => {
+                let shape = make_shape(geometry, &Transform::IDENTITY)?;
+                let object = ObjectSpace {
+                    object_from_world: Affine3A::from_mat4(xf.object_from_world.as_mat4()),
+                    world_from_object: Affine3A::from_mat4(xf.world_from_object.as_mat4()),
+                    normal_to_world: Mat3A::from(xf.normal_matrix().as_mat3()),
+                };
+                (shape, Some(Box::new(object)))
+            }
+        };
+        let local = shape.bounds();
+        let bounds = match &object {
+            Some(o) if local.is_finite() => Aabb::from_points(
+                local
+                    .corners()
+                    .map(|c| o.world_from_object.transform_point3a(c)),
+            ),
+            _ => local,
+        };
+        Ok(Primitive {
+            shape,
+            object,
+            material,
+            bounds,
+        })
+    }
+
+    /// Cheap stage: nearest hit as the shape reports it (object space for transformed shapes;
+    /// `t` is in world units either way).
+    #[inline]
+    pub fn hit(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
+        match &self.object {
+            None => self.shape.intersect(ray, t_max),
+            Some(o) => {
+                let local = Ray::new(
+                    o.object_from_world.transform_point3a(ray.origin),
+                    o.object_from_world.transform_vector3a(ray.dir),
+                );
+                self.shape.intersect(&local, t_max)
+            }
+        }
+    }
+
+    /// Full stage, for the one hit that is kept: world-space point and unit normal.
+    #[inline]
+    pub fn surface(&self, hit: &ShapeHit) -> SurfaceHit {
+        let (point, normal) = match &self.object {
+            None => (hit.point, hit.normal),
+            Some(o) => (
+                o.world_from_object.transform_point3a(hit.point),
+                o.normal_to_world * hit.normal,
+            ),
+        };
+        SurfaceHit {
+            t: hit.t,
+            point,
+            normal: normal.normalize_or_zero(),
+        }
+    }
+
+    /// Both stages at once (tests and tools).
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
+        self.hit(ray, t_max).map(|h| self.surface(&h))
+    }
+
+    pub fn is_bounded(&self) -> bool {
+        self.bounds.is_finite()
+    }
+}
+
+/// Builds the shape for `geometry` mapped through `xf` (which must keep its class).
+fn make_shape(geometry: &Geometry, xf: &Transform) -> Result<Shape, Degenerate> {
+    let p = |v: DVec3| f(xf.point(v));
+    let shape = match geometry {
+        Geometry::Sphere { center, radius } => {
+            let s = similarity_scale(xf.linear()).ok_or(Degenerate)?;
+            Sphere::new(p(*center), (radius.abs() * s) as f32).map(Shape::Sphere)
+        }
+        Geometry::Box { p1, p2 } => AaBox::new(p(*p1), p(*p2)).map(Shape::Box),
+        Geometry::Plane { point, normal } => {
+            Plane::new(p(*point), f(xf.normal_matrix() * *normal)).map(Shape::Plane)
+        }
+        Geometry::Triangle {
+            vertices: [a, b, c],
+        } => Triangle::new(p(*a), p(*b), p(*c)).map(Shape::Triangle),
+        Geometry::Cylinder { p1, p2, radius } => {
+            let s = similarity_scale(xf.linear()).ok_or(Degenerate)?;
+            Cylinder::new(p(*p1), p(*p2), (radius * s) as f32).map(Shape::Cylinder)
+        }
+        Geometry::Cone { base, tip, radius } => {
+            let s = similarity_scale(xf.linear()).ok_or(Degenerate)?;
+            Cone::new(p(*base), p(*tip), (radius * s) as f32).map(Shape::Cone)
+        }
+    };
+    shape.ok_or(Degenerate)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ray(o: [f32; 3], d: [f32; 3]) -> Ray {
+        Ray::new(Vec3A::from(o), Vec3A::from(d))
+    }
+
+    #[test]
+    fn scaled_sphere_is_baked_and_hit_in_world_space() {
+        let xf = Transform::translate(DVec3::new(0.0, 0.0, -10.0))
+            .then_after(&Transform::scale(DVec3::splat(2.0)).unwrap());
+        let prim = Primitive::new(
+            &Geometry::Sphere {
+                center: DVec3::ZERO,
+                radius: 1.0,
+            },
+            &xf,
+            0,
+        )
+        .unwrap();
+        assert!(prim.object.is_none(), "similarity transforms are baked");
+        let h = prim
+            .intersect(&ray([0.0, 0.0, 0.0], [0.0, 0.0, -1.0]), f32::INFINITY)
+            .unwrap();
+        assert!((h.t - 8.0).abs() < 1e-5);
+        assert!((h.normal - Vec3A::Z).length() < 1e-6);
+    }
+
+    #[test]
+    fn ellipsoid_normal_uses_the_inverse_transpose() {
+        // Sphere scaled by (2,1,1) is x²/4 + y² + z² = 1; a ray down −z at (1, 0.5) meets it
+        // at z = √0.5, where the normal is ∝ (x/4, y, z).
+        let xf = Transform::scale(DVec3::new(2.0, 1.0, 1.0)).unwrap();
+        let prim = Primitive::new(
+            &Geometry::Sphere {
+                center: DVec3::ZERO,
+                radius: 1.0,
+            },
+            &xf,
+            0,
+        )
+        .unwrap();
+        assert!(prim.object.is_some());
+        let z = 0.5f32.sqrt();
+        let h = prim
+            .intersect(&ray([1.0, 0.5, 5.0], [0.0, 0.0, -1.0]), f32::INFINITY)
+            .unwrap();
+        let expected = Vec3A::new(0.25, 0.5, z).normalize();
+        assert!((h.normal - expected).length() < 1e-5, "{:?}", h.normal);
+        assert!((h.t - (5.0 - z)).abs() < 1e-5);
+    }
+
+    #[test]
+    fn rotated_box_keeps_its_matrix_and_bounds_cover_it() {
+        let xf = Transform::rotate(45.0, DVec3::Z).unwrap();
+        let prim = Primitive::new(
+            &Geometry::Box {
+                p1: DVec3::splat(-1.0),
+                p2: DVec3::splat(1.0),
+            },
+            &xf,
+            0,
+        )
+        .unwrap();
+        assert!(prim.object.is_some());
+        assert!((prim.bounds.max.x - 2.0f32.sqrt()).abs() < 1e-5);
+        // The rotated corner sits on the +x axis at √2.
+        let h = prim
+            .intersect(&ray([5.0, 0.0, 0.0], [-1.0, 0.0, 0.0]), f32::INFINITY)
+            .unwrap();
+        assert!((h.t - (5.0 - 2.0f32.sqrt())).abs() < 1e-4);
+    }
+}

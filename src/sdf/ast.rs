@@ -1,0 +1,232 @@
+//! SDF statements as parsed, each with its source location, and their canonical text form.
+//! Variants accepted by the reader (DIALECT.md) are normalised into these canonical
+//! statements, so writing a statement list back out gives a plain-dialect file that loads to
+//! the same scene.
+
+use crate::diag::Loc;
+use crate::scene::Geometry;
+use glam::{DVec3, Vec3};
+use std::fmt;
+
+/// A name used to refer to something defined elsewhere, kept with where it was written.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NameRef {
+    pub name: String,
+    pub loc: Loc,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Statement {
+    pub kind: StatementKind,
+    /// Where the statement starts (its first token).
+    pub loc: Loc,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum StatementKind {
+    Material(MaterialDef),
+    Shape {
+        name: String,
+        geometry: Geometry,
+        material: NameRef,
+    },
+    Composite {
+        name: String,
+        children: Vec<NameRef>,
+    },
+    Light(LightDef),
+    /// Sets the scene's ambient light.
+    Ambient(Vec3),
+    /// Adds to the scene's ambient light (the lecture form `light [pos] [La] [Ld]`).
+    AmbientAdd(Vec3),
+    Background(Vec3),
+    Camera(CameraDef),
+    Transform {
+        target: NameRef,
+        ops: Vec<TransformOp>,
+    },
+    Render(RenderDef),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialDef {
+    pub name: String,
+    pub ka: Vec3,
+    pub kd: Vec3,
+    pub ks: Vec3,
+    pub m: f32,
+    pub reflectivity: f32,
+    pub opacity: f32,
+    pub ior: f32,
+}
+
+/// A point light; intensity = brightness · colour.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightDef {
+    pub name: String,
+    pub position: DVec3,
+    pub color: Vec3,
+    pub brightness: f32,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraDef {
+    pub name: String,
+    pub fov_x_deg: f64,
+    pub eye: DVec3,
+    pub dir: DVec3,
+    pub up: DVec3,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TransformOp {
+    Translate(DVec3),
+    /// Degrees about an axis (any length but zero).
+    Rotate {
+        degrees: f64,
+        axis: DVec3,
+    },
+    Scale(DVec3),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderDef {
+    pub camera: NameRef,
+    pub output: String,
+    pub width: u32,
+    pub height: u32,
+    pub samples: Option<u32>,
+}
+
+/// Shortest decimal text that reads back to the same value.
+struct Num(f64);
+
+impl fmt::Display for Num {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.0 == 0.0 {
+            write!(f, "0")
+        } else {
+            write!(f, "{}", self.0)
+        }
+    }
+}
+
+fn v3(v: DVec3) -> String {
+    format!("{} {} {}", Num(v.x), Num(v.y), Num(v.z))
+}
+
+fn c3(v: Vec3) -> String {
+    format!(
+        "{} {} {}",
+        Num(v.x as f64),
+        Num(v.y as f64),
+        Num(v.z as f64)
+    )
+}
+
+impl fmt::Display for StatementKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            StatementKind::Material(m) => write!(
+                f,
+                "define material {} {} {} {} {} {} {} {}",
+                m.name,
+                c3(m.ka),
+                c3(m.kd),
+                c3(m.ks),
+                Num(m.m as f64),
+                Num(m.reflectivity as f64),
+                Num(m.opacity as f64),
+                Num(m.ior as f64)
+            ),
+            StatementKind::Shape {
+                name,
+                geometry,
+                material,
+            } => {
+                let body = match geometry {
+                    Geometry::Sphere { center, radius } => {
+                        format!("sphere {name} {} {}", v3(*center), Num(*radius))
+                    }
+                    Geometry::Box { p1, p2 } => format!("box {name} {} {}", v3(*p1), v3(*p2)),
+                    Geometry::Plane { point, normal } => {
+                        format!("plane {name} {} {}", v3(*point), v3(*normal))
+                    }
+                    Geometry::Triangle {
+                        vertices: [a, b, c],
+                    } => {
+                        format!("triangle {name} {} {} {}", v3(*a), v3(*b), v3(*c))
+                    }
+                    Geometry::Cylinder { p1, p2, radius } => {
+                        format!("cylinder {name} {} {} {}", v3(*p1), v3(*p2), Num(*radius))
+                    }
+                    Geometry::Cone { base, tip, radius } => {
+                        format!("cone {name} {} {} {}", v3(*base), v3(*tip), Num(*radius))
+                    }
+                };
+                write!(f, "define shape {body} {}", material.name)
+            }
+            StatementKind::Composite { name, children } => {
+                write!(f, "define shape composite {name}")?;
+                for c in children {
+                    write!(f, " {}", c.name)?;
+                }
+                Ok(())
+            }
+            StatementKind::Light(l) => write!(
+                f,
+                "define light {} {} {} {}",
+                l.name,
+                v3(l.position),
+                c3(l.color),
+                Num(l.brightness as f64)
+            ),
+            StatementKind::Ambient(rgb) => write!(f, "ambient {}", c3(*rgb)),
+            // There is no canonical "add" statement: a light named like this with zero
+            // intensity in the lecture's 9-number form carries the ambient contribution.
+            StatementKind::AmbientAdd(rgb) => {
+                write!(f, "define light ambient-term 0 0 0 {} 0 0 0", c3(*rgb))
+            }
+            StatementKind::Background(rgb) => write!(f, "background {}", c3(*rgb)),
+            StatementKind::Camera(c) => write!(
+                f,
+                "define camera {} {} {} {} {}",
+                c.name,
+                Num(c.fov_x_deg),
+                v3(c.eye),
+                v3(c.dir),
+                v3(c.up)
+            ),
+            StatementKind::Transform { target, ops } => {
+                write!(f, "transform {}", target.name)?;
+                for op in ops {
+                    match op {
+                        TransformOp::Translate(v) => write!(f, " translate {}", v3(*v))?,
+                        TransformOp::Rotate { degrees, axis } => {
+                            write!(f, " rotate {} {}", Num(*degrees), v3(*axis))?
+                        }
+                        TransformOp::Scale(s) => write!(f, " scale {}", v3(*s))?,
+                    }
+                }
+                Ok(())
+            }
+            StatementKind::Render(r) => {
+                write!(
+                    f,
+                    "render {} {} {} {}",
+                    r.camera.name, r.output, r.width, r.height
+                )?;
+                if let Some(s) = r.samples {
+                    write!(f, " {s}")?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+impl fmt::Display for Statement {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.kind.fmt(f)
+    }
+}

@@ -1,0 +1,73 @@
+//! The closed set of primitives. Each works in its own object space; `Primitive` (in
+//! `crate::render::compile`) pairs one with an optional transform.
+//!
+//! Contract shared by every primitive:
+//! - `intersect(ray, t_max)` returns the nearest hit with `0 < t < t_max`, where the ray
+//!   direction need not be unit length (t is in the caller's units);
+//! - the returned `point` lies on the surface (re-projected where the shape allows), and
+//!   `normal` is the geometric normal there, pointing outwards for closed shapes, not
+//!   necessarily unit length;
+//! - `bounds()` is a conservative object-space box (infinite for the plane).
+
+mod aabox;
+mod cone;
+mod cylinder;
+mod plane;
+mod sphere;
+mod triangle;
+
+pub use aabox::AaBox;
+pub use cone::Cone;
+pub use cylinder::Cylinder;
+pub use plane::Plane;
+pub use sphere::Sphere;
+pub use triangle::Triangle;
+
+use crate::math::{Aabb, Ray};
+use glam::Vec3A;
+
+/// A hit in the shape's own space.
+#[derive(Clone, Copy, Debug)]
+pub struct ShapeHit {
+    pub t: f32,
+    pub point: Vec3A,
+    pub normal: Vec3A,
+}
+
+#[derive(Clone, Debug)]
+pub enum Shape {
+    Sphere(Sphere),
+    Box(AaBox),
+    Plane(Plane),
+    Triangle(Triangle),
+    Cylinder(Cylinder),
+    Cone(Cone),
+}
+
+impl Shape {
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
+        match self {
+            Shape::Sphere(s) => s.intersect(ray, t_max),
+            Shape::Box(s) => s.intersect(ray, t_max),
+            Shape::Plane(s) => s.intersect(ray, t_max),
+            Shape::Triangle(s) => s.intersect(ray, t_max),
+            Shape::Cylinder(s) => s.intersect(ray, t_max),
+            Shape::Cone(s) => s.intersect(ray, t_max),
+        }
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        match self {
+            Shape::Sphere(s) => s.bounds(),
+            Shape::Box(s) => s.bounds(),
+            Shape::Plane(_) => Aabb {
+                min: Vec3A::NEG_INFINITY,
+                max: Vec3A::INFINITY,
+            },
+            Shape::Triangle(s) => s.bounds(),
+            Shape::Cylinder(s) => s.bounds(),
+            Shape::Cone(s) => s.bounds(),
+        }
+    }
+}

@@ -1,0 +1,62 @@
+use super::ShapeHit;
+use crate::math::Ray;
+use glam::Vec3A;
+
+/// Infinite plane through `point` with unit `normal`.
+#[derive(Clone, Debug)]
+pub struct Plane {
+    pub point: Vec3A,
+    pub normal: Vec3A,
+}
+
+impl Plane {
+    pub fn new(point: Vec3A, normal: Vec3A) -> Option<Self> {
+        let normal = normal.try_normalize()?;
+        point.is_finite().then_some(Plane { point, normal })
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
+        let denom = ray.dir.dot(self.normal);
+        if denom == 0.0 {
+            return None;
+        }
+        let t = (self.point - ray.origin).dot(self.normal) / denom;
+        if !(t > 0.0 && t < t_max) {
+            return None;
+        }
+        let p = ray.at(t);
+        // Remove the error along the normal: the point lies on the plane to f32 rounding.
+        let point = p - self.normal * (p - self.point).dot(self.normal);
+        Some(ShapeHit {
+            t,
+            point,
+            normal: self.normal,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hit_from_either_side_and_parallel_miss() {
+        let p = Plane::new(Vec3A::new(0.0, -1.0, 0.0), Vec3A::new(0.0, 2.0, 0.0)).unwrap();
+        let h = p
+            .intersect(&Ray::new(Vec3A::ZERO, -Vec3A::Y), f32::INFINITY)
+            .unwrap();
+        assert_eq!(h.t, 1.0);
+        assert_eq!(h.normal, Vec3A::Y);
+        assert!(p
+            .intersect(
+                &Ray::new(Vec3A::new(0.0, -2.0, 0.0), Vec3A::Y),
+                f32::INFINITY
+            )
+            .is_some());
+        assert!(p
+            .intersect(&Ray::new(Vec3A::ZERO, Vec3A::X), f32::INFINITY)
+            .is_none());
+        assert!(Plane::new(Vec3A::ZERO, Vec3A::ZERO).is_none());
+    }
+}
