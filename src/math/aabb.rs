@@ -107,11 +107,10 @@ impl Aabb {
 pub(crate) fn slabs(min: Vec3A, max: Vec3A, origin: Vec3A, inv_dir: Vec3A) -> (Vec3A, Vec3A) {
     let t0 = (min - origin) * inv_dir;
     let t1 = (max - origin) * inv_dir;
-    let near = t0.min(t1);
-    let far = t0.max(t1);
+    let on_plane = t0.is_nan_mask() | t1.is_nan_mask();
     (
-        Vec3A::select(near.is_nan_mask(), Vec3A::NEG_INFINITY, near),
-        Vec3A::select(far.is_nan_mask(), Vec3A::INFINITY, far),
+        Vec3A::select(on_plane, Vec3A::NEG_INFINITY, t0.min(t1)),
+        Vec3A::select(on_plane, Vec3A::INFINITY, t0.max(t1)),
     )
 }
 
