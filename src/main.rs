@@ -1,8 +1,85 @@
+use anim::cli::{Cli, Command, RenderArgs};
+use anim::render::{self, RenderSettings};
 use clap::Parser;
 use std::process::ExitCode;
+use std::time::Instant;
 
 fn main() -> ExitCode {
-    let cli = anim::cli::Cli::parse();
-    let _ = cli;
-    ExitCode::SUCCESS
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Render(args) => with_threads(args.threads, || render_command(&args)),
+        // WIRING PENDING (helpers' functions land shortly).
+        Command::Check(_) | Command::Generate(_) => ExitCode::FAILURE,
+        Command::Bench(args) => anim::bench::run(&args),
+    }
+}
+
+/// Runs `f` on a rayon pool of `threads` workers (default: one per core).
+fn with_threads(threads: Option<u32>, f: impl FnOnce() -> ExitCode + Send) -> ExitCode {
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        builder = builder.num_threads(n as usize);
+    }
+    match builder.build() {
+        Ok(pool) => pool.install(f),
+        Err(e) => {
+            eprintln!("error: cannot start worker threads: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+pub fn settings_from(args: &RenderArgs) -> RenderSettings {
+    RenderSettings {
+        spp: args.spp,
+        width: args.width,
+        height: args.height,
+        max_depth: args.max_depth,
+        ppm_ascii: args.ppm_ascii,
+        out_dir: args.out.clone(),
+    }
+}
+
+fn render_command(args: &RenderArgs) -> ExitCode {
+    let settings = settings_from(args);
+    let load = args.scene.load_options();
+    let mut failed = false;
+    for input in &args.inputs {
+        if input.is_dir() {
+            failed = true;
+            continue;
+        }
+        let start = Instant::now();
+        match render::render_file(input, &load, &settings, !args.quiet) {
+            Ok(outcome) => {
+                if !args.quiet {
+                    for w in &outcome.warnings {
+                        eprintln!("{w}");
+                    }
+                    let secs = start.elapsed().as_secs_f64();
+                    for out in &outcome.outputs {
+                        eprintln!("wrote {}", out.display());
+                    }
+                    eprintln!(
+                        "{}: {} image(s) in {:.2} s, {:.1} Mrays/s",
+                        input.display(),
+                        outcome.outputs.len(),
+                        secs,
+                        outcome.rays.total() as f64 / secs.max(1e-9) / 1e6
+                    );
+                }
+            }
+            Err(diagnostics) => {
+                failed = true;
+                for d in diagnostics.iter().filter(|d| !args.quiet || d.is_error()) {
+                    eprintln!("{d}");
+                }
+            }
+        }
+    }
+    if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
 }

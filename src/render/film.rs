@@ -1,0 +1,183 @@
+//! From HDR radiance to files: `c/(c+1)` tone mapping, `round(255·c)`, PNG/PPM encoding and
+//! atomic writes (a reader never sees a half-written image).
+
+use super::HdrImage;
+use std::fs;
+use std::io::{self, BufWriter, Write};
+use std::path::Path;
+
+/// SPEC.md §1.5: `c_ldr = c_hdr / (c_hdr + 1)`, stored as `round(255·c_ldr)`. Negative or
+/// non-finite input (which the renderer never produces) maps to 0 rather than wrapping.
+#[inline]
+pub fn tone_map_u8(c: f32) -> u8 {
+    if !(c > 0.0) {
+        return 0;
+    }
+    if c == f32::INFINITY {
+        return 255;
+    }
+    (255.0 * (c / (c + 1.0))).round() as u8
+}
+
+/// 8-bit RGB, row-major from the top row.
+pub fn to_rgb8(img: &HdrImage) -> Vec<u8> {
+    img.pixels
+        .iter()
+        .flat_map(|p| [tone_map_u8(p.x), tone_map_u8(p.y), tone_map_u8(p.z)])
+        .collect()
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    Png,
+    PpmBinary,
+    PpmAscii,
+    Other(image::ImageFormat),
+}
+
+impl ImageFormat {
+    /// The format for a file name, by its extension (case-insensitive).
+    pub fn for_path(path: &Path, ppm_ascii: bool) -> Option<ImageFormat> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "png" => Some(ImageFormat::Png),
+            "ppm" if ppm_ascii => Some(ImageFormat::PpmAscii),
+            "ppm" => Some(ImageFormat::PpmBinary),
+            _ => image::ImageFormat::from_extension(&ext)
+                .filter(|f| f.writing_enabled())
+                .map(ImageFormat::Other),
+        }
+    }
+}
+
+/// Extensions users may write, for error messages.
+pub const KNOWN_EXTENSIONS: &str = ".png, .ppm, .pgm, .pnm, .bmp, .jpg, .tga";
+
+fn encode(
+    out: &mut impl Write,
+    rgb: &[u8],
+    width: u32,
+    height: u32,
+    format: ImageFormat,
+) -> io::Result<()> {
+    use image::ImageEncoder;
+    let to_io = |e: image::ImageError| io::Error::other(e.to_string());
+    match format {
+        ImageFormat::Png => {
+            // Fast compression: at 120 frames, deflate effort is a real share of the run.
+            let enc = image::codecs::png::PngEncoder::new_with_quality(
+                out,
+                image::codecs::png::CompressionType::Fast,
+                image::codecs::png::FilterType::Adaptive,
+            );
+            enc.write_image(rgb, width, height, image::ExtendedColorType::Rgb8)
+                .map_err(to_io)
+        }
+        ImageFormat::PpmBinary => {
+            write!(out, "P6\n{width} {height}\n255\n")?;
+            out.write_all(rgb)
+        }
+        ImageFormat::PpmAscii => {
+            write!(out, "P3\n{width} {height}\n255\n")?;
+            for row in rgb.chunks(width as usize * 3) {
+                let line: Vec<String> = row.iter().map(u8::to_string).collect();
+                writeln!(out, "{}", line.join(" "))?;
+            }
+            Ok(())
+        }
+        ImageFormat::Other(f) => {
+            let img = image::RgbImage::from_raw(width, height, rgb.to_vec())
+                .ok_or_else(|| io::Error::other("image buffer has the wrong size"))?;
+            let mut buf = io::Cursor::new(Vec::new());
+            img.write_to(&mut buf, f).map_err(to_io)?;
+            out.write_all(buf.get_ref())
+        }
+    }
+}
+
+/// Writes `contents` to `path` through a temporary file in the same directory and a rename,
+/// so that `path` either keeps its old contents or has the complete new ones.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<fs::File>) -> io::Result<()>,
+) -> io::Result<()> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    fs::create_dir_all(dir)?;
+    let name = path
+        .file_name()
+        .ok_or_else(|| io::Error::other("output path has no file name"))?;
+    let tmp = dir.join(format!(
+        ".{}.{}.tmp",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let result = (|| {
+        let mut w = BufWriter::new(fs::File::create(&tmp)?);
+        write(&mut w)?;
+        let file = w.into_inner().map_err(|e| e.into_error())?;
+        file.sync_data()?;
+        fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    result
+}
+
+pub fn write_image(path: &Path, img: &HdrImage, format: ImageFormat) -> io::Result<()> {
+    let rgb = to_rgb8(img);
+    write_atomically(path, |w| encode(w, &rgb, img.width, img.height, format))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn tone_mapping_values() {
+        assert_eq!(tone_map_u8(0.0), 0);
+        assert_eq!(tone_map_u8(1.0), 128); // 127.5 rounds away from zero
+        assert_eq!(tone_map_u8(3.0), 191); // 255·0.75 = 191.25
+        assert_eq!(tone_map_u8(f32::INFINITY), 255);
+        assert_eq!(tone_map_u8(f32::NAN), 0);
+        assert_eq!(tone_map_u8(-1.0), 0);
+    }
+
+    #[test]
+    fn formats_by_extension() {
+        assert_eq!(
+            ImageFormat::for_path(Path::new("a.PNG"), false),
+            Some(ImageFormat::Png)
+        );
+        assert_eq!(
+            ImageFormat::for_path(Path::new("a.ppm"), false),
+            Some(ImageFormat::PpmBinary)
+        );
+        assert_eq!(
+            ImageFormat::for_path(Path::new("a.ppm"), true),
+            Some(ImageFormat::PpmAscii)
+        );
+        assert_eq!(ImageFormat::for_path(Path::new("a"), false), None);
+        assert_eq!(ImageFormat::for_path(Path::new("a.xyz"), false), None);
+    }
+
+    #[test]
+    fn ppm_round_trip_and_no_temp_left() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.ppm");
+        let img = HdrImage {
+            width: 2,
+            height: 1,
+            pixels: vec![Vec3::new(1.0, 0.0, 3.0), Vec3::ZERO],
+        };
+        write_image(&path, &img, ImageFormat::PpmBinary).unwrap();
+        let bytes = fs::read(&path).unwrap();
+        assert_eq!(&bytes[..11], b"P6\n2 1\n255\n");
+        assert_eq!(&bytes[11..], &[128, 0, 191, 0, 0, 0]);
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+}

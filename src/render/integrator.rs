@@ -1,0 +1,187 @@
+//! Whitted-style shading: SPEC.md §4's local Phong model with hard shadows, mirror
+//! reflection and Fresnel refraction.
+
+use super::compile::{RenderScene, ShadeMaterial};
+use super::RayCounts;
+use crate::math::{reflect, spawn_ray, Ray};
+use glam::Vec3A;
+
+/// A ray whose contribution to the pixel is below half an 8-bit step cannot change the
+/// result: `c/(c+1)` has slope at most 1, so an HDR change `w·L_max` moves the output by at
+/// most that much.
+const NEGLIGIBLE: f32 = 0.5 / 255.0;
+/// Bound on surfaces a shadow ray may pass through (glass behind glass behind glass ...).
+const MAX_SHADOW_CROSSINGS: usize = 64;
+
+pub struct Integrator<'a> {
+    pub scene: &'a RenderScene,
+    pub max_depth: u32,
+}
+
+/// Fresnel reflectance of an unpolarised ray meeting a dielectric boundary, for the ratio
+/// `eta = η_incident / η_transmitted` and `cos_i` the cosine of the angle of incidence.
+/// Returns `(F, cos_t)`; `F = 1` under total internal reflection.
+pub fn fresnel(cos_i: f32, eta: f32) -> (f32, f32) {
+    let sin_t2 = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
+    if sin_t2 >= 1.0 {
+        return (1.0, 0.0);
+    }
+    let cos_t = (1.0 - sin_t2).sqrt();
+    let r_s = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let r_p = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    (0.5 * (r_s * r_s + r_p * r_p), cos_t)
+}
+
+impl Integrator<'_> {
+    /// Radiance arriving along `ray` (unit direction). `weight` is the ray's share of the
+    /// pixel, `depth` the number of bounces so far.
+    pub fn trace(&self, ray: &Ray, depth: u32, weight: f32, counts: &mut RayCounts) -> Vec3A {
+        let scene = self.scene;
+        let Some((prim, hit)) = scene.closest(ray, f32::INFINITY) else {
+            return scene.background;
+        };
+        let mat = &scene.materials[scene.prims[prim as usize].material as usize];
+        let entering = hit.normal.dot(ray.dir) < 0.0;
+        // Shading normal faces the incoming ray; the geometric one decides inside/outside.
+        let n = if entering { hit.normal } else { -hit.normal };
+        let local = self.local(mat, hit.point, n, -ray.dir, counts);
+        let (rho, alpha) = (mat.reflectivity, mat.opacity);
+        if rho == 0.0 && alpha == 1.0 {
+            return local;
+        }
+
+        // c = α·((1−ρ)·c_local + ρ·c_r) + (1−α)·(F·c_r + (1−F)·c_t)
+        let mut fresnel_f = 1.0;
+        let mut refracted = None;
+        if alpha < 1.0 {
+            let eta = if entering { 1.0 / mat.ior } else { mat.ior };
+            let cos_i = -ray.dir.dot(n);
+            let (f, cos_t) = fresnel(cos_i, eta);
+            fresnel_f = f;
+            if f < 1.0 {
+                refracted = Some((ray.dir * eta + n * (eta * cos_i - cos_t)).normalize());
+            }
+        }
+        let w_reflect = alpha * rho + (1.0 - alpha) * fresnel_f;
+        let w_refract = (1.0 - alpha) * (1.0 - fresnel_f);
+        let mut c = local * (alpha * (1.0 - rho));
+        let can_recurse = depth < self.max_depth;
+        let worth =
+            |w: f32| can_recurse && w > 0.0 && weight * w * scene.max_radiance >= NEGLIGIBLE;
+        if worth(w_reflect) {
+            let dir = reflect(ray.dir, n);
+            counts.reflected += 1;
+            let r = spawn_ray(hit.point, hit.normal, dir);
+            c += self.trace(&r, depth + 1, weight * w_reflect, counts) * w_reflect;
+        }
+        if let Some(dir) = refracted.filter(|_| worth(w_refract)) {
+            counts.refracted += 1;
+            let r = spawn_ray(hit.point, hit.normal, dir);
+            c += self.trace(&r, depth + 1, weight * w_refract, counts) * w_refract;
+        }
+        c
+    }
+
+    /// `Ka·I_ambient + Σ vis·I·(Kd·max(N·L,0) + Ks·max(R·V,0)^m)`, specular only where N·L > 0.
+    #[inline]
+    fn local(
+        &self,
+        mat: &ShadeMaterial,
+        p: Vec3A,
+        n: Vec3A,
+        v: Vec3A,
+        counts: &mut RayCounts,
+    ) -> Vec3A {
+        let scene = self.scene;
+        let mut c = mat.ka * scene.ambient;
+        for light in &scene.lights {
+            let to_light = light.position - p;
+            let dist = to_light.length();
+            if dist == 0.0 {
+                continue;
+            }
+            let l = to_light / dist;
+            let n_dot_l = n.dot(l);
+            if n_dot_l <= 0.0 {
+                continue;
+            }
+            counts.shadow += 1;
+            let vis = self.visibility(p, n, l, dist);
+            if vis == 0.0 {
+                continue;
+            }
+            let r = reflect(-l, n);
+            let spec = r.dot(v).max(0.0).powf(mat.m);
+            c += light.intensity * vis * (mat.kd * n_dot_l + mat.ks * spec);
+        }
+        c
+    }
+
+    /// Fraction of a light's intensity reaching `p`: 0 behind an opaque object, attenuated by
+    /// (1 − α) for every transparent surface crossed (shadow rays are not refracted).
+    fn visibility(&self, p: Vec3A, n: Vec3A, l: Vec3A, dist: f32) -> f32 {
+        let scene = self.scene;
+        let mut ray = spawn_ray(p, n, l);
+        let mut remaining = (p + l * dist - ray.origin).dot(l);
+        if !scene.any_transparent {
+            return if scene.occluded(&ray, remaining) {
+                0.0
+            } else {
+                1.0
+            };
+        }
+        let mut transmit = 1.0;
+        for _ in 0..MAX_SHADOW_CROSSINGS {
+            let Some((prim, hit)) = scene.closest(&ray, remaining) else {
+                return transmit;
+            };
+            let mat = &scene.materials[scene.prims[prim as usize].material as usize];
+            transmit *= 1.0 - mat.opacity;
+            if transmit == 0.0 {
+                return 0.0;
+            }
+            ray = spawn_ray(hit.point, hit.normal, l);
+            remaining = (p + l * dist - ray.origin).dot(l);
+            if remaining <= 0.0 {
+                return transmit;
+            }
+        }
+        transmit
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fresnel_at_normal_incidence() {
+        for ior in [1.0f32, 1.33, 1.5, 2.4] {
+            let (f, cos_t) = fresnel(1.0, 1.0 / ior);
+            let expected = ((ior - 1.0) / (ior + 1.0)).powi(2);
+            assert!((f - expected).abs() < 1e-6, "ior {ior}: {f} vs {expected}");
+            assert!((cos_t - 1.0).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn total_internal_reflection_beyond_the_critical_angle() {
+        let ior = 1.5f32;
+        let critical = (1.0 / ior).asin();
+        let just_inside = (critical - 0.01).cos();
+        let beyond = (critical + 0.01).cos();
+        assert!(fresnel(just_inside, ior).0 < 1.0);
+        assert_eq!(fresnel(beyond, ior).0, 1.0);
+    }
+
+    #[test]
+    fn fresnel_is_symmetric_and_rises_to_one_at_grazing() {
+        let (f_out, _) = fresnel(0.0001, 1.0 / 1.5);
+        assert!(f_out > 0.99);
+        // Same pair of angles from either side gives the same reflectance.
+        let cos_i = 0.8f32;
+        let (f1, cos_t) = fresnel(cos_i, 1.0 / 1.5);
+        let (f2, _) = fresnel(cos_t, 1.5);
+        assert!((f1 - f2).abs() < 1e-5);
+    }
+}

@@ -1,0 +1,102 @@
+//! Helpers shared by the integration tests: run the real `anim` binary on SDF text and read
+//! back the image it wrote.
+#![allow(dead_code)]
+
+use assert_cmd::Command;
+use std::path::{Path, PathBuf};
+
+pub struct Rgb8 {
+    pub width: usize,
+    pub height: usize,
+    pub data: Vec<u8>,
+}
+
+impl Rgb8 {
+    pub fn at(&self, x: usize, y: usize) -> [u8; 3] {
+        let i = (y * self.width + x) * 3;
+        [self.data[i], self.data[i + 1], self.data[i + 2]]
+    }
+}
+
+/// Reads a binary PPM (P6) as written by anim.
+pub fn read_ppm(path: &Path) -> Rgb8 {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut fields = Vec::new();
+    let mut pos = 0;
+    while fields.len() < 4 {
+        while bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        let start = pos;
+        while !bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        fields.push(String::from_utf8_lossy(&bytes[start..pos]).into_owned());
+    }
+    assert_eq!(fields[0], "P6");
+    let width: usize = fields[1].parse().unwrap();
+    let height: usize = fields[2].parse().unwrap();
+    let data = bytes[pos + 1..].to_vec();
+    assert_eq!(data.len(), width * height * 3);
+    Rgb8 {
+        width,
+        height,
+        data,
+    }
+}
+
+pub fn anim() -> Command {
+    Command::cargo_bin("anim").expect("the anim binary is built")
+}
+
+/// Writes `sdf` to `dir/name` and renders it with `args`, images into `dir/out`.
+/// Returns the path of the output directory.
+pub fn render_in(dir: &Path, name: &str, sdf: &str, args: &[&str]) -> PathBuf {
+    let scene = dir.join(name);
+    std::fs::write(&scene, sdf).unwrap();
+    let out = dir.join("out");
+    let assert = anim()
+        .arg("render")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .args(args)
+        .assert();
+    let output = assert.get_output();
+    assert!(
+        output.status.success(),
+        "anim render failed:\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    out
+}
+
+/// Renders `sdf` (which must write `image.ppm`) and reads the image.
+pub fn render_ppm(sdf: &str, args: &[&str]) -> Rgb8 {
+    let dir = tempfile::tempdir().unwrap();
+    let out = render_in(dir.path(), "scene.sdf", sdf, args);
+    read_ppm(&out.join("image.ppm"))
+}
+
+/// `round(255·c/(c+1))`, written out independently of the renderer's own code.
+pub fn expected_u8(c: f64) -> u8 {
+    (255.0 * c / (c + 1.0)).round() as u8
+}
+
+/// Largest per-channel difference and how many pixels differ at all.
+pub fn compare(a: &Rgb8, b: &Rgb8) -> (u8, usize) {
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let mut max = 0u8;
+    let mut differing = 0;
+    for (pa, pb) in a.data.chunks(3).zip(b.data.chunks(3)) {
+        let d = pa
+            .iter()
+            .zip(pb)
+            .map(|(x, y)| x.abs_diff(*y))
+            .max()
+            .unwrap_or(0);
+        max = max.max(d);
+        differing += usize::from(d > 0);
+    }
+    (max, differing)
+}
