@@ -19,13 +19,13 @@ fn unit(a: V) -> V {
 
 const SPHERE_SCENE: &str = "\
 define material m 0.1 0.2 0.3 0.5 0.4 0.3 0.3 0.3 0.3 10
-define material floor 0.2 0.3 0.4 0.6 0.6 0.6 0 0 0 1
+define material floor 0.2 0.3 0.44 0.6 0.6 0.6 0 0 0 1
 define shape sphere ball 0 0 -10 2 m
 define shape box ground -50 -4 -60 50 -3 5 floor
 define light sun 0 20 -10 1 1 1 2
 define light side 10 10 0 1 0.5 0.25 1.5
 ambient 0.5 0.5 0.5
-background 0.2 0.4 0.6
+background 0.25 0.4 0.6
 define camera eye 60
 render eye image.ppm 101 101
 ";
@@ -87,9 +87,9 @@ fn shadowed_point_is_ambient_only_and_background_is_background() {
             "test geometry: {light:?} is not occluded"
         );
     }
-    let ambient_only = [0.2 * 0.5, 0.3 * 0.5, 0.4 * 0.5].map(expected_u8);
+    let ambient_only = [0.2 * 0.5, 0.3 * 0.5, 0.44 * 0.5].map(expected_u8);
     assert_eq!(img.at(50, 72), ambient_only);
-    let background = [0.2, 0.4, 0.6].map(expected_u8);
+    let background = [0.25, 0.4, 0.6].map(expected_u8);
     assert_eq!(img.at(0, 0), background);
     assert_eq!(img.at(100, 0), background);
 }

@@ -117,8 +117,9 @@ pub fn write_atomically(
     let result = (|| {
         let mut w = BufWriter::new(fs::File::create(&tmp)?);
         write(&mut w)?;
-        let file = w.into_inner().map_err(|e| e.into_error())?;
-        file.sync_data()?;
+        // No fsync: the rename already guarantees that an interrupted process never leaves a
+        // partial image under the final name, and syncing every frame costs ~0.1 s each.
+        w.into_inner().map_err(|e| e.into_error())?;
         fs::rename(&tmp, path)
     })();
     if result.is_err() {
