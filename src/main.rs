@@ -8,8 +8,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Render(args) => with_threads(args.threads, || render_command(&args)),
-        // WIRING PENDING (helpers' functions land shortly).
-        Command::Check(_) | Command::Generate(_) => ExitCode::FAILURE,
+        Command::Check(args) => {
+            anim::sdf::check_paths(&args.inputs, &args.scene.load_options(), args.quiet)
+        }
+        Command::Generate(args) => anim::anim::generate_command(&args),
         Command::Bench(args) => anim::bench::run(&args),
     }
 }
@@ -46,7 +48,9 @@ fn render_command(args: &RenderArgs) -> ExitCode {
     let mut failed = false;
     for input in &args.inputs {
         if input.is_dir() {
-            failed = true;
+            if anim::pipeline::render_dir(input, args) != ExitCode::SUCCESS {
+                failed = true;
+            }
             continue;
         }
         let start = Instant::now();

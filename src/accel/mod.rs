@@ -199,7 +199,8 @@ fn find_split(items: &mut [BuildItem], bounds: &Aabb) -> Option<(usize, usize)> 
     let parent_area = bounds.surface_area().max(f32::MIN_POSITIVE);
     let mut best: Option<(f32, usize, usize)> = None;
     for axis in 0..3 {
-        if !(extent[axis] > 0.0) || !extent[axis].is_finite() {
+        // Skips flat axes, and NaN or infinite extents alike.
+        if !(extent[axis].is_finite() && extent[axis] > 0.0) {
             continue;
         }
         let scale = BINS as f32 / extent[axis];

@@ -31,6 +31,15 @@ impl Ray {
 /// every coordinate*, so the error scales with the largest coordinate magnitude of the point
 /// (Wächter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing
 /// Gems ch. 6). Transformed shapes add the error of the matrix product, hence the margin.
+///
+/// Measured, not guessed (tests/robustness.rs; `offset_margin_sweep` spawns 2·10⁵ rays per
+/// shape kind with this offset scaled by 2⁻ᵏ, scales 1e-4…1e5, anisotropy ≤ 4, translations up
+/// to 30× the object size): the first self-intersections appear at 1/8 of this offset for
+/// spheres (so a 4× margin, the tightest), 1/16 for cylinders, 1/32 for boxes, planes and
+/// cones, 1/64 for triangles; at full size 6·10⁶ rays (10⁶ per kind) re-hit nothing. In the
+/// other direction, a sphere resting on a plane or box lies ≥ 5.3× this offset above the
+/// surface 2 % of its radius from the contact point (`contact_shadows_reach_the_resting_sphere`),
+/// so contact shadows stay closed. Hence left as it is.
 const ORIGIN_ERROR_SCALE: f32 = 1.0 / 4096.0 * (1.0 / 32.0);
 /// Floor for points near the origin, where a relative bound would collapse to nothing.
 const ORIGIN_ERROR_FLOOR: f32 = 1.0 / 65536.0 / 1024.0;

@@ -10,7 +10,7 @@ use std::path::Path;
 /// non-finite input (which the renderer never produces) maps to 0 rather than wrapping.
 #[inline]
 pub fn tone_map_u8(c: f32) -> u8 {
-    if !(c > 0.0) {
+    if c.is_nan() || c <= 0.0 {
         return 0;
     }
     if c == f32::INFINITY {

@@ -15,8 +15,14 @@ pub struct SurfaceHit {
     pub normal: Vec3A,
 }
 
+/// The object-space side of a transformed primitive. Rays are moved relative to `anchor`
+/// (the centre of the world bounds) before the f32 matrix is applied: for a small object far
+/// from the origin, `o − anchor` is small and exact where `o` alone would lose the digits
+/// that matter.
 #[derive(Clone, Debug)]
 struct ObjectSpace {
+    anchor: Vec3A,
+    /// `object_from_world` with its translation re-based on the anchor: `L·(o − a) + (L·a + t)`.
     object_from_world: Affine3A,
     world_from_object: Affine3A,
     normal_to_world: Mat3A,
@@ -92,8 +98,18 @@ impl Primitive {
             Some(shape) => (shape, None),
             None => {
                 let shape = make_shape(geometry, &Transform::IDENTITY)?;
+                let local = shape.bounds();
+                let anchor = if local.is_finite() {
+                    xf.point(local.centroid().as_dvec3())
+                } else {
+                    xf.point(DVec3::ZERO)
+                };
+                let mut rebased = xf.object_from_world;
+                // Composed in f64, so the object-space anchor keeps its precision.
+                rebased.w_axis = xf.object_from_world.transform_point3(anchor).extend(1.0);
                 let object = ObjectSpace {
-                    object_from_world: Affine3A::from_mat4(xf.object_from_world.as_mat4()),
+                    anchor: f(anchor),
+                    object_from_world: Affine3A::from_mat4(rebased.as_mat4()),
                     world_from_object: Affine3A::from_mat4(xf.world_from_object.as_mat4()),
                     normal_to_world: Mat3A::from(xf.normal_matrix().as_mat3()),
                 };
@@ -125,7 +141,7 @@ impl Primitive {
             None => self.shape.intersect(ray, t_max),
             Some(o) => {
                 let local = Ray::new(
-                    o.object_from_world.transform_point3a(ray.origin),
+                    o.object_from_world.transform_point3a(ray.origin - o.anchor),
                     o.object_from_world.transform_vector3a(ray.dir),
                 );
                 self.shape.intersect(&local, t_max)

@@ -1,7 +1,8 @@
 //! SDF statements as parsed, each with its source location, and their canonical text form.
 //! Variants accepted by the reader (DIALECT.md) are normalised into these canonical
 //! statements, so writing a statement list back out gives a plain-dialect file that loads to
-//! the same scene.
+//! the same scene (read with the default `--material-fields`, as materials are written with
+//! all three extras: reflectivity, opacity, ior).
 
 use crate::diag::Loc;
 use crate::scene::Geometry;
@@ -115,13 +116,22 @@ fn v3(v: DVec3) -> String {
     format!("{} {} {}", Num(v.x), Num(v.y), Num(v.z))
 }
 
+/// Shortest decimal text that reads back to the same `f32` (`0.1`, not the `f64` expansion
+/// `0.10000000149011612` of the same value): the reader parses in `f64` and rounds to `f32`.
+struct Num32(f32);
+
+impl fmt::Display for Num32 {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.0 == 0.0 {
+            write!(f, "0")
+        } else {
+            write!(f, "{}", self.0)
+        }
+    }
+}
+
 fn c3(v: Vec3) -> String {
-    format!(
-        "{} {} {}",
-        Num(v.x as f64),
-        Num(v.y as f64),
-        Num(v.z as f64)
-    )
+    format!("{} {} {}", Num32(v.x), Num32(v.y), Num32(v.z))
 }
 
 impl fmt::Display for StatementKind {
@@ -134,10 +144,10 @@ impl fmt::Display for StatementKind {
                 c3(m.ka),
                 c3(m.kd),
                 c3(m.ks),
-                Num(m.m as f64),
-                Num(m.reflectivity as f64),
-                Num(m.opacity as f64),
-                Num(m.ior as f64)
+                Num32(m.m),
+                Num32(m.reflectivity),
+                Num32(m.opacity),
+                Num32(m.ior)
             ),
             StatementKind::Shape {
                 name,
@@ -179,7 +189,7 @@ impl fmt::Display for StatementKind {
                 l.name,
                 v3(l.position),
                 c3(l.color),
-                Num(l.brightness as f64)
+                Num32(l.brightness)
             ),
             StatementKind::Ambient(rgb) => write!(f, "ambient {}", c3(*rgb)),
             // There is no canonical "add" statement: a light named like this with zero

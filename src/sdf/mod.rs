@@ -1,9 +1,22 @@
 //! The SDF reader: text → statements with source locations → scene description.
-//! PLACEHOLDER API: the SDF helper implements `parse` and `build` (see DIALECT.md).
+//!
+//! [`parse`] reads the text line by line into canonical [`ast::Statement`]s, normalising
+//! every dialect variant of DIALECT.md; [`build`] resolves names, composes transforms,
+//! flattens the composite tree and makes one [`RenderJob`] per `render` statement.
+//! [`load_str`] does both. Every problem is a [`Diagnostic`] with file, line and column;
+//! warnings let loading go on, errors stop it (`--strict` makes every warning an error).
 
 pub mod ast;
+mod build;
+mod check;
+mod lexer;
+mod parser;
+#[cfg(test)]
+mod tests;
 
-use crate::diag::Diagnostic;
+pub use check::check_paths;
+
+use crate::diag::{Diagnostic, Severity};
 use crate::scene::RenderJob;
 use std::path::Path;
 
@@ -68,9 +81,63 @@ pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnost
     load_str(&String::from_utf8_lossy(&text), path, opts)
 }
 
-pub fn load_str(_text: &str, path: &Path, _opts: &LoadOptions) -> Result<Loaded, Vec<Diagnostic>> {
-    Err(vec![Diagnostic::file_error(
-        path,
-        "SDF reader not implemented yet",
-    )])
+/// Reads a file's text into canonical statements (every dialect variant normalised), with
+/// the problems met. Statements with errors are left out; with `opts.strict`, warnings are
+/// reported as errors.
+pub fn parse(
+    text: &str,
+    path: &Path,
+    opts: &LoadOptions,
+) -> (Vec<ast::Statement>, Vec<Diagnostic>) {
+    let parsed = parser::parse(text, path, opts);
+    (parsed.statements, finish(parsed.diagnostics, opts))
+}
+
+/// Builds the render jobs of a statement list (from [`parse`], or made by a program, whose
+/// values are then checked here). `Err` holds every diagnostic when at least one is an error.
+pub fn build(
+    statements: &[ast::Statement],
+    path: &Path,
+    opts: &LoadOptions,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    let (jobs, diagnostics) = build::build(statements, path, opts, None);
+    conclude(jobs, finish(diagnostics, opts))
+}
+
+/// Parses and builds a file's text. `Err` holds every diagnostic (warnings too) when at least
+/// one is an error.
+pub fn load_str(text: &str, path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnostic>> {
+    let parsed = parser::parse(text, path, opts);
+    let (jobs, built) = build::build(&parsed.statements, path, opts, Some(&parsed.source));
+    let mut diagnostics = parsed.diagnostics;
+    diagnostics.extend(built);
+    conclude(jobs, finish(diagnostics, opts))
+}
+
+fn conclude(jobs: Vec<RenderJob>, diagnostics: Vec<Diagnostic>) -> Result<Loaded, Vec<Diagnostic>> {
+    if diagnostics.iter().any(Diagnostic::is_error) {
+        Err(diagnostics)
+    } else {
+        Ok(Loaded { jobs, diagnostics })
+    }
+}
+
+/// Orders diagnostics by position (file-wide ones last) and applies `--strict`.
+fn finish(mut diagnostics: Vec<Diagnostic>, opts: &LoadOptions) -> Vec<Diagnostic> {
+    diagnostics.sort_by_key(|d| {
+        d.loc
+            .as_ref()
+            .map_or((u32::MAX, u32::MAX), |l| (l.line, l.col))
+    });
+    if opts.strict {
+        for d in &mut diagnostics {
+            if d.severity == Severity::Warning {
+                d.severity = Severity::Error;
+                if d.help.is_none() {
+                    d.help = Some("reported as an error because of --strict".to_string());
+                }
+            }
+        }
+    }
+    diagnostics
 }

@@ -28,6 +28,10 @@ impl Plane {
         let p = ray.at(t);
         // Remove the error along the normal: the point lies on the plane to f32 rounding.
         let point = p - self.normal * (p - self.point).dot(self.normal);
+        // Origins near f32::MAX overflow o + t·d; such a hit has no usable position.
+        if !point.is_finite() {
+            return None;
+        }
         Some(ShapeHit {
             t,
             point,
@@ -58,5 +62,12 @@ mod tests {
             .intersect(&Ray::new(Vec3A::ZERO, Vec3A::X), f32::INFINITY)
             .is_none());
         assert!(Plane::new(Vec3A::ZERO, Vec3A::ZERO).is_none());
+    }
+
+    #[test]
+    fn overflowing_hit_point_is_no_hit() {
+        let p = Plane::new(Vec3A::ZERO, Vec3A::new(0.3, 1.0, 0.0)).unwrap();
+        let ray = Ray::new(Vec3A::new(0.0, 0.0, 2.23e38), Vec3A::new(0.0, -1.79, 0.0));
+        assert!(p.intersect(&ray, f32::INFINITY).is_none_or(|h| h.point.is_finite()));
     }
 }

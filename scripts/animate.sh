@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# The whole job in one command: build anim (release), generate the frames of a keyframe
+# spec, render them in parallel and encode the MP4.
+#
+#   scripts/animate.sh animations/orbit.ron [OUT.mp4]
+#
+# OUT defaults to animation.mp4. Frames go to frames/<spec name>/ (override with FRAMES_DIR);
+# extra `anim render` options can be passed in ANIM_RENDER_ARGS, e.g.
+#   ANIM_RENDER_ARGS="--spp 16" scripts/animate.sh animations/orbit.ron
+# Re-running is cheap: unchanged frames are not rendered again.
+set -euo pipefail
+
+if [ $# -lt 1 ] || [ $# -gt 2 ]; then
+  echo "usage: $0 SPEC.ron [OUT.mp4]" >&2
+  exit 2
+fi
+spec=$1
+out=${2:-animation.mp4}
+root=$(cd "$(dirname "$0")/.." && pwd)
+
+if [ ! -f "$spec" ]; then
+  echo "error: $spec does not exist" >&2
+  exit 1
+fi
+# Fail before the long part if a tool is missing.
+if ! command -v cargo >/dev/null 2>&1; then
+  echo "error: cargo is not installed; install Rust from https://rustup.rs" >&2
+  exit 127
+fi
+if ! command -v ffmpeg >/dev/null 2>&1; then
+  echo "error: ffmpeg is not installed (Debian/Ubuntu: sudo apt-get install -y ffmpeg; macOS: brew install ffmpeg)" >&2
+  exit 127
+fi
+
+stem=$(basename -- "$spec")
+stem=${stem%.*}
+frames=${FRAMES_DIR:-frames/$stem}
+
+echo "==> building anim (release)"
+cargo build --release --quiet --manifest-path "$root/Cargo.toml"
+# The binary lives in cargo's target directory, wherever CARGO_TARGET_DIR or a config puts it.
+target_dir=$(cargo metadata --format-version 1 --no-deps --manifest-path "$root/Cargo.toml" |
+  sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p')
+anim="${target_dir:-$root/target}/release/anim"
+if [ ! -x "$anim" ]; then
+  echo "error: built anim not found at $anim" >&2
+  exit 1
+fi
+
+echo "==> generating $spec into $frames"
+"$anim" generate "$spec" -o "$frames"
+
+echo "==> rendering $frames"
+# shellcheck disable=SC2086  # ANIM_RENDER_ARGS is a list of options, split on purpose.
+"$anim" render "$frames" ${ANIM_RENDER_ARGS:-}
+
+echo "==> encoding $out"
+# The frame rate, as the generator wrote it in the first frame's header ("... at 24 fps").
+first_frame=$(find "$frames" -maxdepth 1 -name '*.sdf' | sort | head -n 1)
+fps=$(sed -n '1s/.* at \([0-9][0-9]*\) fps.*/\1/p' "$first_frame")
+"$root/scripts/encode.sh" "$frames" "$out" "${fps:-24}"

@@ -1,0 +1,289 @@
+//! Splitting SDF text into lines and tokens, and reading numbers.
+//!
+//! The language is line oriented: a line is a list of tokens separated by runs of whitespace,
+//! `#` starts a comment anywhere, and a line whose first token starts with `//` is a comment.
+//! Columns count characters from 1, so a caret can be placed under any token even in lines
+//! with non-ASCII names (`jklö`).
+
+/// Numbers beyond this magnitude are rejected: they are never meant, and squaring them (as
+/// ray/sphere tests do) would overflow to infinity in the renderer.
+pub const MAX_MAGNITUDE: f64 = 1e12;
+
+/// One whitespace-separated word of a line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Token<'a> {
+    pub text: &'a str,
+    /// 1-based column of the first character, counted in characters.
+    pub col: u32,
+    /// Length in characters.
+    pub width: u32,
+}
+
+/// A source line with its comments removed.
+#[derive(Clone, Debug)]
+pub struct Line<'a> {
+    /// 1-based line number.
+    pub number: u32,
+    /// The whole line as written, without its line ending.
+    pub text: &'a str,
+    pub tokens: Vec<Token<'a>>,
+}
+
+impl Line<'_> {
+    /// The column just after the last token: where a missing argument would have gone.
+    pub fn end_col(&self) -> u32 {
+        self.tokens
+            .last()
+            .map_or(1, |t| t.col.saturating_add(t.width))
+    }
+}
+
+/// Splits a whole file into lines (LF or CRLF, final newline optional) and tokenizes each.
+/// A byte-order mark at the start of the file is ignored.
+pub fn lines(text: &str) -> Vec<Line<'_>> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut out = Vec::new();
+    let mut raw_lines = text.split('\n').peekable();
+    let mut number: u32 = 0;
+    while let Some(raw) = raw_lines.next() {
+        // `split` yields one empty piece after a final newline; it is not a line.
+        if raw.is_empty() && raw_lines.peek().is_none() {
+            break;
+        }
+        number = number.saturating_add(1);
+        let raw = raw.strip_suffix('\r').unwrap_or(raw);
+        out.push(Line {
+            number,
+            text: raw,
+            tokens: tokenize(raw),
+        });
+    }
+    out
+}
+
+/// The tokens of one line, comments removed.
+pub fn tokenize(line: &str) -> Vec<Token<'_>> {
+    let mut tokens = Vec::new();
+    let mut start: Option<(usize, u32)> = None;
+    let mut col: u32 = 0;
+    let mut end_byte = line.len();
+    for (i, ch) in line.char_indices() {
+        col = col.saturating_add(1);
+        if ch == '#' {
+            end_byte = i;
+            break;
+        }
+        if ch.is_whitespace() {
+            if let Some((s, c)) = start.take() {
+                tokens.push(make_token(line, s, i, c));
+            }
+        } else if start.is_none() {
+            start = Some((i, col));
+        }
+    }
+    if let Some((s, c)) = start {
+        tokens.push(make_token(line, s, end_byte, c));
+    }
+    // A line starting with `//` is a comment as a whole (`//define shape ...` included).
+    if tokens.first().is_some_and(|t| t.text.starts_with("//")) {
+        tokens.clear();
+    }
+    tokens
+}
+
+fn make_token(line: &str, start: usize, end: usize, col: u32) -> Token<'_> {
+    let text = &line[start..end];
+    Token {
+        text,
+        col,
+        width: u32::try_from(text.chars().count()).unwrap_or(u32::MAX),
+    }
+}
+
+/// Why a token is not an acceptable number.
+#[derive(Clone, Debug, PartialEq)]
+pub enum NumberError {
+    /// Not a number at all (`1O`, `abc`, `0x10`).
+    Malformed,
+    /// `nan`, `inf`, `infinity`: never accepted.
+    NotFinite,
+    /// A C-style suffix such as `1.0f`; carries the number without it.
+    Suffix(String),
+    /// A decimal comma (`1,5`); carries the number written with a point.
+    DecimalComma(String),
+    /// Finite but absurdly large (or overflowing to infinity, like `1e999`).
+    TooLarge,
+}
+
+/// Reads a finite decimal number: `1`, `-1.5`, `.5`, `-.5`, `+100`, `1e-3`, `1.`.
+pub fn parse_number(s: &str) -> Result<f64, NumberError> {
+    if is_decimal(s) {
+        let v: f64 = s.parse().map_err(|_| NumberError::Malformed)?;
+        if !v.is_finite() || v.abs() > MAX_MAGNITUDE {
+            return Err(NumberError::TooLarge);
+        }
+        return Ok(v);
+    }
+    let lower = s.to_ascii_lowercase();
+    let unsigned = lower.trim_start_matches(['+', '-']);
+    if matches!(unsigned, "nan" | "inf" | "infinity") {
+        return Err(NumberError::NotFinite);
+    }
+    if let Some(stem) = s.strip_suffix(['f', 'F', 'd', 'D']) {
+        if is_decimal(stem) {
+            return Err(NumberError::Suffix(stem.to_string()));
+        }
+    }
+    if s.matches(',').count() == 1 {
+        let dotted = s.replace(',', ".");
+        if is_decimal(&dotted) {
+            return Err(NumberError::DecimalComma(dotted));
+        }
+    }
+    Err(NumberError::Malformed)
+}
+
+/// Whether `s` has the shape of a decimal number (checked before calling `str::parse`, which
+/// would also accept `inf` and `nan`).
+fn is_decimal(s: &str) -> bool {
+    let b = s.as_bytes();
+    let mut i = 0;
+    if i < b.len() && (b[i] == b'+' || b[i] == b'-') {
+        i += 1;
+    }
+    let int_start = i;
+    while i < b.len() && b[i].is_ascii_digit() {
+        i += 1;
+    }
+    let mut digits = i - int_start;
+    if i < b.len() && b[i] == b'.' {
+        i += 1;
+        let frac_start = i;
+        while i < b.len() && b[i].is_ascii_digit() {
+            i += 1;
+        }
+        digits += i - frac_start;
+    }
+    if digits == 0 {
+        return false;
+    }
+    if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
+        i += 1;
+        if i < b.len() && (b[i] == b'+' || b[i] == b'-') {
+            i += 1;
+        }
+        let exp_start = i;
+        while i < b.len() && b[i].is_ascii_digit() {
+            i += 1;
+        }
+        if i == exp_start {
+            return false;
+        }
+    }
+    i == b.len()
+}
+
+/// Whether a token was probably meant as a number (even a malformed one such as `1O` or
+/// `nan`). Used to tell layouts apart, e.g. a material name written before the coordinates.
+pub fn looks_numeric(s: &str) -> bool {
+    let unsigned = s.trim_start_matches(['+', '-']);
+    let lower = unsigned.to_ascii_lowercase();
+    if matches!(lower.as_str(), "nan" | "inf" | "infinity") {
+        return true;
+    }
+    let mut chars = unsigned.chars();
+    match chars.next() {
+        Some(c) if c.is_ascii_digit() => true,
+        Some('.') => chars.next().is_some_and(|c| c.is_ascii_digit()),
+        _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn accepts_every_documented_number_form() {
+        for (text, value) in [
+            ("1", 1.0),
+            ("-1.5", -1.5),
+            (".5", 0.5),
+            ("-.5", -0.5),
+            ("+100", 100.0),
+            ("1e-3", 0.001),
+            ("2E+2", 200.0),
+            ("1.", 1.0),
+            ("000", 0.0),
+        ] {
+            assert_eq!(parse_number(text), Ok(value), "{text}");
+        }
+    }
+
+    #[test]
+    fn rejects_non_finite_and_malformed_numbers() {
+        assert_eq!(parse_number("1O"), Err(NumberError::Malformed));
+        assert_eq!(parse_number("nan"), Err(NumberError::NotFinite));
+        assert_eq!(parse_number("-inf"), Err(NumberError::NotFinite));
+        assert_eq!(parse_number("Infinity"), Err(NumberError::NotFinite));
+        assert_eq!(parse_number("0x10"), Err(NumberError::Malformed));
+        assert_eq!(parse_number("1e"), Err(NumberError::Malformed));
+        assert_eq!(parse_number("."), Err(NumberError::Malformed));
+        assert_eq!(parse_number("-"), Err(NumberError::Malformed));
+        assert_eq!(parse_number("1e999"), Err(NumberError::TooLarge));
+        assert_eq!(parse_number("1e13"), Err(NumberError::TooLarge));
+        assert_eq!(
+            parse_number("1.0f"),
+            Err(NumberError::Suffix("1.0".to_string()))
+        );
+        assert_eq!(
+            parse_number("1,5"),
+            Err(NumberError::DecimalComma("1.5".to_string()))
+        );
+    }
+
+    #[test]
+    fn numeric_looking_tokens() {
+        for t in ["1", "-1", ".5", "-.5", "1O", "nan", "-inf", "+3"] {
+            assert!(looks_numeric(t), "{t}");
+        }
+        for t in ["red", "image.ppm", ".ppm", ".", "x1", "-"] {
+            assert!(!looks_numeric(t), "{t}");
+        }
+    }
+
+    #[test]
+    fn tokens_carry_character_columns_and_comments_are_dropped() {
+        let toks = tokenize("  jklö\t12 # comment 3");
+        assert_eq!(
+            toks,
+            vec![
+                Token {
+                    text: "jklö",
+                    col: 3,
+                    width: 4
+                },
+                Token {
+                    text: "12",
+                    col: 8,
+                    width: 2
+                },
+            ]
+        );
+        assert!(tokenize("// define shape").is_empty());
+        assert!(tokenize("   //define shape").is_empty());
+        assert_eq!(tokenize("a#b").len(), 1);
+    }
+
+    #[test]
+    fn crlf_missing_final_newline_and_bom() {
+        let ls = lines("\u{feff}a b\r\nc\r\n\r\nd");
+        assert_eq!(ls.len(), 4);
+        assert_eq!(ls[0].text, "a b");
+        assert_eq!(ls[1].number, 2);
+        assert!(ls[2].tokens.is_empty());
+        assert_eq!(ls[3].tokens[0].text, "d");
+        assert_eq!(lines("a\n").len(), 1);
+        assert!(lines("").is_empty());
+    }
+}

@@ -1,0 +1,140 @@
+//! Every real-world scene file of `../shared/corpus/wild` either loads or is rejected with
+//! located errors, and none makes the reader panic.
+
+use anim::diag::Diagnostic;
+use anim::sdf::{load_file, LoadOptions};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+
+const CORPUS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/corpus/wild");
+
+fn files_below(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            files_below(&path, out);
+        } else if path.file_name().is_some_and(|n| n != "MANIFEST.tsv") {
+            out.push(path);
+        }
+    }
+}
+
+/// Whether a file-wide diagnostic (no line) is about reading the file rather than its text.
+fn is_io_problem(d: &Diagnostic) -> bool {
+    d.message.starts_with("cannot read")
+}
+
+#[test]
+fn every_corpus_file_loads_or_is_rejected_with_located_errors() {
+    let dir = Path::new(CORPUS);
+    if !dir.is_dir() {
+        println!("note: {CORPUS} not found; corpus test skipped");
+        return;
+    }
+    let mut files = Vec::new();
+    files_below(dir, &mut files);
+    files.sort();
+    assert!(!files.is_empty(), "the corpus folder holds no files");
+
+    let opts = LoadOptions::default();
+    let (mut loaded, mut rejected) = (Vec::new(), Vec::new());
+    let mut problems = Vec::new();
+    for file in &files {
+        let name = file.strip_prefix(dir).unwrap_or(file).display().to_string();
+        match catch_unwind(AssertUnwindSafe(|| load_file(file, &opts))) {
+            Err(_) => problems.push(format!("{name}: the reader panicked")),
+            Ok(Ok(l)) => loaded.push(format!(
+                "{name}: {} job(s), {} warning(s)",
+                l.jobs.len(),
+                l.diagnostics.len()
+            )),
+            Ok(Err(diagnostics)) => {
+                for d in diagnostics.iter().filter(|d| d.is_error()) {
+                    if d.loc.is_none() && !is_io_problem(d) {
+                        problems.push(format!("{name}: error without a location: {d}"));
+                    }
+                }
+                let first = diagnostics
+                    .iter()
+                    .find(|d| d.is_error())
+                    .map(|d| d.to_string().lines().next().unwrap_or_default().to_string())
+                    .unwrap_or_default();
+                rejected.push(format!("{name}: {first}"));
+            }
+        }
+    }
+    println!("loaded {} of {} files:", loaded.len(), files.len());
+    for l in &loaded {
+        println!("  {l}");
+    }
+    println!("rejected {}:", rejected.len());
+    for r in &rejected {
+        println!("  {r}");
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// The canonical text of every file that loads (statements written back with `Display`, as
+/// the animation generator does) loads to the same render jobs.
+#[test]
+fn canonical_text_of_corpus_files_loads_to_the_same_jobs() {
+    let dir = Path::new(CORPUS);
+    if !dir.is_dir() {
+        println!("note: {CORPUS} not found; corpus test skipped");
+        return;
+    }
+    let mut files = Vec::new();
+    files_below(dir, &mut files);
+    files.sort();
+    let opts = LoadOptions::default();
+    let mut compared = 0;
+    for file in &files {
+        let Ok(bytes) = std::fs::read(file) else {
+            continue;
+        };
+        let text = String::from_utf8_lossy(&bytes);
+        let Ok(original) = anim::sdf::load_str(&text, file, &opts) else {
+            continue;
+        };
+        let (statements, _) = anim::sdf::parse(&text, file, &opts);
+        let canonical: String = statements.iter().map(|s| format!("{s}\n")).collect();
+        let again = anim::sdf::load_str(&canonical, file, &opts).unwrap_or_else(|ds| {
+            panic!(
+                "{}: canonical text rejected:\n{}\n{canonical}",
+                file.display(),
+                ds.iter()
+                    .map(|d| d.to_string())
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            )
+        });
+        assert_eq!(original.jobs.len(), again.jobs.len(), "{}", file.display());
+        for (a, b) in original.jobs.iter().zip(&again.jobs) {
+            let name = file.display();
+            assert_eq!(a.camera, b.camera, "{name}");
+            assert_eq!(a.output, b.output, "{name}");
+            assert_eq!(
+                (a.width, a.height, a.samples),
+                (b.width, b.height, b.samples),
+                "{name}"
+            );
+            assert_eq!(a.scene.materials, b.scene.materials, "{name}");
+            assert_eq!(a.scene.lights, b.scene.lights, "{name}");
+            assert_eq!(a.scene.ambient, b.scene.ambient, "{name}");
+            assert_eq!(a.scene.background, b.scene.background, "{name}");
+            assert_eq!(a.scene.instances.len(), b.scene.instances.len(), "{name}");
+            for (x, y) in a.scene.instances.iter().zip(&b.scene.instances) {
+                assert_eq!(
+                    (&x.name, &x.geometry, x.material, x.transform),
+                    (&y.name, &y.geometry, y.material, y.transform),
+                    "{name}"
+                );
+            }
+        }
+        compared += 1;
+    }
+    println!("{compared} corpus files round-trip through their canonical text");
+}
