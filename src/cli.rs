@@ -1,5 +1,6 @@
 //! Command-line definitions (clap derive), resolved into configuration before any work starts.
 
+use crate::render::RenderSettings;
 use crate::sdf::{LoadOptions, MaterialField, TransformOrder};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
@@ -165,6 +166,20 @@ pub fn parse_material_fields(s: &str) -> Result<MaterialField, String> {
         other => Err(format!(
             "unknown material field '{other}' (expected reflectivity, opacity, transparency, ior or roughness)"
         )),
+    }
+}
+
+impl RenderArgs {
+    /// The settings that decide what the images look like and where they go.
+    pub fn settings(&self) -> RenderSettings {
+        RenderSettings {
+            spp: self.spp,
+            width: self.width,
+            height: self.height,
+            max_depth: self.max_depth,
+            ppm_ascii: self.ppm_ascii,
+            out_dir: self.out.clone(),
+        }
     }
 }
 

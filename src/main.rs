@@ -1,5 +1,5 @@
 use anim::cli::{Cli, Command, RenderArgs};
-use anim::render::{self, RenderSettings};
+use anim::render;
 use clap::Parser;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -31,19 +31,8 @@ fn with_threads(threads: Option<u32>, f: impl FnOnce() -> ExitCode + Send) -> Ex
     }
 }
 
-pub fn settings_from(args: &RenderArgs) -> RenderSettings {
-    RenderSettings {
-        spp: args.spp,
-        width: args.width,
-        height: args.height,
-        max_depth: args.max_depth,
-        ppm_ascii: args.ppm_ascii,
-        out_dir: args.out.clone(),
-    }
-}
-
 fn render_command(args: &RenderArgs) -> ExitCode {
-    let settings = settings_from(args);
+    let settings = args.settings();
     let load = args.scene.load_options();
     let mut failed = false;
     for input in &args.inputs {

@@ -10,9 +10,9 @@
 //! after its images are complete, so an interrupted run never leaves a record for an image
 //! that is not finished: the next run renders that frame again.
 
-use crate::anim::write_atomic;
 use crate::cli::{RenderArgs, Shard};
 use crate::diag::Diagnostic;
+use crate::render::film::write_atomically;
 use crate::render::{render_file, RenderSettings};
 use crate::sdf::LoadOptions;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicUsize, Ordering as AtomicOrdering};
@@ -75,18 +76,6 @@ pub fn render_dir(dir: &Path, args: &RenderArgs) -> ExitCode {
     }
 }
 
-/// The render settings the command line asks for.
-pub fn settings(args: &RenderArgs) -> RenderSettings {
-    RenderSettings {
-        spp: args.spp,
-        width: args.width,
-        height: args.height,
-        max_depth: args.max_depth,
-        ppm_ascii: args.ppm_ascii,
-        out_dir: args.out.clone(),
-    }
-}
-
 /// Renders the frames of `dir` (see the module doc). `Err` only when the directory itself is
 /// unusable; failing frames are listed in the summary.
 pub fn run(dir: &Path, args: &RenderArgs) -> Result<Summary, Box<Diagnostic>> {
@@ -103,7 +92,7 @@ pub fn run(dir: &Path, args: &RenderArgs) -> Result<Summary, Box<Diagnostic>> {
             "no .sdf files in this directory",
         )));
     }
-    let settings = settings(args);
+    let settings = args.settings();
     let load = args.scene.load_options();
     let out_dir = settings
         .out_dir
@@ -343,7 +332,7 @@ fn write_record(
         std::fs::create_dir_all(parent)?;
     }
     let text = record_text(hash, out_dir, outputs)?;
-    write_atomic(record, text.as_bytes())
+    write_atomically(record, |w| w.write_all(text.as_bytes()))
 }
 
 /// Whether frame `name`'s record matches `hash` and every image it lists is there, whole.

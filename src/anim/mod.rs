@@ -12,6 +12,7 @@ pub mod spec;
 
 use crate::cli::GenerateArgs;
 use crate::diag::{Diagnostic, Loc};
+use crate::render::film::write_atomically;
 use crate::sdf::LoadOptions;
 use generate::{BaseScene, Generator};
 use spec::{Animation, SceneSource, Source};
@@ -89,7 +90,7 @@ pub fn run_generate(args: &GenerateArgs) -> Result<GenerateReport, Vec<Diagnosti
         if std::fs::read(&path).ok().as_deref() == Some(text.as_bytes()) {
             continue;
         }
-        write_atomic(&path, text.as_bytes()).map_err(|e| {
+        write_atomically(&path, |w| w.write_all(text.as_bytes())).map_err(|e| {
             vec![Diagnostic::file_error(
                 &path,
                 format!("cannot write the frame: {e}"),
@@ -314,29 +315,4 @@ fn remove_stale(dir: &Path, anim: &Animation) -> std::io::Result<usize> {
         }
     }
     Ok(removed)
-}
-
-/// Writes `bytes` to `path` so that `path` is either absent, the old file or the complete new
-/// one: a temporary file in the same directory, flushed, then renamed over it.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        drop(f);
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }

@@ -287,15 +287,15 @@ impl Parser<'_> {
 
     /// Explains a variant spelling the first time the file uses it.
     fn variant(&mut self, line: &Line, at: At, key: &'static str, message: String, help: String) {
+        let help =
+            format!("{help} (later lines written this way are read the same, without a warning)");
+        self.warn_once(line, at, key, message, help);
+    }
+
+    /// A warning given only the first time its `key` comes up in the file.
+    fn warn_once(&mut self, line: &Line, at: At, key: &'static str, message: String, help: String) {
         if self.variants_noted.insert(key) {
-            self.warn(
-                line,
-                at,
-                message,
-                Some(format!(
-                    "{help} (later lines written this way are read the same, without a warning)"
-                )),
-            );
+            self.warn(line, at, message, Some(help));
         }
     }
 
@@ -553,6 +553,7 @@ impl Parser<'_> {
                 Some("m is usually between 1 (dull) and a few hundred (sharp)".to_string()),
             );
         }
+        let mut opacity_at = None;
         for (k, field) in fields.iter().enumerate().take(extras) {
             let value = nums[10 + k];
             let at = At::Tok(13 + k);
@@ -562,6 +563,7 @@ impl Parser<'_> {
                 }
                 MaterialField::Opacity => {
                     def.opacity = self.unit_interval(line, at, "opacity", value);
+                    opacity_at = Some(at);
                 }
                 MaterialField::Transparency => {
                     def.opacity = 1.0 - self.unit_interval(line, at, "transparency", value);
@@ -582,6 +584,22 @@ impl Parser<'_> {
                 }
                 MaterialField::Roughness => {}
             }
+        }
+        if let Some(at) = opacity_at.filter(|_| def.opacity == 0.0 && def.ior == 1.0) {
+            // Fully transparent without refraction: invisible. Many files mean transparency
+            // by this number (0 = opaque), and this is the symptom. Said once per file.
+            self.warn_once(
+                line,
+                at,
+                "invisible-material",
+                format!(
+                    "material `{}` is invisible: fully transparent (opacity 0) and not refracting (ior 1)",
+                    def.name
+                ),
+                "if this file means transparency by this number, load it with \
+                 --material-fields reflectivity,transparency,ior"
+                    .to_string(),
+            );
         }
         self.emit(line, StatementKind::Material(def));
         Ok(())
@@ -964,6 +982,22 @@ impl Parser<'_> {
                     }
                 }
             }
+            4 => {
+                // No position: the only meaning left is an ambient term, colour × brightness
+                // (`define light ambient1 .3 .2 .6 5`), added like the lecture form's La.
+                let rgb = c(0) * nums[3] as f32;
+                self.warn(
+                    line,
+                    At::Span(name_at + 1, toks.len() - 1),
+                    "a light with 4 numbers has no position: read as ambient light [rgb] <brightness>, \
+                     added to the scene's ambient light",
+                    Some(format!(
+                        "write `{FORM_AMBIENT}` for ambient light, or `{FORM_LIGHT}` for a point light"
+                    )),
+                );
+                self.skipped.insert(name);
+                self.emit(line, StatementKind::AmbientAdd(rgb));
+            }
             n => {
                 let at = if n > 7 {
                     At::Span(name_at + 8, toks.len() - 1)
@@ -973,7 +1007,7 @@ impl Parser<'_> {
                 let mut help = format!(
                     "canonical form: `{FORM_LIGHT}`; 6 numbers (no brightness) and 9 are also read"
                 );
-                if matches!(n, 1 | 3 | 4) {
+                if matches!(n, 1 | 3) {
                     help.push_str(&format!(
                         ". An ambient light is written `{FORM_AMBIENT}` or `{FORM_AMBIENT_LIGHT}`"
                     ));
@@ -1081,8 +1115,28 @@ impl Parser<'_> {
         };
         let name = name_tok.text.to_string();
         let first = name_at + 1;
-        let nums = self.numbers(line, first, toks.len())?;
-        if nums.len() != 1 && nums.len() != 10 {
+        let mut nums = self.numbers(line, first, toks.len())?;
+        // Two unambiguous layouts that their authors' renderers drew: the eye alone (looking
+        // along -z with y up), and the full form with one stray number after it.
+        if nums.len() == 4 {
+            self.warn(
+                line,
+                At::Span(first + 1, first + 3),
+                "camera with an eye position but no direction or up vector: looking along -z with y up",
+                Some(format!("canonical form: `{FORM_CAMERA}`")),
+            );
+        } else if nums.len() == 11 {
+            self.warn(
+                line,
+                At::Tok(first + 10),
+                format!(
+                    "extra number '{}' after the camera's up vector ignored",
+                    toks[first + 10].text
+                ),
+                Some(format!("canonical form: `{FORM_CAMERA}`")),
+            );
+            nums.truncate(10);
+        } else if nums.len() != 1 && nums.len() != 10 {
             let n = nums.len();
             let mut help = format!("canonical form: `{FORM_CAMERA}` (1 or 10 numbers)");
             if n == 3 || n == 9 {
@@ -1130,6 +1184,9 @@ impl Parser<'_> {
             dir: DVec3::NEG_Z,
             up: DVec3::Y,
         };
+        if nums.len() == 4 {
+            def.eye = DVec3::new(nums[1], nums[2], nums[3]);
+        }
         if nums.len() == 10 {
             let v = |i: usize| DVec3::new(nums[i], nums[i + 1], nums[i + 2]);
             def.eye = v(1);

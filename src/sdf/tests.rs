@@ -668,3 +668,21 @@ fn render_file_names_and_cameras_may_look_like_numbers() {
     let ds = errors("define camera eye 60\nrender eye out.png 48O 320\n");
     assert_eq!(ds[0].message, "expected a number, found '48O'");
 }
+
+#[test]
+fn camera_with_only_an_eye_and_light_without_position() {
+    let loaded = load(
+        "ambient 0.1 0.1 0.1\ndefine light amb .3 .2 .6 5\ndefine camera c 60 10 0 0\nrender c out.png 8 8\n",
+    );
+    let job = &loaded.jobs[0];
+    assert_eq!(job.camera.eye, DVec3::new(10.0, 0.0, 0.0));
+    assert_eq!(job.camera.dir, DVec3::NEG_Z);
+    // 0.1 set, plus (.3, .2, .6)·5 added.
+    assert!(
+        (job.scene.ambient - Vec3::new(1.6, 1.1, 3.1))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
+    assert!(job.scene.lights.is_empty());
+}

@@ -68,6 +68,8 @@ mod tests {
     fn overflowing_hit_point_is_no_hit() {
         let p = Plane::new(Vec3A::ZERO, Vec3A::new(0.3, 1.0, 0.0)).unwrap();
         let ray = Ray::new(Vec3A::new(0.0, 0.0, 2.23e38), Vec3A::new(0.0, -1.79, 0.0));
-        assert!(p.intersect(&ray, f32::INFINITY).is_none_or(|h| h.point.is_finite()));
+        assert!(p
+            .intersect(&ray, f32::INFINITY)
+            .is_none_or(|h| h.point.is_finite()));
     }
 }

@@ -1,0 +1,70 @@
+//! No scene we ship or our users have may produce a NaN or infinite pixel: every file in
+//! scenes/, animations/ and the shared corpus that loads is rendered small, and its HDR
+//! buffer (before tone mapping could hide a NaN as 0) is checked.
+
+use anim::render::{render_job, RenderSettings};
+use anim::sdf::{load_file, LoadOptions};
+use std::path::{Path, PathBuf};
+
+fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            scene_files(&path, out);
+        } else if path.extension().is_none_or(|e| e == "sdf" || e == "txt") {
+            out.push(path);
+        }
+    }
+}
+
+#[test]
+fn every_loadable_scene_renders_finite_pixels() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    scene_files(&root.join("scenes"), &mut files);
+    scene_files(&root.join("animations"), &mut files);
+    let corpus = root.join("../shared/corpus/wild");
+    if corpus.is_dir() {
+        scene_files(&corpus, &mut files);
+    } else {
+        eprintln!(
+            "note: {} is missing; checking the project's own scenes only",
+            corpus.display()
+        );
+    }
+    files.sort();
+    let settings = RenderSettings {
+        spp: Some(1),
+        width: Some(48),
+        height: Some(32),
+        ..RenderSettings::default()
+    };
+    let (mut rendered, mut images) = (0, 0);
+    for file in &files {
+        let Ok(loaded) = load_file(file, &LoadOptions::default()) else {
+            continue;
+        };
+        rendered += 1;
+        for job in &loaded.jobs {
+            let Ok((img, _)) = render_job(job, &settings, &|_| {}) else {
+                continue;
+            };
+            images += 1;
+            let bad = img
+                .pixels
+                .iter()
+                .position(|p| !p.is_finite() || p.min_element() < 0.0);
+            assert!(
+                bad.is_none(),
+                "{}: pixel {bad:?} is {:?}",
+                file.display(),
+                bad.map(|i| img.pixels[i])
+            );
+        }
+    }
+    eprintln!("{rendered} files, {images} images, all pixels finite");
+    assert!(rendered >= 5, "the project's own scenes load");
+}
