@@ -53,12 +53,17 @@ fn render_command(args: &RenderArgs) -> ExitCode {
                     for out in &outcome.outputs {
                         eprintln!("wrote {}", out.display());
                     }
+                    let r = outcome.rays;
                     eprintln!(
-                        "{}: {} image(s) in {:.2} s, {:.1} Mrays/s",
+                        "{}: {} image(s) in {:.2} s, {:.1} Mrays/s (primary {}, shadow {}, reflected {}, refracted {})",
                         input.display(),
                         outcome.outputs.len(),
                         secs,
-                        outcome.rays.total() as f64 / secs.max(1e-9) / 1e6
+                        r.total() as f64 / secs.max(1e-9) / 1e6,
+                        r.primary,
+                        r.shadow,
+                        r.reflected,
+                        r.refracted
                     );
                 }
             }

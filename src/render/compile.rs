@@ -145,11 +145,15 @@ impl RenderScene {
     /// Whether anything lies on the ray before `t_max`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.unbounded
-            .iter()
-            .any(|&i| self.prims[i as usize].hit(ray, t_max).is_some())
-            || self.bvh.any(ray, t_max, |i| {
-                self.prims[i as usize].hit(ray, t_max).is_some()
-            })
+        self.any_candidate(ray, t_max, |i| {
+            self.prims[i as usize].hit(ray, t_max).is_some()
+        })
+    }
+
+    /// Offers every primitive the ray may meet before `t_max` to `stop`, in no particular
+    /// order, until it returns true (then true).
+    #[inline]
+    pub fn any_candidate(&self, ray: &Ray, t_max: f32, mut stop: impl FnMut(u32) -> bool) -> bool {
+        self.unbounded.iter().any(|&i| stop(i)) || self.bvh.any(ray, t_max, stop)
     }
 }

@@ -118,11 +118,14 @@ impl Integrator<'_> {
     }
 
     /// Fraction of a light's intensity reaching `p`: 0 behind an opaque object, attenuated by
-    /// (1 − α) for every transparent surface crossed (shadow rays are not refracted).
+    /// (1 − α) for every transparent surface crossed (shadow rays are not refracted). Any-hit
+    /// either way: the first opaque blocker ends the query, and crossings of transparent
+    /// objects multiply in whatever order the hierarchy offers them.
     fn visibility(&self, p: Vec3A, n: Vec3A, l: Vec3A, dist: f32) -> f32 {
         let scene = self.scene;
-        let mut ray = spawn_ray(p, n, l);
-        let mut remaining = (p + l * dist - ray.origin).dot(l);
+        let ray = spawn_ray(p, n, l);
+        let light = p + l * dist;
+        let remaining = (light - ray.origin).dot(l);
         if !scene.any_transparent {
             return if scene.occluded(&ray, remaining) {
                 0.0
@@ -130,23 +133,37 @@ impl Integrator<'_> {
                 1.0
             };
         }
-        let mut transmit = 1.0;
-        for _ in 0..MAX_SHADOW_CROSSINGS {
-            let Some((prim, hit)) = scene.closest(&ray, remaining) else {
-                return transmit;
-            };
-            let mat = &scene.materials[scene.prims[prim as usize].material as usize];
-            transmit *= 1.0 - mat.opacity;
-            if transmit == 0.0 {
-                return 0.0;
+        let mut transmit = 1.0f32;
+        let blocked = scene.any_candidate(&ray, remaining, |i| {
+            let prim = &scene.prims[i as usize];
+            let opacity = scene.materials[prim.material as usize].opacity;
+            if opacity >= 1.0 {
+                return prim.hit(&ray, remaining).is_some();
             }
-            ray = spawn_ray(hit.point, hit.normal, l);
-            remaining = (p + l * dist - ray.origin).dot(l);
-            if remaining <= 0.0 {
-                return transmit;
+            // Count this object's crossings along the segment, stepping past each one.
+            let mut segment = ray;
+            let mut left = remaining;
+            for _ in 0..MAX_SHADOW_CROSSINGS {
+                let Some(hit) = prim.intersect(&segment, left) else {
+                    break;
+                };
+                transmit *= 1.0 - opacity;
+                if transmit == 0.0 {
+                    return true;
+                }
+                segment = spawn_ray(hit.point, hit.normal, l);
+                left = (light - segment.origin).dot(l);
+                if left <= 0.0 {
+                    break;
+                }
             }
+            false
+        });
+        if blocked {
+            0.0
+        } else {
+            transmit
         }
-        transmit
     }
 }
 
