@@ -242,3 +242,53 @@ fn opaque_scenes_trace_no_secondary_rays() {
     assert_eq!(counts.reflected + counts.refracted, 0);
     assert_eq!(counts.primary, 32 * 32);
 }
+
+#[test]
+fn shadow_through_glass_is_attenuated_per_surface_crossed() {
+    // The light straight above the floor point (0,0,0) shines through a sphere of opacity
+    // α = 0.5: the shadow ray crosses two surfaces, so (1 − α)² = 1/4 of the light arrives.
+    // Expected: Ka·I_a + ¼·I·Kd·(N·L) with N·L = 1 (no specular: Ks = 0).
+    let floor = Material::phong(
+        "floor",
+        Vec3::splat(0.2),
+        Vec3::new(0.6, 0.4, 0.2),
+        Vec3::ZERO,
+        1.0,
+    );
+    let mut veil = material("veil", 0.0, [0.0; 3], 0.0, 1.0);
+    veil.opacity = 0.5;
+    let scene = Scene {
+        materials: vec![floor, veil],
+        instances: vec![
+            instance(
+                Geometry::Box {
+                    p1: DVec3::new(-10.0, -1.0, -10.0),
+                    p2: DVec3::new(10.0, 0.0, 10.0),
+                },
+                0,
+            ),
+            sphere([0.0, 5.0, 0.0], 1.0, 1),
+        ],
+        lights: vec![Light {
+            name: "l".into(),
+            position: DVec3::new(0.0, 10.0, 0.0),
+            intensity: Vec3::splat(2.0),
+        }],
+        ambient: Vec3::splat(0.5),
+        background: Vec3::ZERO,
+    };
+    let cam = Camera {
+        name: "c".into(),
+        fov_x_deg: 10.0,
+        eye: DVec3::new(0.0, 1.0, 5.0),
+        dir: DVec3::new(0.0, -1.0, -5.0),
+        up: DVec3::Y,
+    };
+    let img = render(&job(scene, cam, 3, 3));
+    let expected = Vec3::splat(0.2 * 0.5) + Vec3::new(0.6, 0.4, 0.2) * (2.0 * 0.25);
+    assert!(
+        (img.pixels[4] - expected).abs().max_element() < 1e-5,
+        "{:?} vs {expected:?}",
+        img.pixels[4]
+    );
+}
