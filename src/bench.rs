@@ -49,9 +49,8 @@ fn render_timed(
         ..RenderSettings::default()
     };
     let start = Instant::now();
-    let (img, counts) =
-        render::render_job(job, &settings, &|_| {}).map_err(|e| format!("{e:?}"))?;
-    Ok((img, start.elapsed().as_secs_f64(), counts.total()))
+    let r = render::render_job(job, &settings, &|_| {}).map_err(|e| format!("{e:?}"))?;
+    Ok((r.image, start.elapsed().as_secs_f64(), r.rays.total()))
 }
 
 /// Root-mean-square difference of the 8-bit images, in 8-bit steps.

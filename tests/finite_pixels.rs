@@ -49,9 +49,10 @@ fn every_loadable_scene_renders_finite_pixels() {
         };
         rendered += 1;
         for job in &loaded.jobs {
-            let Ok((img, _)) = render_job(job, &settings, &|_| {}) else {
+            let Ok(rendered) = render_job(job, &settings, &|_| {}) else {
                 continue;
             };
+            let img = rendered.image;
             images += 1;
             let bad = img
                 .pixels

@@ -290,3 +290,30 @@ fn camera_and_object_directions() {
         "up vector respected: {x},{y}"
     );
 }
+
+#[test]
+fn a_shape_lost_to_f32_underflow_is_reported_not_silently_dropped() {
+    // Each factor is acceptable on its own, but together they scale the radius to 1e-48,
+    // below the smallest f32: the renderer cannot place the sphere and must say so.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.sdf");
+    let scales = "transform tiny scale 1e-8\n".repeat(6);
+    std::fs::write(
+        &scene,
+        format!("define material m 1 1 1 1 1 1 0 0 0 1\ndefine shape sphere tiny 0 0 0 1 m\n{scales}define camera c 60\nrender c x.png 8 8\n"),
+    )
+    .unwrap();
+    let out = anim()
+        .arg("render")
+        .arg(&scene)
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("scene.sdf:2:1: warning: shape 'tiny' is degenerate once transformed"),
+        "{stderr}"
+    );
+}

@@ -63,6 +63,7 @@ pub struct RenderScene {
 #[derive(Clone, Debug)]
 pub struct Dropped {
     pub instance: String,
+    pub loc: Option<crate::diag::Loc>,
 }
 
 impl RenderScene {
@@ -74,6 +75,7 @@ impl RenderScene {
                 Ok(p) => prims.push(p),
                 Err(_) => dropped.push(Dropped {
                     instance: inst.name.clone(),
+                    loc: inst.loc.clone(),
                 }),
             }
         }

@@ -105,15 +105,24 @@ impl RenderSettings {
     }
 }
 
+/// One rendered image and what it took.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    pub image: HdrImage,
+    pub rays: RayCounts,
+    /// Shapes that became degenerate once transformed (in f32) and were left out.
+    pub dropped: Vec<compile::Dropped>,
+}
+
 /// Renders one job to an HDR image. `on_tile(pixels)` is called as tiles finish.
 pub fn render_job(
     job: &RenderJob,
     settings: &RenderSettings,
     on_tile: &(dyn Fn(u64) + Sync),
-) -> Result<(HdrImage, RayCounts), CameraError> {
+) -> Result<Rendered, CameraError> {
     let (width, height, spp) = settings.resolve(job);
     let camera = CameraRays::new(&job.camera, width, height)?;
-    let (scene, _dropped) = RenderScene::compile(&job.scene);
+    let (scene, dropped) = RenderScene::compile(&job.scene);
     let integrator = Integrator {
         scene: &scene,
         max_depth: settings.max_depth,
@@ -157,14 +166,15 @@ pub fn render_job(
             pixels[start..start + chunk.len()].copy_from_slice(chunk);
         }
     }
-    Ok((
-        HdrImage {
+    Ok(Rendered {
+        image: HdrImage {
             width,
             height,
             pixels,
         },
-        counts,
-    ))
+        rays: counts,
+        dropped,
+    })
 }
 
 /// Where a job's image goes: relative paths are taken against `--out` or the scene's folder.
@@ -289,7 +299,11 @@ pub fn render_file(
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default(),
         );
-        let (image, counts) = match render_job(job, settings, &|n| progress.advance(n)) {
+        let Rendered {
+            image,
+            rays: counts,
+            dropped,
+        } = match render_job(job, settings, &|n| progress.advance(n)) {
             Ok(r) => r,
             Err(e) => {
                 progress.finish();
@@ -307,6 +321,16 @@ pub fn render_file(
                 return Err(warnings);
             }
         };
+        for d in dropped {
+            let message = format!(
+                "shape '{}' is degenerate once transformed (too thin or too small to intersect) and is not drawn",
+                d.instance
+            );
+            warnings.push(match d.loc {
+                Some(loc) => Diagnostic::new(Severity::Warning, loc, message),
+                None => job_error(path, job, message).with_severity(Severity::Warning),
+            });
+        }
         if let Err(e) = film::write_image(&out, &image, format) {
             progress.finish();
             warnings.push(job_error(

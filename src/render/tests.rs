@@ -45,7 +45,7 @@ fn job(scene: Scene, camera: Camera, w: u32, h: u32) -> RenderJob {
 fn render(job: &RenderJob) -> HdrImage {
     render_job(job, &RenderSettings::default(), &|_| {})
         .unwrap()
-        .0
+        .image
 }
 
 /// A lit scene: a red ball on a grey floor, two lights.
@@ -233,12 +233,13 @@ fn no_pixel_is_ever_nan_or_infinite() {
 
 #[test]
 fn opaque_scenes_trace_no_secondary_rays() {
-    let (_, counts) = render_job(
+    let counts = render_job(
         &job(base_scene(), Camera::default_with_fov("c", 60.0), 32, 32),
         &RenderSettings::default(),
         &|_| {},
     )
-    .unwrap();
+    .unwrap()
+    .rays;
     assert_eq!(counts.reflected + counts.refracted, 0);
     assert_eq!(counts.primary, 32 * 32);
 }
