@@ -147,9 +147,7 @@ impl Cone {
             Part::Cap { .. } if rho >= r - band => rim,
             Part::Cap { z, sign } => (DVec3::new(p.x, p.y, z), DVec3::new(0.0, 0.0, sign)),
         };
-        let point: Vec3A = self.frame.point_to_world(local).as_vec3().into();
-        let normal: Vec3A = self.frame.vector_to_world(normal).as_vec3().into();
-        (point.is_finite() && normal.is_finite()).then_some(ShapeHit { t, point, normal })
+        self.frame.shape_hit(t, local, normal)
     }
 }
 

@@ -90,6 +90,15 @@ impl AxisFrame {
         self.u * v.x + self.v * v.y + self.w * v.z
     }
 
+    /// The hit at parameter `t` from a local point and normal, or `None` if mapping them to
+    /// world space overflowed.
+    #[inline]
+    pub fn shape_hit(&self, t: f32, local: DVec3, normal: DVec3) -> Option<ShapeHit> {
+        let point: Vec3A = self.point_to_world(local).as_vec3().into();
+        let normal: Vec3A = self.vector_to_world(normal).as_vec3().into();
+        (point.is_finite() && normal.is_finite()).then_some(ShapeHit { t, point, normal })
+    }
+
     /// Half-width of the band around a rim (or the cone's apex) within which a hit is snapped
     /// onto that edge, for a hit near local point `near` on a shape whose smallest dimension
     /// is `smallest`.
@@ -306,9 +315,7 @@ impl Cylinder {
             Part::Cap { z, sign } if rho >= r - band => rim(z, sign),
             Part::Cap { z, sign } => (DVec3::new(p.x, p.y, z), DVec3::new(0.0, 0.0, sign)),
         };
-        let point: Vec3A = self.frame.point_to_world(local).as_vec3().into();
-        let normal: Vec3A = self.frame.vector_to_world(normal).as_vec3().into();
-        (point.is_finite() && normal.is_finite()).then_some(ShapeHit { t, point, normal })
+        self.frame.shape_hit(t, local, normal)
     }
 }
 
