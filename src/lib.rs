@@ -11,6 +11,7 @@ pub mod anim;
 pub mod bench;
 pub mod cli;
 pub mod diag;
+pub mod limits;
 pub mod math;
 pub mod pipeline;
 pub mod render;

@@ -100,3 +100,32 @@ pub fn compare(a: &Rgb8, b: &Rgb8) -> (u8, usize) {
     }
     (max, differing)
 }
+
+/// The project's shared documents and corpus beside the checkout (`../shared`), if there.
+/// Tests that need it call this: a missing folder is reported as a visible skip, and is a
+/// failure under CI (where the environment variable `CI` is set), so a broken checkout cannot
+/// pass by testing nothing.
+pub fn shared_dir(test: &str) -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared");
+    if dir.is_dir() {
+        return Some(dir);
+    }
+    if std::env::var_os("CI").is_some() {
+        panic!(
+            "{test}: {} is missing, and CI is set: this test must not be skipped there",
+            dir.display()
+        );
+    }
+    eprintln!("{test}: skipped: {} is missing", dir.display());
+    None
+}
+
+/// FNV-1a, 64 bits: a stable fingerprint of bytes for manifests.
+pub fn fnv1a64(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}

@@ -1,0 +1,195 @@
+//! The golden image manifest: every scene we ship (scenes/, animations/ and frames generated
+//! from every spec in animations/) and every file of the shared corpus, rendered small by the
+//! real binary, with a fingerprint of each image's decoded pixels. Refactoring must not change
+//! a single pixel: the manifest is compared line by line, and it is rewritten only on purpose,
+//! with `ANIM_UPDATE_GOLDEN=1 cargo test --test golden` after a deliberate change of output.
+
+mod common;
+
+use common::{anim, fnv1a64, shared_dir};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+const MANIFEST: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/golden/manifest.tsv");
+
+/// Small enough to keep the suite fast, big enough that every object covers pixels.
+const SIZE: [&str; 4] = ["--width", "48", "--height", "36"];
+
+fn files_below(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            files_below(&path, out);
+        } else {
+            out.push(path);
+        }
+    }
+}
+
+fn image_files(dir: &Path) -> Vec<PathBuf> {
+    let mut all = Vec::new();
+    files_below(dir, &mut all);
+    let mut images: Vec<PathBuf> = all
+        .into_iter()
+        .filter(|p| {
+            p.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+                ["png", "ppm", "pgm", "pnm", "bmp", "jpg", "jpeg", "tga"]
+                    .contains(&e.to_ascii_lowercase().as_str())
+            })
+        })
+        .collect();
+    images.sort();
+    images
+}
+
+/// Renders one scene file in a sandbox of its own (deep enough that render lines with `../..`
+/// stay inside it) and returns its manifest lines.
+fn manifest_lines(label: &str, scene: &Path) -> String {
+    let sandbox = tempfile::tempdir().unwrap();
+    let dir = sandbox.path().join("a/b/c/d");
+    std::fs::create_dir_all(&dir).unwrap();
+    let name = scene.file_name().unwrap();
+    let copy = dir.join(name);
+    std::fs::copy(scene, &copy).unwrap();
+    let output = anim()
+        .arg("render")
+        .arg(&copy)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .args(SIZE)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    let mut lines = String::new();
+    if !output.status.success() {
+        writeln!(lines, "{label}\trejected").unwrap();
+        return lines;
+    }
+    let images = image_files(sandbox.path());
+    if images.is_empty() {
+        writeln!(lines, "{label}\tno image").unwrap();
+    }
+    for image in images {
+        let decoded = image::open(&image)
+            .unwrap_or_else(|e| panic!("{label}: {}: {e}", image.display()))
+            .to_rgb8();
+        writeln!(
+            lines,
+            "{label}\t{}\t{}x{}\t{:016x}",
+            image.file_name().unwrap().to_string_lossy(),
+            decoded.width(),
+            decoded.height(),
+            fnv1a64(decoded.as_raw())
+        )
+        .unwrap();
+    }
+    lines
+}
+
+/// Frames 0, a third and two thirds of the way through each spec's animation.
+fn generated_frames(root: &Path, frames_root: &Path) -> Vec<(String, PathBuf)> {
+    let mut specs: Vec<PathBuf> = std::fs::read_dir(root.join("animations"))
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    specs.sort();
+    let mut frames = Vec::new();
+    for spec in specs {
+        let stem = spec.file_stem().unwrap().to_string_lossy().into_owned();
+        let out = frames_root.join(&stem);
+        let status = anim()
+            .arg("generate")
+            .arg(&spec)
+            .arg("-o")
+            .arg(&out)
+            .arg("--quiet")
+            .output()
+            .unwrap();
+        assert!(
+            status.status.success(),
+            "anim generate {} failed: {}",
+            spec.display(),
+            String::from_utf8_lossy(&status.stderr)
+        );
+        let mut sdf: Vec<PathBuf> = std::fs::read_dir(&out)
+            .unwrap()
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|e| e == "sdf"))
+            .collect();
+        sdf.sort();
+        let n = sdf.len();
+        for i in [0, n / 3, 2 * n / 3] {
+            let name = sdf[i].file_name().unwrap().to_string_lossy().into_owned();
+            frames.push((format!("generated/{stem}/{name}"), sdf[i].clone()));
+        }
+    }
+    frames
+}
+
+#[test]
+fn every_scene_renders_the_pixels_of_the_golden_manifest() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut scenes: Vec<(String, PathBuf)> = Vec::new();
+    for folder in ["scenes", "animations"] {
+        let mut files = Vec::new();
+        files_below(&root.join(folder), &mut files);
+        for f in files
+            .into_iter()
+            .filter(|f| f.extension().is_some_and(|e| e == "sdf"))
+        {
+            let label = f.strip_prefix(root).unwrap().display().to_string();
+            scenes.push((label, f));
+        }
+    }
+    let frames_root = tempfile::tempdir().unwrap();
+    scenes.extend(generated_frames(root, frames_root.path()));
+    let shared = shared_dir("golden manifest (corpus part)");
+    if let Some(shared) = &shared {
+        let corpus = shared.join("corpus/wild");
+        let mut files = Vec::new();
+        files_below(&corpus, &mut files);
+        for f in files
+            .into_iter()
+            .filter(|f| f.file_name().is_some_and(|n| n != "MANIFEST.tsv"))
+        {
+            let label = format!("corpus/{}", f.strip_prefix(&corpus).unwrap().display());
+            scenes.push((label, f));
+        }
+    }
+    scenes.sort();
+    let actual: String = scenes
+        .iter()
+        .map(|(label, path)| manifest_lines(label, path))
+        .collect();
+
+    if std::env::var_os("ANIM_UPDATE_GOLDEN").is_some() {
+        assert!(
+            shared.is_some(),
+            "the manifest is written only with the corpus present"
+        );
+        std::fs::write(MANIFEST, &actual).unwrap();
+        eprintln!("wrote {MANIFEST}");
+        return;
+    }
+    let expected = std::fs::read_to_string(MANIFEST).expect("tests/golden/manifest.tsv exists");
+    let expected: Vec<&str> = expected
+        .lines()
+        .filter(|l| shared.is_some() || !l.starts_with("corpus/"))
+        .collect();
+    let actual: Vec<&str> = actual.lines().collect();
+    let missing: Vec<&&str> = expected.iter().filter(|l| !actual.contains(l)).collect();
+    let extra: Vec<&&str> = actual.iter().filter(|l| !expected.contains(l)).collect();
+    assert!(
+        missing.is_empty() && extra.is_empty(),
+        "the images differ from the golden manifest\nexpected, not found:\n{}\nfound, not expected:\n{}",
+        missing.iter().map(|l| format!("  {l}")).collect::<Vec<_>>().join("\n"),
+        extra.iter().map(|l| format!("  {l}")).collect::<Vec<_>>().join("\n"),
+    );
+    eprintln!("{} manifest lines match", actual.len());
+}
