@@ -1,5 +1,8 @@
 //! Command-line definitions (clap derive), resolved into configuration before any work starts.
 
+use crate::app::{CheckConfig, RenderConfig};
+use crate::limits;
+use crate::pipeline::{FrameOptions, Shard};
 use crate::render::RenderSettings;
 use crate::sdf::{LoadOptions, MaterialField, TransformOrder};
 use clap::{Args, Parser, Subcommand, ValueEnum};
@@ -53,19 +56,19 @@ pub struct RenderArgs {
     pub out: Option<PathBuf>,
     /// Samples per pixel (k² gives a k×k stratified grid; 1 = one ray through the pixel
     /// centre). Overrides the render statement's own count. Default 4.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    #[arg(long, value_name = "N", value_parser = parse_samples)]
     pub spp: Option<u32>,
     /// Worker threads (default: one per core). The output does not depend on it.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
     /// Override every render statement's image width.
-    #[arg(long, value_name = "W", value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, value_name = "W", value_parser = parse_image_side)]
     pub width: Option<u32>,
     /// Override every render statement's image height.
-    #[arg(long, value_name = "H", value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, value_name = "H", value_parser = parse_image_side)]
     pub height: Option<u32>,
     /// Maximum depth of reflected and refracted rays.
-    #[arg(long, value_name = "N", default_value_t = 8)]
+    #[arg(long, value_name = "N", default_value_t = limits::DEFAULT_MAX_DEPTH)]
     pub max_depth: u32,
     /// Write .ppm files as ASCII (P3) instead of binary (P6).
     #[arg(long)]
@@ -126,36 +129,6 @@ pub enum TransformOrderArg {
     Local,
 }
 
-/// One shard of an animation: K of N, K counting from 1 (as Slurm array task ids do).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Shard {
-    pub index: u32,
-    pub count: u32,
-}
-
-impl Shard {
-    /// Whether frame `i` (counting from 0) belongs to this shard.
-    pub fn contains(&self, i: usize) -> bool {
-        i % self.count as usize == (self.index - 1) as usize
-    }
-}
-
-fn parse_shard(s: &str) -> Result<Shard, String> {
-    let (k, n) = s.split_once('/').ok_or("expected K/N, e.g. 2/3")?;
-    let index: u32 = k
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{k}' is not a whole number"))?;
-    let count: u32 = n
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{n}' is not a whole number"))?;
-    if count == 0 || index == 0 || index > count {
-        return Err(format!("K must be between 1 and N (got {index}/{count})"));
-    }
-    Ok(Shard { index, count })
-}
-
 pub fn parse_material_fields(s: &str) -> Result<MaterialField, String> {
     match s.trim() {
         "reflectivity" => Ok(MaterialField::Reflectivity),
@@ -169,7 +142,46 @@ pub fn parse_material_fields(s: &str) -> Result<MaterialField, String> {
     }
 }
 
+fn parse_shard(s: &str) -> Result<Shard, String> {
+    s.parse()
+}
+
+/// A whole number within `range` (one of the value rules of `limits`).
+fn whole_in(s: &str, range: std::ops::RangeInclusive<u32>) -> Result<u32, String> {
+    let n: u32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a whole number"))?;
+    if range.contains(&n) {
+        Ok(n)
+    } else {
+        Err(format!("{n} is not in {}..={}", range.start(), range.end()))
+    }
+}
+
+fn parse_samples(s: &str) -> Result<u32, String> {
+    whole_in(s, limits::SAMPLES)
+}
+
+fn parse_image_side(s: &str) -> Result<u32, String> {
+    whole_in(s, limits::IMAGE_SIDE)
+}
+
 impl RenderArgs {
+    /// What the command line asks `anim render` to do.
+    pub fn config(&self) -> RenderConfig {
+        RenderConfig {
+            inputs: self.inputs.clone(),
+            settings: self.settings(),
+            load: self.scene.load_options(),
+            frames: FrameOptions {
+                force: self.force,
+                shard: self.shard,
+            },
+            quiet: self.quiet,
+        }
+    }
+
     /// The settings that decide what the images look like and where they go.
     pub fn settings(&self) -> RenderSettings {
         RenderSettings {
@@ -179,6 +191,17 @@ impl RenderArgs {
             max_depth: self.max_depth,
             ppm_ascii: self.ppm_ascii,
             out_dir: self.out.clone(),
+        }
+    }
+}
+
+impl CheckArgs {
+    /// What the command line asks `anim check` to do.
+    pub fn config(&self) -> CheckConfig {
+        CheckConfig {
+            inputs: self.inputs.clone(),
+            load: self.scene.load_options(),
+            quiet: self.quiet,
         }
     }
 }
@@ -193,23 +216,5 @@ impl SceneArgs {
                 TransformOrderArg::Local => TransformOrder::Local,
             },
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn shards_partition_the_frames() {
-        let shards: Vec<Shard> = (1..=3)
-            .map(|k| parse_shard(&format!("{k}/3")).unwrap())
-            .collect();
-        for i in 0..10 {
-            assert_eq!(shards.iter().filter(|s| s.contains(i)).count(), 1);
-        }
-        assert!(parse_shard("0/3").is_err());
-        assert!(parse_shard("4/3").is_err());
-        assert!(parse_shard("1/0").is_err());
     }
 }

@@ -8,6 +8,7 @@
 
 pub mod accel;
 pub mod anim;
+pub mod app;
 pub mod bench;
 pub mod cli;
 pub mod diag;

@@ -39,6 +39,9 @@ impl ImageFormat {
     /// The format for a file name, by its extension (case-insensitive).
     pub fn for_path(path: &Path, ppm_ascii: bool) -> Option<ImageFormat> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        if !crate::limits::is_image_extension(&ext) {
+            return None;
+        }
         match ext.as_str() {
             "png" => Some(ImageFormat::Png),
             "ppm" if ppm_ascii => Some(ImageFormat::PpmAscii),
@@ -49,9 +52,6 @@ impl ImageFormat {
         }
     }
 }
-
-/// Extensions users may write, for error messages.
-pub const KNOWN_EXTENSIONS: &str = ".png, .ppm, .pgm, .pnm, .bmp, .jpg, .tga";
 
 fn encode(
     out: &mut impl Write,
