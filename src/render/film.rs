@@ -6,7 +6,7 @@ use std::fs;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
-/// SPEC.md §1.5: `c_ldr = c_hdr / (c_hdr + 1)`, stored as `round(255·c_ldr)`. Negative or
+/// docs/shading.md §4: `c_ldr = c_hdr / (c_hdr + 1)`, stored as `round(255·c_ldr)`. Negative or
 /// non-finite input (which the renderer never produces) maps to 0 rather than wrapping.
 #[inline]
 pub fn tone_map_u8(c: f32) -> u8 {
