@@ -69,9 +69,9 @@ pub fn run(args: &BenchArgs) -> ExitCode {
         Ok(table) => {
             print!("{table}");
             if let Some(path) = &args.markdown {
-                if let Err(e) =
-                    film::write_atomically(path, |w| std::io::Write::write_all(w, table.as_bytes()))
-                {
+                if let Err(e) = crate::util::write_atomically(path, |w| {
+                    std::io::Write::write_all(w, table.as_bytes())
+                }) {
                     eprintln!("error: cannot write {}: {e}", path.display());
                     return ExitCode::FAILURE;
                 }

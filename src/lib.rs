@@ -19,3 +19,4 @@ pub mod render;
 pub mod scene;
 pub mod sdf;
 pub mod shape;
+pub mod util;

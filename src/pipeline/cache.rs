@@ -8,9 +8,9 @@
 //! images are complete, so an interrupted run never leaves a record for an image that is not
 //! finished: the next run renders that frame again.
 
-use crate::render::film::write_atomically;
 use crate::render::RenderSettings;
 use crate::sdf::LoadOptions;
+use crate::util::write_atomically;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 

@@ -2,8 +2,8 @@
 //! atomic writes (a reader never sees a half-written image).
 
 use super::HdrImage;
-use std::fs;
-use std::io::{self, BufWriter, Write};
+
+use std::io::{self, Write};
 use std::path::Path;
 
 /// docs/shading.md §4: `c_ldr = c_hdr / (c_hdr + 1)`, stored as `round(255·c_ldr)`. Negative or
@@ -95,42 +95,9 @@ fn encode(
     }
 }
 
-/// Writes `contents` to `path` through a temporary file in the same directory and a rename,
-/// so that `path` either keeps its old contents or has the complete new ones.
-pub fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&mut BufWriter<fs::File>) -> io::Result<()>,
-) -> io::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    fs::create_dir_all(dir)?;
-    let name = path
-        .file_name()
-        .ok_or_else(|| io::Error::other("output path has no file name"))?;
-    let tmp = dir.join(format!(
-        ".{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| {
-        let mut w = BufWriter::new(fs::File::create(&tmp)?);
-        write(&mut w)?;
-        // No fsync: the rename already guarantees that an interrupted process never leaves a
-        // partial image under the final name, and syncing every frame costs ~0.1 s each.
-        w.into_inner().map_err(|e| e.into_error())?;
-        fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result
-}
-
 pub fn write_image(path: &Path, img: &HdrImage, format: ImageFormat) -> io::Result<()> {
     let rgb = to_rgb8(img);
-    write_atomically(path, |w| encode(w, &rgb, img.width, img.height, format))
+    crate::util::write_atomically(path, |w| encode(w, &rgb, img.width, img.height, format))
 }
 
 #[cfg(test)]
@@ -176,9 +143,9 @@ mod tests {
             pixels: vec![Vec3::new(1.0, 0.0, 3.0), Vec3::ZERO],
         };
         write_image(&path, &img, ImageFormat::PpmBinary).unwrap();
-        let bytes = fs::read(&path).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
         assert_eq!(&bytes[..11], b"P6\n2 1\n255\n");
         assert_eq!(&bytes[11..], &[128, 0, 191, 0, 0, 0]);
-        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 }
