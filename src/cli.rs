@@ -67,12 +67,20 @@ pub struct RenderArgs {
     /// Override every render statement's image height.
     #[arg(long, value_name = "H", value_parser = parse_image_side)]
     pub height: Option<u32>,
-    /// Maximum depth of reflected and refracted rays.
-    #[arg(long, value_name = "N", default_value_t = limits::DEFAULT_MAX_DEPTH)]
+    /// Maximum depth of reflected and refracted rays (at most 10000).
+    #[arg(long, value_name = "N", default_value_t = limits::DEFAULT_MAX_DEPTH, value_parser = parse_max_depth)]
     pub max_depth: u32,
     /// Write .ppm files as ASCII (P3) instead of binary (P6).
     #[arg(long)]
     pub ppm_ascii: bool,
+    /// Write images where render lines say even outside the scene's folder (or --out):
+    /// absolute paths and paths climbing out with `..`.
+    #[arg(long)]
+    pub allow_any_output: bool,
+    /// Memory one image may take while it is made, e.g. 512M or 8G (default: half the
+    /// machine's memory). Bigger images are refused before anything is allocated.
+    #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
+    pub max_memory: Option<u64>,
     /// Render frames even if their input and settings are unchanged since the last run.
     #[arg(long)]
     pub force: bool,
@@ -167,6 +175,31 @@ fn parse_image_side(s: &str) -> Result<u32, String> {
     whole_in(s, limits::IMAGE_SIDE)
 }
 
+fn parse_max_depth(s: &str) -> Result<u32, String> {
+    whole_in(s, 0..=limits::MAX_DEPTH)
+}
+
+/// A byte count with an optional binary suffix: `4096`, `512K`, `512M`, `8G` (also `8GiB`).
+fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let digits = t.find(|c: char| !c.is_ascii_digit()).unwrap_or(t.len());
+    let (number, unit) = t.split_at(digits);
+    let n: u64 = number
+        .parse()
+        .map_err(|_| format!("'{s}' is not a size such as 512M or 8G"))?;
+    let shift = match unit.trim().to_ascii_uppercase().as_str() {
+        "" | "B" => 0,
+        "K" | "KB" | "KIB" => 10,
+        "M" | "MB" | "MIB" => 20,
+        "G" | "GB" | "GIB" => 30,
+        "T" | "TB" | "TIB" => 40,
+        _ => return Err(format!("'{s}' is not a size such as 512M or 8G")),
+    };
+    n.checked_mul(1 << shift)
+        .filter(|&b| b > 0)
+        .ok_or_else(|| format!("'{s}' is not a size between 1 byte and 16 EiB"))
+}
+
 impl RenderArgs {
     /// What the command line asks `anim render` to do.
     pub fn config(&self) -> RenderConfig {
@@ -191,6 +224,10 @@ impl RenderArgs {
             max_depth: self.max_depth,
             ppm_ascii: self.ppm_ascii,
             out_dir: self.out.clone(),
+            allow_any_output: self.allow_any_output,
+            max_memory: self
+                .max_memory
+                .unwrap_or_else(limits::default_memory_budget),
         }
     }
 }

@@ -9,6 +9,7 @@ mod render;
 pub use check::CheckConfig;
 pub use render::RenderConfig;
 
+use crate::limits;
 use std::process::ExitCode;
 
 /// A command with its configuration.
@@ -21,7 +22,8 @@ pub enum Command {
 /// Runs `command` on a rayon pool of `threads` workers (default: one per core), the one pool
 /// of the process: tiles of a frame and frames of a directory share it.
 pub fn run(command: Command, threads: Option<u32>) -> ExitCode {
-    let mut builder = rayon::ThreadPoolBuilder::new();
+    // Deep mirror recursion (up to limits::MAX_DEPTH) runs on these threads.
+    let mut builder = rayon::ThreadPoolBuilder::new().stack_size(limits::RENDER_STACK_BYTES);
     if let Some(n) = threads {
         builder = builder.num_threads(n as usize);
     }

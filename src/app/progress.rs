@@ -140,6 +140,12 @@ impl FrameObserver for FrameLog {
             bar.finish_and_clear();
         }
     }
+
+    fn note(&self, message: &str) {
+        if !self.quiet {
+            eprintln!("note: {message}");
+        }
+    }
 }
 
 pub fn plural(n: usize) -> &'static str {

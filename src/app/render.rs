@@ -47,7 +47,7 @@ fn render_file(input: &Path, config: &RenderConfig) -> bool {
                 }
                 let secs = start.elapsed().as_secs_f64();
                 for out in &outcome.outputs {
-                    eprintln!("wrote {}", out.display());
+                    eprintln!("wrote {}", out.path.display());
                 }
                 let r = outcome.rays;
                 eprintln!(

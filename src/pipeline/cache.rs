@@ -2,15 +2,19 @@
 //!
 //! After a frame's images are written (atomically), a small record
 //! `.anim-cache/<frame>.sdf.hash` is written (atomically too) beside them, holding a hash of the
-//! frame's SDF bytes, every setting that changes pixels and anim's version, and the size of each
-//! image. A frame is skipped only when its record matches and its images are there with those
-//! sizes. The record is removed before a frame is rendered again and written only after its
-//! images are complete, so an interrupted run never leaves a record for an image that is not
+//! frame's SDF bytes, every setting that changes pixels and anim's version, and the length and a
+//! hash of the exact bytes this process wrote to each image (taken as they were written, not
+//! read back, so a concurrent writer cannot slip its image under this record). A frame is
+//! skipped only when its record matches and its images still hold exactly those bytes.
+//!
+//! The record is removed before a frame is rendered again and written only after its images
+//! are complete, so an interrupted run never leaves a record for an image that is not
 //! finished: the next run renders that frame again.
 
+use super::scene_file::Output;
 use crate::render::RenderSettings;
 use crate::sdf::LoadOptions;
-use crate::util::write_atomically;
+use crate::util::{write_atomically, Fnv64};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -25,22 +29,6 @@ pub fn record_path(out_dir: &Path, sdf_name: &str) -> PathBuf {
     out_dir.join(CACHE_DIR).join(format!("{sdf_name}.hash"))
 }
 
-/// FNV-1a, 64 bits: change detection, not security.
-struct Fnv(u64);
-
-impl Fnv {
-    fn new() -> Self {
-        Fnv(0xcbf2_9ce4_8422_2325)
-    }
-
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 ^= b as u64;
-            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-    }
-}
-
 /// Every setting that can change a frame's pixels (or whether it renders at all), as text.
 /// It is the whole of both settings structs, so a setting added to either is part of the key
 /// without anyone having to remember to list it here.
@@ -52,39 +40,44 @@ pub fn settings_fingerprint(settings: &RenderSettings, load: &LoadOptions) -> St
 }
 
 pub(super) fn frame_hash(sdf: &[u8], fingerprint: &str) -> u64 {
-    let mut h = Fnv::new();
+    let mut h = Fnv64::default();
     h.write(fingerprint.as_bytes());
     // A separator that cannot occur in the fingerprint keeps the two parts apart.
     h.write(&[0]);
     h.write(sdf);
-    h.0
+    h.finish()
 }
 
-/// The record's text: a header, the hash, and each image with its size in bytes.
-fn record_text(hash: u64, out_dir: &Path, outputs: &[PathBuf]) -> std::io::Result<String> {
+/// The record's text: a header, the hash, and each image with its length and byte hash.
+fn record_text(hash: u64, out_dir: &Path, outputs: &[Output]) -> String {
     let mut text = format!("anim-render-record {RECORD_VERSION}\nhash {hash:016x}\n");
     for out in outputs {
-        let size = std::fs::metadata(out)?.len();
-        let rel = out.strip_prefix(out_dir).unwrap_or(out);
-        text.push_str(&format!("image {size} {}\n", rel.display()));
+        let rel = out.path.strip_prefix(out_dir).unwrap_or(&out.path);
+        text.push_str(&format!(
+            "image {} {:016x} {}\n",
+            out.bytes.len,
+            out.bytes.hash,
+            rel.display()
+        ));
     }
-    Ok(text)
+    text
 }
 
 pub(super) fn write_record(
     record: &Path,
     out_dir: &Path,
     hash: u64,
-    outputs: &[PathBuf],
+    outputs: &[Output],
 ) -> std::io::Result<()> {
     if let Some(parent) = record.parent() {
         std::fs::create_dir_all(parent)?;
     }
-    let text = record_text(hash, out_dir, outputs)?;
+    let text = record_text(hash, out_dir, outputs);
     write_atomically(record, |w| w.write_all(text.as_bytes()))
 }
 
-/// Whether frame `name`'s record matches `hash` and every image it lists is there, whole.
+/// Whether frame `name`'s record matches `hash` and every image it lists still holds exactly
+/// the bytes that were written (a truncated, corrupted or replaced image is rendered again).
 pub(super) fn is_up_to_date(out_dir: &Path, name: &str, hash: u64) -> bool {
     let Ok(text) = std::fs::read_to_string(record_path(out_dir, name)) else {
         return false;
@@ -98,19 +91,23 @@ pub(super) fn is_up_to_date(out_dir: &Path, name: &str, hash: u64) -> bool {
     }
     let mut images = 0;
     for line in lines {
-        let Some(rest) = line.strip_prefix("image ") else {
+        let mut fields = line.splitn(4, ' ');
+        let (Some("image"), Some(len), Some(bytes_hash), Some(rel)) =
+            (fields.next(), fields.next(), fields.next(), fields.next())
+        else {
             return false;
         };
-        let Some((size, rel)) = rest.split_once(' ') else {
+        let (Ok(len), Ok(bytes_hash)) = (len.parse::<u64>(), u64::from_str_radix(bytes_hash, 16))
+        else {
             return false;
         };
-        let Ok(size) = size.parse::<u64>() else {
+        let path = out_dir.join(rel);
+        let same_length = std::fs::metadata(&path).is_ok_and(|m| m.is_file() && m.len() == len);
+        // The length first: a changed size is caught without reading the image.
+        if !same_length || std::fs::read(&path).map(|b| Fnv64::of(&b)).ok() != Some(bytes_hash) {
             return false;
-        };
-        match std::fs::metadata(out_dir.join(rel)) {
-            Ok(m) if m.is_file() && m.len() == size => images += 1,
-            _ => return false,
         }
+        images += 1;
     }
     images > 0
 }
@@ -119,18 +116,6 @@ pub(super) fn is_up_to_date(out_dir: &Path, name: &str, hash: u64) -> bool {
 mod tests {
     use super::*;
     use crate::sdf::{MaterialField, TransformOrder};
-
-    #[test]
-    fn fnv_known_values() {
-        // Published FNV-1a 64 test vectors.
-        let mut h = Fnv::new();
-        assert_eq!(h.0, 0xcbf29ce484222325);
-        h.write(b"a");
-        assert_eq!(h.0, 0xaf63dc4c8601ec8c);
-        let mut h = Fnv::new();
-        h.write(b"foobar");
-        assert_eq!(h.0, 0x85944171f73967e8);
-    }
 
     /// Changing any one setting changes the key. The structs are taken apart field by field
     /// without `..`, so a new setting does not compile here until it has a case of its own.
@@ -145,6 +130,8 @@ mod tests {
             max_depth,
             ppm_ascii,
             out_dir,
+            allow_any_output,
+            max_memory,
         } = base.clone();
         let LoadOptions {
             strict,
@@ -190,6 +177,20 @@ mod tests {
             (
                 RenderSettings {
                     out_dir: Some(out_dir.unwrap_or_default().join("elsewhere")),
+                    ..base.clone()
+                },
+                load.clone(),
+            ),
+            (
+                RenderSettings {
+                    allow_any_output: !allow_any_output,
+                    ..base.clone()
+                },
+                load.clone(),
+            ),
+            (
+                RenderSettings {
+                    max_memory: max_memory / 2,
                     ..base.clone()
                 },
                 load.clone(),

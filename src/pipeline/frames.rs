@@ -2,15 +2,20 @@
 //! frames in parallel (and tiles within frames), unchanged frames skipped (see [`super::cache`]),
 //! one shard of the frames when asked, and a summary at the end.
 
-use super::cache::{frame_hash, is_up_to_date, record_path, settings_fingerprint, write_record};
+use super::cache::{
+    frame_hash, is_up_to_date, record_path, settings_fingerprint, write_record, CACHE_DIR,
+};
 use super::scene_file::{render_scene_file, NoProgress};
 use super::Shard;
 use crate::diag::Diagnostic;
 use crate::render::RenderSettings;
 use crate::sdf::LoadOptions;
+use crate::util::remove_stale_temp_files;
 use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::collections::BTreeMap;
+use std::fs::{File, OpenOptions, TryLockError};
+use std::io::{Read as _, Seek as _, SeekFrom, Write as _};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -69,6 +74,52 @@ pub trait FrameObserver: Sync {
     fn finished(&self, _name: &str, _outcome: &FrameOutcome, _took: Duration) {}
     /// Every frame is done.
     fn end(&self) {}
+    /// Something worth saying that is not about one frame.
+    fn note(&self, _message: &str) {}
+}
+
+/// Holds the frame directory's lock file, `.anim-cache/lock`, for as long as it lives: two
+/// runs on one directory would otherwise write records that vouch for each other's images. A
+/// second run waits for the first, after saying which process it waits for.
+fn lock_frames(out_dir: &Path, observer: &dyn FrameObserver) -> Result<File, Vec<Diagnostic>> {
+    let path = out_dir.join(CACHE_DIR).join("lock");
+    let fail = |e: std::io::Error| {
+        vec![Diagnostic::file_error(
+            &path,
+            format!("cannot lock the frame directory: {e}"),
+        )]
+    };
+    std::fs::create_dir_all(out_dir.join(CACHE_DIR)).map_err(fail)?;
+    let mut file = OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(&path)
+        .map_err(fail)?;
+    match file.try_lock() {
+        Ok(()) => {}
+        Err(TryLockError::WouldBlock) => {
+            let mut holder = String::new();
+            let _ = file.read_to_string(&mut holder);
+            let holder = holder.trim();
+            observer.note(&format!(
+                "waiting for another anim render of this directory{} to finish",
+                if holder.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (process {holder})")
+                }
+            ));
+            file.lock().map_err(fail)?;
+        }
+        Err(TryLockError::Error(e)) => return Err(fail(e)),
+    }
+    // Who holds the lock, for the message of a run that has to wait.
+    file.set_len(0).map_err(fail)?;
+    file.seek(SeekFrom::Start(0)).map_err(fail)?;
+    write!(file, "{}", std::process::id()).map_err(fail)?;
+    Ok(file)
 }
 
 /// Renders the frames of `dir` on the current rayon pool. `Err` only when the directory itself
@@ -98,6 +149,15 @@ pub fn render_dir(
         .clone()
         .unwrap_or_else(|| dir.to_path_buf());
     let fingerprint = settings_fingerprint(settings, load);
+    let _lock = lock_frames(&out_dir, observer)?;
+    // Temporary files of runs that were killed mid-write; the lock keeps live ones of another
+    // run of this directory away, and other processes' temporary files are kept.
+    if let Err(e) = remove_stale_temp_files(&out_dir) {
+        observer.note(&format!(
+            "cannot clear old temporary files in {}: {e}",
+            out_dir.display()
+        ));
+    }
 
     let mut summary = Summary {
         total: frames.len(),

@@ -12,5 +12,7 @@ pub use cache::{record_path, settings_fingerprint, CACHE_DIR};
 pub use frames::{
     list_frames, natural_cmp, render_dir, FrameObserver, FrameOptions, FrameOutcome, Summary,
 };
-pub use scene_file::{output_path, render_scene_file, FileOutcome, ImageProgress, NoProgress};
+pub use scene_file::{
+    output_path, render_scene_file, FileOutcome, ImageProgress, NoProgress, Output,
+};
 pub use shard::Shard;

@@ -4,16 +4,23 @@
 use crate::diag::{Diagnostic, Severity};
 use crate::limits;
 use crate::render::camera::CameraError;
-use crate::render::film::{self, ImageFormat};
+use crate::render::film::{self, ImageBytes, ImageFormat};
 use crate::render::{render_job, RayCounts, RenderSettings, Rendered};
 use crate::scene::RenderJob;
 use crate::sdf::LoadOptions;
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
+
+/// An image file written, with what was written to it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Output {
+    pub path: PathBuf,
+    pub bytes: ImageBytes,
+}
 
 /// What rendering one scene file produced.
 #[derive(Clone, Debug)]
 pub struct FileOutcome {
-    pub outputs: Vec<PathBuf>,
+    pub outputs: Vec<Output>,
     pub warnings: Vec<Diagnostic>,
     pub rays: RayCounts,
 }
@@ -36,14 +43,70 @@ pub struct NoProgress;
 impl ImageProgress for NoProgress {}
 
 /// Where a job's image goes: relative paths are taken against `--out` or the scene's folder.
-pub fn output_path(scene_file: &Path, job: &RenderJob, settings: &RenderSettings) -> PathBuf {
+/// A path that would leave that folder (absolute, or climbing out with `..`) is confined to it:
+/// its file name is written there instead, and the second value says so (an error under
+/// `--strict`). `--allow-any-output` honours every path as written.
+pub fn output_path(
+    scene_file: &Path,
+    job: &RenderJob,
+    settings: &RenderSettings,
+    strict: bool,
+) -> (PathBuf, Option<Diagnostic>) {
     let base = settings.out_dir.clone().unwrap_or_else(|| {
         scene_file
             .parent()
             .map(Path::to_path_buf)
             .unwrap_or_default()
     });
-    base.join(&job.output)
+    if settings.allow_any_output || stays_inside(&job.output) {
+        return (base.join(&job.output), None);
+    }
+    let Some(name) = job.output.file_name() else {
+        return (base.join(&job.output), None);
+    };
+    let confined = base.join(name);
+    let severity = if strict {
+        Severity::Error
+    } else {
+        Severity::Warning
+    };
+    let folder = if settings.out_dir.is_some() {
+        "the output folder (--out)"
+    } else {
+        "the scene's folder"
+    };
+    let diagnostic = job_error(
+        scene_file,
+        job,
+        format!(
+            "'{}' is outside {folder}; the image is written to '{}' instead",
+            job.output.display(),
+            confined.display()
+        ),
+    )
+    .with_severity(severity)
+    .with_help("pass --allow-any-output to write where the render line says");
+    (confined, Some(diagnostic))
+}
+
+/// Whether a relative path stays inside the folder it is taken against (`a/../b` does,
+/// `../b` and `/b` do not).
+fn stays_inside(path: &Path) -> bool {
+    let mut depth = 0usize;
+    for component in path.components() {
+        match component {
+            Component::Normal(_) => depth += 1,
+            Component::CurDir => {}
+            Component::ParentDir => {
+                let Some(up) = depth.checked_sub(1) else {
+                    return false;
+                };
+                depth = up;
+            }
+            Component::RootDir | Component::Prefix(_) => return false,
+        }
+    }
+    true
 }
 
 fn job_error(path: &Path, job: &RenderJob, message: String) -> Diagnostic {
@@ -67,7 +130,33 @@ pub fn render_scene_file(
     let mut targets = Vec::with_capacity(loaded.jobs.len());
     let mut errors = Vec::new();
     for job in &loaded.jobs {
-        let out = output_path(path, job, settings);
+        let (out, confined) = output_path(path, job, settings, load.strict);
+        if let Some(d) = confined {
+            if d.is_error() {
+                errors.push(d);
+            } else {
+                warnings.push(d);
+            }
+        }
+        let (width, height, _) = settings.resolve(job);
+        let needed = limits::image_memory(width, height);
+        if needed > settings.max_memory {
+            errors.push(
+                job_error(
+                    path,
+                    job,
+                    format!(
+                        "a {width}×{height} image needs about {} to render, more than the {} allowed",
+                        gib(needed),
+                        gib(settings.max_memory)
+                    ),
+                )
+                .with_help(
+                    "render it smaller, or in tiles (several cameras, each seeing part of the view); --max-memory raises the limit",
+                ),
+            );
+            continue;
+        }
         match ImageFormat::for_path(&out, settings.ppm_ascii) {
             Some(format) => targets.push((out, format)),
             None => errors.push(
@@ -116,6 +205,11 @@ pub fn render_scene_file(
     }
 }
 
+/// `bytes` in GiB, for messages.
+fn gib(bytes: u64) -> String {
+    format!("{:.1} GiB", bytes as f64 / (1u64 << 30) as f64)
+}
+
 /// Renders and writes each job; problems go to `diagnostics`, and an error stops the file.
 fn render_jobs(
     path: &Path,
@@ -124,7 +218,7 @@ fn render_jobs(
     settings: &RenderSettings,
     progress: &dyn ImageProgress,
     diagnostics: &mut Vec<Diagnostic>,
-) -> Result<(Vec<PathBuf>, RayCounts), ()> {
+) -> Result<(Vec<Output>, RayCounts), ()> {
     let mut outputs = Vec::with_capacity(jobs.len());
     let mut rays = RayCounts::default();
     for (job, (out, format)) in jobs.iter().zip(targets) {
@@ -166,16 +260,19 @@ fn render_jobs(
                 None => job_error(path, job, message).with_severity(Severity::Warning),
             });
         }
-        if let Err(e) = film::write_image(&out, &image, format) {
-            diagnostics.push(job_error(
-                path,
-                job,
-                format!("cannot write '{}': {e}", out.display()),
-            ));
-            return Err(());
-        }
+        let bytes = match film::write_image(&out, &image, format) {
+            Ok(bytes) => bytes,
+            Err(e) => {
+                diagnostics.push(job_error(
+                    path,
+                    job,
+                    format!("cannot write '{}': {e}", out.display()),
+                ));
+                return Err(());
+            }
+        };
         rays += counts;
-        outputs.push(out);
+        outputs.push(Output { path: out, bytes });
     }
     Ok((outputs, rays))
 }

@@ -95,9 +95,24 @@ fn encode(
     }
 }
 
-pub fn write_image(path: &Path, img: &HdrImage, format: ImageFormat) -> io::Result<()> {
+/// What was written to an image file: its length and a fingerprint of its exact bytes, so
+/// that a later run can tell the file is still the one this run wrote.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ImageBytes {
+    pub len: u64,
+    pub hash: u64,
+}
+
+/// Encodes `img` and writes it to `path` atomically.
+pub fn write_image(path: &Path, img: &HdrImage, format: ImageFormat) -> io::Result<ImageBytes> {
     let rgb = to_rgb8(img);
-    crate::util::write_atomically(path, |w| encode(w, &rgb, img.width, img.height, format))
+    let mut encoded = Vec::new();
+    encode(&mut encoded, &rgb, img.width, img.height, format)?;
+    crate::util::write_atomically(path, |w| w.write_all(&encoded))?;
+    Ok(ImageBytes {
+        len: encoded.len() as u64,
+        hash: crate::util::Fnv64::of(&encoded),
+    })
 }
 
 #[cfg(test)]
@@ -142,8 +157,10 @@ mod tests {
             height: 1,
             pixels: vec![Vec3::new(1.0, 0.0, 3.0), Vec3::ZERO],
         };
-        write_image(&path, &img, ImageFormat::PpmBinary).unwrap();
+        let written = write_image(&path, &img, ImageFormat::PpmBinary).unwrap();
         let bytes = std::fs::read(&path).unwrap();
+        assert_eq!(written.len, bytes.len() as u64);
+        assert_eq!(written.hash, crate::util::Fnv64::of(&bytes));
         assert_eq!(&bytes[..11], b"P6\n2 1\n255\n");
         assert_eq!(&bytes[11..], &[128, 0, 191, 0, 0, 0]);
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);

@@ -31,6 +31,11 @@ pub struct RenderSettings {
     pub ppm_ascii: bool,
     /// Images go here instead of beside the scene file.
     pub out_dir: Option<PathBuf>,
+    /// Honour render lines that write outside the output folder (absolute paths, `..`).
+    pub allow_any_output: bool,
+    /// Bytes one image may take while it is made; bigger images are refused before any
+    /// allocation.
+    pub max_memory: u64,
 }
 
 impl Default for RenderSettings {
@@ -39,9 +44,11 @@ impl Default for RenderSettings {
             spp: None,
             width: None,
             height: None,
-            max_depth: 8,
+            max_depth: crate::limits::DEFAULT_MAX_DEPTH,
             ppm_ascii: false,
             out_dir: None,
+            allow_any_output: false,
+            max_memory: crate::limits::default_memory_budget(),
         }
     }
 }
