@@ -11,7 +11,13 @@ fn main() -> ExitCode {
         Command::Check(args) => {
             anim::sdf::check_paths(&args.inputs, &args.scene.load_options(), args.quiet)
         }
-        Command::Generate(args) => anim::anim::generate_command(&args),
+        Command::Generate(args) => {
+            let config = anim::anim::GenerateConfig {
+                spec: args.spec,
+                out: args.out,
+            };
+            anim::anim::generate_command(&config, args.quiet)
+        }
         Command::Bench(args) => anim::bench::run(&args),
     }
 }

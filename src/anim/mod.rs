@@ -2,15 +2,16 @@
 //! file per frame.
 //!
 //! [`spec`] reads and checks the spec, [`interp`] samples keyed values, [`orbit`] places the
-//! turntable camera and [`generate`] writes the frames.
+//! turntable camera and [`generate`] writes the frames. Imports run one way: `generate` →
+//! `orbit` → `spec` → {`interp`, `locate`, `tidy`}.
 
 pub mod generate;
 pub mod interp;
 pub mod locate;
 pub mod orbit;
 pub mod spec;
+pub mod tidy;
 
-use crate::cli::GenerateArgs;
 use crate::diag::{Diagnostic, Loc};
 use crate::render::film::write_atomically;
 use crate::sdf::LoadOptions;
@@ -20,6 +21,16 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
+
+/// What to generate, and where.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GenerateConfig {
+    /// The RON keyframe spec.
+    pub spec: PathBuf,
+    /// Where the frames go; default: the spec's `frames_dir`, else `frames/<spec name>`
+    /// beside the spec.
+    pub out: Option<PathBuf>,
+}
 
 /// What `anim generate` did.
 #[derive(Debug)]
@@ -39,8 +50,8 @@ pub struct GenerateReport {
 }
 
 /// `anim generate`: reads the spec, writes the frames. `Err` holds every error found.
-pub fn run_generate(args: &GenerateArgs) -> Result<GenerateReport, Vec<Diagnostic>> {
-    let spec_path = args.spec.as_path();
+pub fn run_generate(config: &GenerateConfig) -> Result<GenerateReport, Vec<Diagnostic>> {
+    let spec_path = config.spec.as_path();
     let bytes = std::fs::read(spec_path).map_err(|e| {
         vec![Diagnostic::file_error(
             spec_path,
@@ -54,7 +65,7 @@ pub fn run_generate(args: &GenerateArgs) -> Result<GenerateReport, Vec<Diagnosti
         )]
     })?;
     let src = Source::new(spec_path, text);
-    let spec_file = spec::parse(&src).map_err(|d| vec![*d])?;
+    let spec_file = spec::parse(&src)?;
     let spec_dir = spec_path
         .parent()
         .map(Path::to_path_buf)
@@ -64,7 +75,7 @@ pub fn run_generate(args: &GenerateArgs) -> Result<GenerateReport, Vec<Diagnosti
     let base = BaseScene::new(statements);
     let anim = spec::validate(&spec_file, &base, &src)?;
 
-    let dir = match (&args.out, &spec_file.frames_dir) {
+    let dir = match (&config.out, &spec_file.frames_dir) {
         (Some(out), _) => out.clone(),
         (None, Some(d)) => spec_dir.join(d),
         (None, None) => {
@@ -114,17 +125,18 @@ pub fn run_generate(args: &GenerateArgs) -> Result<GenerateReport, Vec<Diagnosti
     })
 }
 
-/// `anim generate` as a command: prints warnings, errors and what was written.
-pub fn generate_command(args: &GenerateArgs) -> ExitCode {
-    match run_generate(args) {
+/// `anim generate` as a command: prints warnings (unless `quiet`), errors and what was
+/// written.
+pub fn generate_command(config: &GenerateConfig, quiet: bool) -> ExitCode {
+    match run_generate(config) {
         Ok(report) => {
-            if !args.quiet {
+            if !quiet {
                 for w in &report.warnings {
                     eprintln!("{w}");
                 }
                 let length = format!(
                     "{} s at {} fps",
-                    generate::tidy(report.frames as f64 / report.fps as f64),
+                    tidy::tidy(report.frames as f64 / report.fps as f64),
                     report.fps
                 );
                 let mut line = if report.written == report.frames {
@@ -155,13 +167,13 @@ pub fn generate_command(args: &GenerateArgs) -> ExitCode {
         Err(diags) => {
             let errors = diags.iter().filter(|d| d.is_error()).count();
             for d in &diags {
-                if d.is_error() || !args.quiet {
+                if d.is_error() || !quiet {
                     eprintln!("{d}");
                 }
             }
             eprintln!(
                 "error: {} not generated: {errors} error{}",
-                args.spec.display(),
+                config.spec.display(),
                 if errors == 1 { "" } else { "s" }
             );
             ExitCode::FAILURE
@@ -251,7 +263,7 @@ fn frame_texts(
     let opts = LoadOptions::default();
     let mut texts = Vec::with_capacity(anim.frames);
     for i in 0..anim.frames {
-        let text = generator.frame_text(i).map_err(|d| vec![*d])?;
+        let text = generator.frame_text(i)?;
         let path: Arc<Path> = Arc::from(dir.join(anim.output.sdf(i, anim.digits())).as_path());
         if let Err(diags) = crate::sdf::load_str(&text, &path, &opts) {
             // A frame that does not load is a bug or a combination the spec checks missed;
