@@ -83,6 +83,9 @@ fn number(v: &f64) -> f64 {
     *v
 }
 
+// The checks of keyed values: each sees a value as a vector (a number as `x`) and says what is
+// wrong with it, to follow the channel's name in the message.
+
 fn non_negative(v: DVec3) -> Option<String> {
     (v.x < 0.0).then(|| "must not be negative".to_string())
 }
