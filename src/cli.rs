@@ -1,6 +1,6 @@
 //! Command-line definitions (clap derive), resolved into configuration before any work starts.
 
-use crate::app::{CheckConfig, RenderConfig};
+use crate::app::{CheckConfig, GenerateConfig, RenderConfig};
 use crate::limits;
 use crate::pipeline::{FrameOptions, Shard};
 use crate::render::RenderSettings;
@@ -228,6 +228,16 @@ impl RenderArgs {
             max_memory: self
                 .max_memory
                 .unwrap_or_else(limits::default_memory_budget),
+        }
+    }
+}
+
+impl GenerateArgs {
+    /// What the command line asks `anim generate` to do.
+    pub fn config(&self) -> GenerateConfig {
+        GenerateConfig {
+            spec: self.spec.clone(),
+            out: self.out.clone(),
         }
     }
 }

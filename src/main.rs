@@ -8,7 +8,13 @@ fn main() -> ExitCode {
     match cli.command {
         Command::Render(args) => app::run(app::Command::Render(args.config()), args.threads),
         Command::Check(args) => app::run(app::Command::Check(args.config()), None),
-        Command::Generate(args) => anim::anim::generate_command(&args),
+        Command::Generate(args) => app::run(
+            app::Command::Generate {
+                config: args.config(),
+                quiet: args.quiet,
+            },
+            None,
+        ),
         Command::Bench(args) => anim::bench::run(&args),
     }
 }

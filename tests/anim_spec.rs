@@ -1,84 +1,38 @@
 //! The keyframe spec: parsing, located errors, interpolation values, the orbit camera and how
 //! keyed transforms compose with the base scene's own.
 
-use anim::anim::generate::{ops_matrix, BaseScene, Generator};
+use anim::anim::generate::{BaseScene, Generator};
 use anim::anim::interp::{sample, Interp, Key};
 use anim::anim::orbit::pose_at;
 use anim::anim::spec::{self, Animation, Orbit, Source};
-use anim::diag::{Diagnostic, Loc};
-use anim::scene::Geometry;
-use anim::sdf::ast::{CameraDef, LightDef, NameRef, Statement, StatementKind, TransformOp};
-use glam::{DMat4, DVec3, Vec3};
+use anim::diag::Diagnostic;
+use anim::scene::RenderJob;
+use anim::sdf::ast::StatementKind;
+use anim::sdf::LoadOptions;
+use glam::{DVec3, Vec3};
 use std::path::Path;
-use std::sync::Arc;
 
 // ---------------------------------------------------------------------------------------------
-// A small base scene built statement by statement (independent of the SDF reader).
+// A small base scene
 
-fn loc() -> Loc {
-    Loc {
-        file: Arc::from(Path::new("base.sdf")),
-        line: 1,
-        col: 1,
-    }
-}
-
-fn st(kind: StatementKind) -> Statement {
-    Statement { kind, loc: loc() }
-}
-
-fn name(n: &str) -> NameRef {
-    NameRef {
-        name: n.to_string(),
-        loc: loc(),
-    }
-}
+/// The base file places the ball (radius 1) at (5, 0, 0); the crate spans 1..3 × 0..2 × 1..3;
+/// the camera sits at (0, 0, 10) by its own transform.
+const BASE: &str = "\
+define material red 0.1 0.1 0.1 0.8 0 0 0 0 0 1
+define shape sphere ball 0 0 0 1 red
+transform ball translate 5 0 0
+define shape box crate 1 0 1 3 2 3 red
+define shape composite group ball crate
+define light sun 0 10 0 1 1 1 1
+define camera cam 60 0 0 0 0 0 -1 0 1 0
+transform cam translate 0 0 10
+";
 
 fn base() -> BaseScene {
-    BaseScene::new(vec![
-        st(StatementKind::Shape {
-            name: "ball".into(),
-            geometry: Geometry::Sphere {
-                center: DVec3::ZERO,
-                radius: 1.0,
-            },
-            material: name("red"),
-        }),
-        // The base file places the ball at (5, 0, 0).
-        st(StatementKind::Transform {
-            target: name("ball"),
-            ops: vec![TransformOp::Translate(DVec3::new(5.0, 0.0, 0.0))],
-        }),
-        st(StatementKind::Shape {
-            name: "crate".into(),
-            geometry: Geometry::Box {
-                p1: DVec3::new(1.0, 0.0, 1.0),
-                p2: DVec3::new(3.0, 2.0, 3.0),
-            },
-            material: name("red"),
-        }),
-        st(StatementKind::Composite {
-            name: "group".into(),
-            children: vec![name("ball"), name("crate")],
-        }),
-        st(StatementKind::Light(LightDef {
-            name: "sun".into(),
-            position: DVec3::new(0.0, 10.0, 0.0),
-            color: Vec3::ONE,
-            brightness: 1.0,
-        })),
-        st(StatementKind::Camera(CameraDef {
-            name: "cam".into(),
-            fov_x_deg: 60.0,
-            eye: DVec3::ZERO,
-            dir: DVec3::NEG_Z,
-            up: DVec3::Y,
-        })),
-        st(StatementKind::Transform {
-            target: name("cam"),
-            ops: vec![TransformOp::Translate(DVec3::new(0.0, 0.0, 10.0))],
-        }),
-    ])
+    let (statements, diags) =
+        anim::sdf::parse(BASE, Path::new("base.sdf"), &LoadOptions::default());
+    assert!(diags.is_empty(), "{diags:?}");
+    BaseScene::new(statements)
 }
 
 const HEADER: &str =
@@ -87,7 +41,8 @@ const HEADER: &str =
 /// Parses and validates `text` against [`base`]; errors rendered as text.
 fn check(text: &str) -> Result<Animation, Vec<String>> {
     let src = Source::new(Path::new("spec.ron"), text.to_string());
-    let parsed = spec::parse(&src).map_err(|d| vec![d.to_string()])?;
+    let parsed =
+        spec::parse(&src).map_err(|ds| ds.iter().map(Diagnostic::to_string).collect::<Vec<_>>())?;
     spec::validate(&parsed, &base(), &src)
         .map_err(|ds| ds.iter().map(Diagnostic::to_string).collect())
 }
@@ -145,7 +100,13 @@ fn wrong_type_is_located() {
         "(\n    {HEADER}    tracks: [(target: \"ball\", translate: [(at: 0, value: 5)])],\n)"
     );
     let e = one_error(&text);
-    assert!(e.starts_with("spec.ron:6:59: error: expected three numbers (x, y, z), found the unsigned integer `5`"), "{e}");
+    assert!(e.starts_with("spec.ron:6:58: error: expected three numbers (x, y, z), found the unsigned integer `5`"), "{e}");
+    assert!(
+        e.ends_with(
+            "value: 5)])],\n  |                                                          ^"
+        ),
+        "{e}"
+    );
 }
 
 #[test]
@@ -159,6 +120,36 @@ fn unknown_variant_is_located_with_a_suggestion() {
         "{e}"
     );
     assert!(e.contains("did you mean `EaseInOut`?"), "{e}");
+}
+
+/// The caret line of a rendered diagnostic: where it starts and how many carets.
+fn caret(e: &str) -> (usize, usize) {
+    let line = e
+        .lines()
+        .find(|l| l.trim_start().starts_with("| ") && l.contains('^'))
+        .unwrap_or_else(|| panic!("no caret in {e}"));
+    let after_bar = &line[line.find("| ").expect("gutter") + 2..];
+    let start = after_bar.find('^').expect("caret");
+    (
+        start + 1,
+        after_bar[start..].chars().take_while(|&c| c == '^').count(),
+    )
+}
+
+#[test]
+fn carets_cover_exactly_the_bad_text() {
+    let e = one_error(&format!("(\n    {HEADER}    fps: 30,\n)"));
+    assert!(
+        e.starts_with("spec.ron:6:5: error: the field `fps` is given twice"),
+        "{e}"
+    );
+    assert_eq!(caret(&e), (5, 3), "{e}");
+    let e = one_error(&format!(
+        "(\n    {HEADER}    tracks: [(target: \"ball\", rotate: [(at: 0, value: 1, interp: Smoth)])],\n)"
+    ));
+    assert_eq!(caret(&e), (66, 5), "{e}");
+    let e = one_error("(\n    scene: Inline(\"\"),\n    fps: \"24\",\n    length: Seconds(5),\n    resolution: (64, 36),\n)");
+    assert_eq!(caret(&e), (10, 4), "{e}");
 }
 
 #[test]
@@ -416,61 +407,98 @@ fn orbit_replaces_the_camera_pose_and_its_transforms() {
 // ---------------------------------------------------------------------------------------------
 // Composition with the base file's transforms
 
-/// The world matrix of `target` after frame `i`: its transform statements in order.
-fn final_matrix(statements: &[Statement], target: &str) -> DMat4 {
-    let ops: Vec<TransformOp> = statements
-        .iter()
-        .filter_map(|s| match &s.kind {
-            StatementKind::Transform { target: t, ops } if t.name == target => Some(ops.clone()),
-            _ => None,
-        })
-        .flatten()
-        .collect();
-    ops_matrix(&ops)
-}
-
-fn frame(text: &str, i: usize) -> Vec<Statement> {
+/// Frame `i` of the spec `text`, loaded by the real scene builder as the renderer will.
+fn frame(text: &str, i: usize) -> RenderJob {
     let anim = check(text).expect("valid");
     let src = Source::new(Path::new("spec.ron"), text.to_string());
     let b = base();
-    let g = Generator::new(&b, &anim, &src);
-    g.frame_statements(i).expect("frame")
+    let frame_text = Generator::new(&b, &anim, &src)
+        .frame_text(i)
+        .expect("frame");
+    let mut loaded =
+        anim::sdf::load_str(&frame_text, Path::new("frame.sdf"), &LoadOptions::default())
+            .unwrap_or_else(|e| panic!("{frame_text}\n{e:?}"));
+    assert_eq!(loaded.jobs.len(), 1);
+    loaded.jobs.remove(0)
 }
 
-#[test]
-fn keyed_rotation_and_scale_act_about_the_objects_own_centre() {
-    // The base file put the ball at (5, 0, 0). Turning it 90° and doubling it must leave its
-    // centre where it is (a spin, not an orbit about the origin).
-    let text = format!(
-        "(\n    {HEADER}    tracks: [(target: \"ball\", rotate: [(at: 0, value: 90)], scale: [(at: 0, value: 2)])],\n)"
-    );
-    let m = final_matrix(&frame(&text, 0), "ball");
-    assert!((m.transform_point3(DVec3::ZERO) - DVec3::new(5.0, 0.0, 0.0)).length() < 1e-9);
-    // A point on the sphere's +x side goes to the −z side, twice as far out.
-    let p = m.transform_point3(DVec3::new(1.0, 0.0, 0.0));
-    assert!((p - DVec3::new(5.0, 0.0, -2.0)).length() < 1e-9, "{p:?}");
+/// Where the object-space point `p` of instance `name` (`group/ball`) ends up in the world.
+fn world_point(job: &RenderJob, name: &str, p: DVec3) -> DVec3 {
+    let instance = job
+        .scene
+        .instances
+        .iter()
+        .find(|inst| inst.name == name)
+        .unwrap_or_else(|| panic!("no instance {name}"));
+    instance.transform.point(p)
+}
+
+fn assert_near(got: DVec3, want: DVec3) {
+    assert!((got - want).length() < 1e-9, "{got:?} != {want:?}");
 }
 
 #[test]
 fn keyed_translation_adds_to_the_base_placement_in_parent_axes() {
     let text = format!(
-        "(\n    {HEADER}    tracks: [(target: \"ball\", translate: [(at: 0, value: (0, 0, 0)), (at: 4, value: (0, 4, 0))])],\n)"
+        "(\n    {HEADER}    tracks: [(target: \"ball\", translate: [(at: 0, value: (0, 0, 0)), (at: 2, value: (0, 2, 0))])],\n)"
     );
-    // Frame 24 is t = 1 s: a quarter of the way.
-    let m = final_matrix(&frame(&text, 24), "ball");
-    assert!((m.transform_point3(DVec3::ZERO) - DVec3::new(5.0, 1.0, 0.0)).length() < 1e-9);
+    // The key is reached at t = 2 s (frame 48): the centre (5, 0, 0) has moved by (0, 2, 0).
+    let job = frame(&text, 48);
+    assert_near(
+        world_point(&job, "group/ball", DVec3::ZERO),
+        DVec3::new(5.0, 2.0, 0.0),
+    );
+    // Halfway there at t = 1 s, moving linearly.
+    let job = frame(&text, 24);
+    assert_near(
+        world_point(&job, "group/ball", DVec3::ZERO),
+        DVec3::new(5.0, 1.0, 0.0),
+    );
+    // The crate is not keyed and stays where the base file put it.
+    let corner = DVec3::new(1.0, 0.0, 1.0);
+    assert_near(world_point(&job, "group/crate", corner), corner);
+}
+
+#[test]
+fn keyed_rotation_and_scale_act_about_the_objects_own_centre() {
+    // Turning the ball 90° about +y and doubling it must leave its centre at (5, 0, 0): a spin,
+    // not an orbit about the origin.
+    let text = format!(
+        "(\n    {HEADER}    tracks: [(target: \"ball\", rotate: [(at: 0, value: 90)], scale: [(at: 0, value: 2)])],\n)"
+    );
+    let job = frame(&text, 0);
+    assert_near(
+        world_point(&job, "group/ball", DVec3::ZERO),
+        DVec3::new(5.0, 0.0, 0.0),
+    );
+    // +90° about +y takes +x to −z: the sphere's +x pole goes to the −z side, twice as far out.
+    assert_near(
+        world_point(&job, "group/ball", DVec3::X),
+        DVec3::new(5.0, 0.0, -2.0),
+    );
+    assert_near(
+        world_point(&job, "group/ball", DVec3::Z),
+        DVec3::new(7.0, 0.0, 0.0),
+    );
 }
 
 #[test]
 fn composite_pivot_is_the_centre_of_its_children() {
     // group = ball (bounds 4..6 × −1..1 × −1..1) + crate (1..3 × 0..2 × 1..3):
-    // bounds 1..6 × −1..2 × −1..3, centre (3.5, 0.5, 1). A half turn about y keeps it fixed.
+    // bounds 1..6 × −1..2 × −1..3, centre (3.5, 0.5, 1). A half turn about y through it maps
+    // (x, y, z) to (7 − x, y, 2 − z).
     let text = format!(
         "(\n    {HEADER}    tracks: [(target: \"group\", rotate: [(at: 0, value: 180)])],\n)"
     );
-    let m = final_matrix(&frame(&text, 0), "group");
-    let c = DVec3::new(3.5, 0.5, 1.0);
-    assert!((m.transform_point3(c) - c).length() < 1e-9);
+    let job = frame(&text, 0);
+    assert_near(
+        world_point(&job, "group/ball", DVec3::ZERO),
+        DVec3::new(2.0, 0.0, 2.0),
+    );
+    assert_near(
+        world_point(&job, "group/crate", DVec3::new(1.0, 0.0, 1.0)),
+        DVec3::new(6.0, 0.0, 1.0),
+    );
 }
 
 #[test]
@@ -478,22 +506,26 @@ fn explicit_pivot_turns_a_light_around_a_point() {
     let text = format!(
         "(\n    {HEADER}    tracks: [(target: \"sun\", pivot: (0, 0, 0), axis: (1, 0, 0), rotate: [(at: 0, value: 90)], brightness: [(at: 0, value: 0.5)], color: [(at: 0, value: (1, 0.5, 0))])],\n)"
     );
-    let statements = frame(&text, 0);
-    let m = final_matrix(&statements, "sun");
+    let job = frame(&text, 0);
+    let sun = &job.scene.lights[0];
     // (0, 10, 0) turned 90° about +x goes to (0, 0, 10).
-    assert!(
-        (m.transform_point3(DVec3::new(0.0, 10.0, 0.0)) - DVec3::new(0.0, 0.0, 10.0)).length()
-            < 1e-9
-    );
-    let light = statements
-        .iter()
-        .find_map(|s| match &s.kind {
-            StatementKind::Light(l) => Some(l.clone()),
-            _ => None,
-        })
-        .expect("light");
-    assert_eq!(light.brightness, 0.5);
-    assert_eq!(light.color, Vec3::new(1.0, 0.5, 0.0));
+    assert_near(sun.position, DVec3::new(0.0, 0.0, 10.0));
+    // Intensity is brightness · colour.
+    assert_eq!(sun.intensity, Vec3::new(0.5, 0.25, 0.0));
+}
+
+#[test]
+fn orbit_eye_follows_the_circle_whatever_the_base_transforms() {
+    let text = format!("(\n    {HEADER}    orbit: (center: (0, 0, 0), radius: 4, height: 1),\n)");
+    // One turn in 120 frames: 3° per frame, from the +z side towards +x. The base file's
+    // `transform cam translate 0 0 10` must not move the eye off the circle.
+    for i in [0, 17, 30, 60, 101] {
+        let job = frame(&text, i);
+        let theta = (3.0 * i as f64).to_radians();
+        let eye = DVec3::new(4.0 * theta.sin(), 1.0, 4.0 * theta.cos());
+        assert_near(job.camera.eye, eye);
+        assert_near(job.camera.dir.normalize(), -eye.normalize());
+    }
 }
 
 #[test]
@@ -501,32 +533,14 @@ fn ambient_and_fov_keys_are_set_in_place() {
     let text = format!(
         "(\n    {HEADER}    ambient: [(at: 0, value: 0), (at: 5, value: 1)],\n    tracks: [(target: \"cam\", fov: [(at: 0, value: 30), (at: 5, value: 80)])],\n)"
     );
-    let statements = frame(&text, 60); // t = 2.5 s, halfway
-    let ambient = statements
-        .iter()
-        .find_map(|s| match s.kind {
-            StatementKind::Ambient(a) => Some(a),
-            _ => None,
-        })
-        .expect("an ambient statement is added");
-    assert_eq!(ambient, Vec3::splat(0.5));
-    let fov = statements
-        .iter()
-        .find_map(|s| match &s.kind {
-            StatementKind::Camera(c) => Some(c.fov_x_deg),
-            _ => None,
-        })
-        .expect("camera");
-    assert_eq!(fov, 55.0);
-    // The frame ends with its own render line.
-    match &statements.last().expect("statements").kind {
-        StatementKind::Render(r) => {
-            assert_eq!(r.output, "frame_0060.png");
-            assert_eq!((r.width, r.height), (64, 36));
-            assert_eq!(r.camera.name, "cam");
-        }
-        other => panic!("last statement is {other}"),
-    }
+    let job = frame(&text, 60); // t = 2.5 s, halfway
+    assert_eq!(job.scene.ambient, Vec3::splat(0.5));
+    assert_eq!(job.camera.fov_x_deg, 55.0);
+    assert_eq!(job.output, Path::new("frame_0060.png"));
+    assert_eq!((job.width, job.height), (64, 36));
+    assert_eq!(job.camera.name, "cam");
+    // The base placement of the camera is kept when nothing moves it.
+    assert_near(job.camera.eye, DVec3::new(0.0, 0.0, 10.0));
 }
 
 #[test]
@@ -536,10 +550,9 @@ fn scale_through_zero_is_reported_at_the_frame() {
     let src = Source::new(Path::new("spec.ron"), text.clone());
     let b = base();
     let g = Generator::new(&b, &anim, &src);
-    let e = g
-        .frame_statements(24)
-        .expect_err("t = 1 s is scale 0")
-        .to_string();
+    let errors = g.frame_statements(24).expect_err("t = 1 s is scale 0");
+    assert_eq!(errors.len(), 1, "{errors:#?}");
+    let e = errors[0].to_string();
     assert!(
         e.starts_with(
             "spec.ron:6:38: error: at frame 24 (t = 1 s) the scale of 'ball' passes through 0"

@@ -377,7 +377,7 @@ fn committed_animations_generate_frames_that_load() {
         .expect("arguments")
         .command
         {
-            Sub::Generate(a) => a,
+            Sub::Generate(a) => a.config(),
             _ => unreachable!("a generate command"),
         };
         let report = anim::anim::run_generate(&args).unwrap_or_else(|e| {

@@ -16,10 +16,13 @@
 
 use super::orbit;
 use super::spec::{Animation, SceneNames, Source, TargetKind, Track};
+use super::tidy::{tidy, tidy3};
 use crate::diag::{Diagnostic, Loc};
+use crate::limits;
+use crate::math::Transform;
 use crate::scene::Geometry;
 use crate::sdf::ast::{NameRef, RenderDef, Statement, StatementKind, TransformOp};
-use glam::{DMat4, DVec3, Vec3};
+use glam::{DVec3, Vec3};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -29,9 +32,6 @@ pub struct BaseScene {
     kinds: BTreeMap<String, TargetKind>,
     default_camera: Option<String>,
 }
-
-/// Deeper than any real composite tree; guards against a malformed cycle.
-const MAX_NESTING: usize = 256;
 
 impl BaseScene {
     pub fn new(statements: Vec<Statement>) -> BaseScene {
@@ -72,20 +72,15 @@ impl BaseScene {
         }
     }
 
-    /// The product of `name`'s own transform statements, in file order (each applies after
-    /// the ones before it: `M ← T·M`, the renderer's default rule).
-    pub fn own_transform(&self, name: &str) -> DMat4 {
-        let mut m = DMat4::IDENTITY;
-        for s in &self.statements {
-            if let StatementKind::Transform { target, ops } = &s.kind {
-                if target.name == name {
-                    for op in ops {
-                        m = op_matrix(op) * m;
-                    }
-                }
-            }
-        }
-        m
+    /// `name`'s own transform statements composed as the scene builder composes them for
+    /// generated frames (`TransformOrder::World`: each applies after the ones before it).
+    pub fn own_transform(&self, name: &str) -> Transform {
+        let ops = self.statements.iter().flat_map(|s| match &s.kind {
+            StatementKind::Transform { target, ops } if target.name == name => ops.as_slice(),
+            _ => &[],
+        });
+        ops.filter_map(op_transform)
+            .fold(Transform::IDENTITY, |m, t| t.then_after(&m))
     }
 
     /// The last definition of `name` (later definitions replace earlier ones).
@@ -106,36 +101,28 @@ impl BaseScene {
 
     /// Bounding box of `name` in its parent's frame: its geometry (or its children) under
     /// its own transforms.
-    fn local_bounds(&self, name: &str, depth: usize) -> Option<(DVec3, DVec3)> {
-        if depth > MAX_NESTING {
+    fn local_bounds(&self, name: &str, depth: usize) -> Option<Bounds> {
+        if depth > limits::MAX_NESTING {
             return None;
         }
-        let (lo, hi) = match self.definition(name)? {
-            StatementKind::Shape { geometry, .. } => geometry_bounds(geometry),
-            StatementKind::Composite { children, .. } => {
-                let mut acc: Option<(DVec3, DVec3)> = None;
-                for c in children {
-                    if let Some((lo, hi)) = self.local_bounds(&c.name, depth + 1) {
-                        acc = Some(match acc {
-                            Some((a, b)) => (a.min(lo), b.max(hi)),
-                            None => (lo, hi),
-                        });
-                    }
-                }
-                acc?
-            }
-            StatementKind::Light(l) => (l.position, l.position),
-            StatementKind::Camera(c) => (c.eye, c.eye),
+        let own = match self.definition(name)? {
+            StatementKind::Shape { geometry, .. } => Bounds::of_geometry(geometry),
+            StatementKind::Composite { children, .. } => children
+                .iter()
+                .filter_map(|c| self.local_bounds(&c.name, depth + 1))
+                .reduce(Bounds::union)?,
+            StatementKind::Light(l) => Bounds::point(l.position),
+            StatementKind::Camera(c) => Bounds::point(c.eye),
             _ => return None,
         };
-        Some(transform_box(&self.own_transform(name), lo, hi))
+        Some(own.transformed(&self.own_transform(name)))
     }
 
     /// The default pivot of `name`: the centre of its bounding box where the base scene puts
     /// it (in its parent's frame); a light's or camera's position.
     pub fn default_pivot(&self, name: &str) -> DVec3 {
         self.local_bounds(name, 0)
-            .map(|(lo, hi)| (lo + hi) * 0.5)
+            .map(|b| b.center())
             .filter(|c| c.is_finite())
             .unwrap_or(DVec3::ZERO)
     }
@@ -155,83 +142,73 @@ impl SceneNames for BaseScene {
     }
 }
 
-fn op_matrix(op: &TransformOp) -> DMat4 {
+/// The transform of one operation, as the scene builder makes it; `None` for a zero scale or
+/// axis, which the builder rejects (the base scene has loaded, so none is left).
+fn op_transform(op: &TransformOp) -> Option<Transform> {
     match *op {
-        TransformOp::Translate(v) => DMat4::from_translation(v),
-        TransformOp::Rotate { degrees, axis } => match axis.try_normalize() {
-            Some(a) => DMat4::from_axis_angle(a, degrees.to_radians()),
-            None => DMat4::IDENTITY,
-        },
-        TransformOp::Scale(s) => DMat4::from_scale(s),
+        TransformOp::Translate(v) => Some(Transform::translate(v)),
+        TransformOp::Rotate { degrees, axis } => Transform::rotate(degrees, axis),
+        TransformOp::Scale(s) => Transform::scale(s),
     }
 }
 
-/// Object-space bounds; infinite planes count as their anchor point.
-fn geometry_bounds(g: &Geometry) -> (DVec3, DVec3) {
-    let around = |points: &[DVec3], r: f64| {
+/// An axis-aligned box in f64. `crate::math::Aabb` is f32 and padded for ray traversal; the
+/// default pivots written into frames need the exact centre.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Bounds {
+    lo: DVec3,
+    hi: DVec3,
+}
+
+impl Bounds {
+    fn point(p: DVec3) -> Bounds {
+        Bounds { lo: p, hi: p }
+    }
+
+    fn around(points: &[DVec3], radius: f64) -> Bounds {
+        let r = DVec3::splat(limits::fixed_radius(radius));
         let lo = points.iter().copied().fold(DVec3::INFINITY, DVec3::min);
         let hi = points.iter().copied().fold(DVec3::NEG_INFINITY, DVec3::max);
-        (lo - DVec3::splat(r.abs()), hi + DVec3::splat(r.abs()))
-    };
-    match g {
-        Geometry::Sphere { center, radius } => around(&[*center], *radius),
-        Geometry::Box { p1, p2 } => around(&[*p1, *p2], 0.0),
-        Geometry::Plane { point, .. } => (*point, *point),
-        Geometry::Triangle { vertices } => around(vertices, 0.0),
-        Geometry::Cylinder { p1, p2, radius } => around(&[*p1, *p2], *radius),
-        Geometry::Cone { base, tip, radius } => around(&[*base, *tip], *radius),
+        Bounds {
+            lo: lo - r,
+            hi: hi + r,
+        }
     }
-}
 
-fn transform_box(m: &DMat4, lo: DVec3, hi: DVec3) -> (DVec3, DVec3) {
-    let mut out = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-    for i in 0..8 {
-        let corner = DVec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        );
-        let p = m.transform_point3(corner);
-        out = (out.0.min(p), out.1.max(p));
+    /// Object-space bounds, loose for cylinders and cones (a sphere around each end); an
+    /// infinite plane counts as its anchor point.
+    fn of_geometry(g: &Geometry) -> Bounds {
+        match g {
+            Geometry::Sphere { center, radius } => Bounds::around(&[*center], *radius),
+            Geometry::Box { p1, p2 } => Bounds::around(&[*p1, *p2], 0.0),
+            Geometry::Plane { point, .. } => Bounds::point(*point),
+            Geometry::Triangle { vertices } => Bounds::around(vertices, 0.0),
+            Geometry::Cylinder { p1, p2, radius } => Bounds::around(&[*p1, *p2], *radius),
+            Geometry::Cone { base, tip, radius } => Bounds::around(&[*base, *tip], *radius),
+        }
     }
-    out
-}
 
-/// Rounds to 12 significant digits, so that generated files read `12` rather than
-/// `11.999999999999998`; far below anything visible, and deterministic.
-pub fn tidy(x: f64) -> f64 {
-    if x == 0.0 || !x.is_finite() {
-        return if x == 0.0 { 0.0 } else { x };
+    fn union(self, o: Bounds) -> Bounds {
+        Bounds {
+            lo: self.lo.min(o.lo),
+            hi: self.hi.max(o.hi),
+        }
     }
-    let scale = 10f64.powi(11 - x.abs().log10().floor() as i32);
-    if !scale.is_finite() || scale == 0.0 {
-        return x;
-    }
-    let r = (x * scale).round() / scale;
-    if r.is_finite() {
-        r
-    } else {
-        x
-    }
-}
 
-/// [`tidy`] for a vector, to 12 significant digits of its largest component, so that the
-/// round-off of a rotation (`2.4e-16` beside `4`) reads as 0.
-fn tidy3(v: DVec3) -> DVec3 {
-    let m = v.abs().max_element();
-    if m == 0.0 || !m.is_finite() {
-        return DVec3::new(tidy(v.x), tidy(v.y), tidy(v.z));
+    /// The box around this box's eight corners mapped by `t`.
+    fn transformed(&self, t: &Transform) -> Bounds {
+        let corners: [DVec3; 8] = std::array::from_fn(|i| {
+            t.point(DVec3::new(
+                if i & 1 == 0 { self.lo.x } else { self.hi.x },
+                if i & 2 == 0 { self.lo.y } else { self.hi.y },
+                if i & 4 == 0 { self.lo.z } else { self.hi.z },
+            ))
+        });
+        Bounds::around(&corners, 0.0)
     }
-    let scale = 10f64.powi(11 - m.log10().floor() as i32);
-    if !scale.is_finite() || scale == 0.0 {
-        return v;
-    }
-    let r = (v * scale).round() / scale;
-    // `+ 0.0` turns −0 into 0, which prints as `0` rather than `-0`.
-    if r.is_finite() {
-        r + DVec3::ZERO
-    } else {
-        v
+
+    fn center(&self) -> DVec3 {
+        (self.lo + self.hi) * 0.5
     }
 }
 
@@ -287,7 +264,7 @@ impl<'a> Generator<'a> {
     }
 
     /// The statements of frame `i`.
-    pub fn frame_statements(&self, i: usize) -> Result<Vec<Statement>, Box<Diagnostic>> {
+    pub fn frame_statements(&self, i: usize) -> Result<Vec<Statement>, Vec<Diagnostic>> {
         let anim = self.anim;
         let t = anim.time(i);
         let when = || format!("at frame {i} (t = {} s)", tidy(t));
@@ -295,13 +272,13 @@ impl<'a> Generator<'a> {
 
         if let Some(o) = &anim.orbit {
             let pose = orbit::pose_at(o, t, anim.duration()).ok_or_else(|| {
-                Box::new(self.src.error(
+                vec![self.src.error(
                     &["orbit.look_at", "orbit"],
                     format!(
                         "{} the orbiting camera would look straight up or down",
                         when()
                     ),
-                ))
+                )]
             })?;
             // The orbit sets the camera outright: its base transforms would move it off.
             out.retain(|s| !matches!(&s.kind, StatementKind::Transform { target, .. } if target.name == anim.camera));
@@ -368,12 +345,12 @@ impl<'a> Generator<'a> {
         t: f64,
         out: &mut [Statement],
         when: &dyn Fn() -> String,
-    ) -> Result<(), Box<Diagnostic>> {
+    ) -> Result<(), Vec<Diagnostic>> {
         let brightness = track.brightness.as_ref().and_then(|c| c.at(t));
         let rgb = track.color.as_ref().and_then(|c| c.at(t));
         let fov = match track.fov.as_ref().and_then(|c| c.at(t).map(|v| (v, c))) {
-            Some((v, ch)) if !(v > 0.0 && v < 180.0) => {
-                return Err(Box::new(self.src.error(
+            Some((v, ch)) if !limits::fov_is_valid(v) => {
+                return Err(vec![self.src.error(
                     &[&ch.path],
                     format!(
                         "{} the field of view of '{}' is {}°, outside 0–180° (a smooth curve overshoots here: add a key or use another interp)",
@@ -381,7 +358,7 @@ impl<'a> Generator<'a> {
                         track.target,
                         tidy(v)
                     ),
-                )));
+                )]);
             }
             other => other.map(|(v, _)| v),
         };
@@ -414,7 +391,7 @@ impl<'a> Generator<'a> {
         pivot: DVec3,
         t: f64,
         when: &dyn Fn() -> String,
-    ) -> Result<Vec<TransformOp>, Box<Diagnostic>> {
+    ) -> Result<Vec<TransformOp>, Vec<Diagnostic>> {
         let translate = tidy3(
             track
                 .translate
@@ -432,14 +409,14 @@ impl<'a> Generator<'a> {
         );
         if let Some(ch) = &track.scale {
             if scale.cmpeq(DVec3::ZERO).any() {
-                return Err(Box::new(self.src.error(
+                return Err(vec![self.src.error(
                     &[&ch.path],
                     format!(
                         "{} the scale of '{}' passes through 0, which cannot be rendered",
                         when(),
                         track.target
                     ),
-                )));
+                )]);
             }
         }
         let mut ops = Vec::new();
@@ -470,7 +447,7 @@ impl<'a> Generator<'a> {
     }
 
     /// The complete SDF text of frame `i`.
-    pub fn frame_text(&self, i: usize) -> Result<String, Box<Diagnostic>> {
+    pub fn frame_text(&self, i: usize) -> Result<String, Vec<Diagnostic>> {
         let statements = self.frame_statements(i)?;
         let anim = self.anim;
         let mut text = String::new();
@@ -511,9 +488,4 @@ fn set_or_append(
     if !found {
         out.push(g.statement(kind));
     }
-}
-
-/// Used by tests and the pivot logic: the matrix of a list of ops applied in order.
-pub fn ops_matrix(ops: &[TransformOp]) -> DMat4 {
-    ops.iter().fold(DMat4::IDENTITY, |m, op| op_matrix(op) * m)
 }

@@ -2,24 +2,35 @@
 //! file per frame.
 //!
 //! [`spec`] reads and checks the spec, [`interp`] samples keyed values, [`orbit`] places the
-//! turntable camera and [`generate`] writes the frames.
+//! turntable camera and [`generate`] writes the frames. Imports run one way: `generate` →
+//! `orbit` → `spec` → {`interp`, `locate`, `tidy`}.
 
 pub mod generate;
 pub mod interp;
 pub mod locate;
 pub mod orbit;
 pub mod spec;
+pub mod tidy;
 
-use crate::cli::GenerateArgs;
 use crate::diag::{Diagnostic, Loc};
 use crate::sdf::LoadOptions;
 use crate::util::write_atomically;
 use generate::{BaseScene, Generator};
 use spec::{Animation, SceneSource, Source};
+use std::collections::HashSet;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 use std::sync::Arc;
+
+/// What to generate, and where.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GenerateConfig {
+    /// The RON keyframe spec.
+    pub spec: PathBuf,
+    /// Where the frames go; default: the spec's `frames_dir`, else `frames/<spec name>`
+    /// beside the spec.
+    pub out: Option<PathBuf>,
+}
 
 /// What `anim generate` did.
 #[derive(Debug)]
@@ -30,8 +41,8 @@ pub struct GenerateReport {
     pub frames: usize,
     /// How many frame files were written because they were new or differed.
     pub written: usize,
-    /// Frame files (and their images) of an earlier, longer version of the animation that
-    /// were removed so they cannot be rendered or encoded by mistake.
+    /// Files an earlier run of `anim generate` wrote here (frames and their images) that the
+    /// animation no longer has, removed so they cannot be rendered or encoded by mistake.
     pub removed: usize,
     pub fps: u32,
     /// Warnings about the base scene.
@@ -39,8 +50,8 @@ pub struct GenerateReport {
 }
 
 /// `anim generate`: reads the spec, writes the frames. `Err` holds every error found.
-pub fn run_generate(args: &GenerateArgs) -> Result<GenerateReport, Vec<Diagnostic>> {
-    let spec_path = args.spec.as_path();
+pub fn run_generate(config: &GenerateConfig) -> Result<GenerateReport, Vec<Diagnostic>> {
+    let spec_path = config.spec.as_path();
     let bytes = std::fs::read(spec_path).map_err(|e| {
         vec![Diagnostic::file_error(
             spec_path,
@@ -54,7 +65,7 @@ pub fn run_generate(args: &GenerateArgs) -> Result<GenerateReport, Vec<Diagnosti
         )]
     })?;
     let src = Source::new(spec_path, text);
-    let spec_file = spec::parse(&src).map_err(|d| vec![*d])?;
+    let spec_file = spec::parse(&src)?;
     let spec_dir = spec_path
         .parent()
         .map(Path::to_path_buf)
@@ -64,7 +75,7 @@ pub fn run_generate(args: &GenerateArgs) -> Result<GenerateReport, Vec<Diagnosti
     let base = BaseScene::new(statements);
     let anim = spec::validate(&spec_file, &base, &src)?;
 
-    let dir = match (&args.out, &spec_file.frames_dir) {
+    let dir = match (&config.out, &spec_file.frames_dir) {
         (Some(out), _) => out.clone(),
         (None, Some(d)) => spec_dir.join(d),
         (None, None) => {
@@ -75,35 +86,61 @@ pub fn run_generate(args: &GenerateArgs) -> Result<GenerateReport, Vec<Diagnosti
             spec_dir.join("frames").join(stem)
         }
     };
-    let texts = frame_texts(&base, &anim, &src, &dir)?;
+    // Every frame is made and checked before any is written, so an invalid spec writes
+    // nothing; then they are made again one at a time as they are written, so memory holds
+    // one frame, however long the animation.
+    let generator = Generator::new(&base, &anim, &src);
+    for i in 0..anim.frames {
+        checked_frame_text(&generator, &anim, &src, &dir, i)?;
+    }
     std::fs::create_dir_all(&dir).map_err(|e| {
         vec![Diagnostic::file_error(
             &dir,
             format!("cannot create the frame directory: {e}"),
         )]
     })?;
+    let fail = |path: &Path, what: &str, e: std::io::Error| {
+        vec![Diagnostic::file_error(path, format!("{what}: {e}"))]
+    };
+    let manifest_path = dir.join(MANIFEST);
+    let previous = read_manifest(&manifest_path).map_err(|e| {
+        fail(
+            &manifest_path,
+            "cannot read the list of generated frames",
+            e,
+        )
+    })?;
     let mut written = 0;
-    for (i, text) in texts.iter().enumerate() {
-        let path = dir.join(anim.output.sdf(i, anim.digits()));
+    let mut manifest = String::new();
+    for i in 0..anim.frames {
+        let text = checked_frame_text(&generator, &anim, &src, &dir, i)?;
+        let name = anim.output.sdf(i, anim.digits());
+        let path = dir.join(&name);
+        manifest.push_str(&format!(
+            "{name}\t{}\n",
+            anim.output.image(i, anim.digits())
+        ));
         // Unchanged frames are left alone, so their files keep their identity for tools
         // that look at modification times.
         if std::fs::read(&path).ok().as_deref() == Some(text.as_bytes()) {
             continue;
         }
-        write_atomically(&path, |w| w.write_all(text.as_bytes())).map_err(|e| {
-            vec![Diagnostic::file_error(
-                &path,
-                format!("cannot write the frame: {e}"),
-            )]
-        })?;
+        write_atomically(&path, |w| w.write_all(text.as_bytes()))
+            .map_err(|e| fail(&path, "cannot write the frame", e))?;
         written += 1;
     }
-    let removed = remove_stale(&dir, &anim).map_err(|e| {
-        vec![Diagnostic::file_error(
-            &dir,
-            format!("cannot remove old frames: {e}"),
-        )]
-    })?;
+    let current: HashSet<&str> = manifest.lines().flat_map(|l| l.split('\t')).collect();
+    let mut removed = 0;
+    for stale in previous.iter().filter(|f| !current.contains(f.as_str())) {
+        let path = dir.join(stale);
+        match std::fs::remove_file(&path) {
+            Ok(()) => removed += 1,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(fail(&path, "cannot remove an old frame", e)),
+        }
+    }
+    write_atomically(&manifest_path, |w| w.write_all(manifest.as_bytes()))
+        .map_err(|e| fail(&manifest_path, "cannot record the generated frames", e))?;
     Ok(GenerateReport {
         dir,
         frames: anim.frames,
@@ -112,61 +149,6 @@ pub fn run_generate(args: &GenerateArgs) -> Result<GenerateReport, Vec<Diagnosti
         fps: anim.fps,
         warnings,
     })
-}
-
-/// `anim generate` as a command: prints warnings, errors and what was written.
-pub fn generate_command(args: &GenerateArgs) -> ExitCode {
-    match run_generate(args) {
-        Ok(report) => {
-            if !args.quiet {
-                for w in &report.warnings {
-                    eprintln!("{w}");
-                }
-                let length = format!(
-                    "{} s at {} fps",
-                    generate::tidy(report.frames as f64 / report.fps as f64),
-                    report.fps
-                );
-                let mut line = if report.written == report.frames {
-                    format!(
-                        "wrote {} frames ({length}) to {}",
-                        report.frames,
-                        report.dir.display()
-                    )
-                } else {
-                    format!(
-                        "wrote {} of {} frames ({length}) to {}; the others were unchanged",
-                        report.written,
-                        report.frames,
-                        report.dir.display()
-                    )
-                };
-                if report.removed > 0 {
-                    line += &format!(
-                        "; removed {} file{} of frames past the end",
-                        report.removed,
-                        if report.removed == 1 { "" } else { "s" }
-                    );
-                }
-                println!("{line}");
-            }
-            ExitCode::SUCCESS
-        }
-        Err(diags) => {
-            let errors = diags.iter().filter(|d| d.is_error()).count();
-            for d in &diags {
-                if d.is_error() || !args.quiet {
-                    eprintln!("{d}");
-                }
-            }
-            eprintln!(
-                "error: {} not generated: {errors} error{}",
-                args.spec.display(),
-                if errors == 1 { "" } else { "s" }
-            );
-            ExitCode::FAILURE
-        }
-    }
 }
 
 /// Parses the base scene. Errors stop generation; warnings are passed on.
@@ -240,79 +222,48 @@ fn shift_into_spec(mut d: Diagnostic, src: &Source) -> Diagnostic {
     d
 }
 
-/// Every frame's text, each checked by loading it as the renderer will.
-fn frame_texts(
-    base: &BaseScene,
+/// Frame `i`'s text, checked by loading it as the renderer will.
+fn checked_frame_text(
+    generator: &Generator,
     anim: &Animation,
     src: &Source,
     dir: &Path,
-) -> Result<Vec<String>, Vec<Diagnostic>> {
-    let generator = Generator::new(base, anim, src);
-    let opts = LoadOptions::default();
-    let mut texts = Vec::with_capacity(anim.frames);
-    for i in 0..anim.frames {
-        let text = generator.frame_text(i).map_err(|d| vec![*d])?;
-        let path: Arc<Path> = Arc::from(dir.join(anim.output.sdf(i, anim.digits())).as_path());
-        if let Err(diags) = crate::sdf::load_str(&text, &path, &opts) {
-            // A frame that does not load is a bug or a combination the spec checks missed;
-            // show the loader's own words with the frame text they are about.
-            let mut out = vec![Diagnostic::file_error(
-                &path,
-                format!(
-                    "frame {i} generated from {} does not load:",
-                    src.path.display()
-                ),
-            )];
-            out.extend(diags.into_iter().filter(Diagnostic::is_error));
-            return Err(out);
-        }
-        texts.push(text);
+    i: usize,
+) -> Result<String, Vec<Diagnostic>> {
+    let text = generator.frame_text(i)?;
+    let path: Arc<Path> = Arc::from(dir.join(anim.output.sdf(i, anim.digits())).as_path());
+    if let Err(diags) = crate::sdf::load_str(&text, &path, &LoadOptions::default()) {
+        // A frame that does not load is a bug or a combination the spec checks missed;
+        // show the loader's own words with the frame text they are about.
+        let mut out = vec![Diagnostic::file_error(
+            &path,
+            format!(
+                "frame {i} generated from {} does not load:",
+                src.path.display()
+            ),
+        )];
+        out.extend(diags.into_iter().filter(Diagnostic::is_error));
+        return Err(out);
     }
-    Ok(texts)
+    Ok(text)
 }
 
-/// Removes frame files (`.sdf`, image and render record) numbered at or beyond the frame
-/// count, or with a different number of digits: leftovers of an earlier version of the spec.
-fn remove_stale(dir: &Path, anim: &Animation) -> std::io::Result<usize> {
-    let digits = anim.digits();
-    let image_ext = anim
-        .output
-        .suffix
-        .rsplit_once('.')
-        .map(|(_, e)| e)
-        .unwrap_or("");
-    let stem_suffix = anim.output.suffix_stem();
-    let mut removed = 0;
-    let mut names: Vec<String> = std::fs::read_dir(dir)?
-        .filter_map(|e| e.ok())
-        .filter_map(|e| e.file_name().into_string().ok())
-        .collect();
-    names.sort();
-    for name in names {
-        let Some(rest) = name.strip_prefix(anim.output.prefix.as_str()) else {
-            continue;
-        };
-        let num_len = rest.chars().take_while(char::is_ascii_digit).count();
-        if num_len == 0 {
-            continue;
-        }
-        let (num, tail) = rest.split_at(num_len);
-        let is_frame_file =
-            tail == format!("{stem_suffix}.sdf") || tail == format!("{stem_suffix}.{image_ext}");
-        if !is_frame_file {
-            continue;
-        }
-        let stale = num.len() != digits || num.parse::<usize>().map_or(true, |n| n >= anim.frames);
-        if stale {
-            std::fs::remove_file(dir.join(&name))?;
-            if name.ends_with(".sdf") {
-                let record = crate::pipeline::record_path(dir, &name);
-                if record.exists() {
-                    std::fs::remove_file(record)?;
-                }
-            }
-            removed += 1;
-        }
+/// The files `anim generate` wrote into a frame directory, one frame a line (its `.sdf` file
+/// and the image its render line names). Only files listed here are ever removed: a frame
+/// directory may hold the user's own files with names like frames.
+const MANIFEST: &str = ".anim-generated";
+
+/// The files listed by an earlier run's manifest (none without one).
+fn read_manifest(path: &Path) -> std::io::Result<Vec<String>> {
+    match std::fs::read_to_string(path) {
+        Ok(text) => Ok(text
+            .lines()
+            .flat_map(|l| l.split('\t'))
+            // Only plain names in the directory itself, whatever the file says.
+            .filter(|f| !f.is_empty() && Path::new(f).file_name() == Some(f.as_ref()))
+            .map(str::to_string)
+            .collect()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Vec::new()),
+        Err(e) => Err(e),
     }
-    Ok(removed)
 }

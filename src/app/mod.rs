@@ -3,9 +3,11 @@
 //! calls the library, which returns values and diagnostics.
 
 mod check;
+mod generate;
 mod progress;
 mod render;
 
+pub use crate::anim::GenerateConfig;
 pub use check::CheckConfig;
 pub use render::RenderConfig;
 
@@ -17,6 +19,7 @@ use std::process::ExitCode;
 pub enum Command {
     Render(RenderConfig),
     Check(CheckConfig),
+    Generate { config: GenerateConfig, quiet: bool },
 }
 
 /// Runs `command` on a rayon pool of `threads` workers (default: one per core), the one pool
@@ -37,5 +40,6 @@ pub fn run(command: Command, threads: Option<u32>) -> ExitCode {
     pool.install(|| match &command {
         Command::Render(config) => render::run(config),
         Command::Check(config) => check::run(config),
+        Command::Generate { config, quiet } => generate::run(config, *quiet),
     })
 }

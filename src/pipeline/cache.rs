@@ -48,6 +48,24 @@ pub(super) fn frame_hash(sdf: &[u8], fingerprint: &str) -> u64 {
     h.finish()
 }
 
+/// Removes the records of frames whose `.sdf` file is gone from `frames_dir` (an animation
+/// made shorter), so they cannot vouch for anything later.
+pub(super) fn prune_orphan_records(frames_dir: &Path, out_dir: &Path) -> std::io::Result<()> {
+    let Ok(entries) = std::fs::read_dir(out_dir.join(CACHE_DIR)) else {
+        return Ok(());
+    };
+    for entry in entries {
+        let entry = entry?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if let Some(sdf) = name.strip_suffix(".hash") {
+            if !frames_dir.join(sdf).exists() {
+                std::fs::remove_file(entry.path())?;
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The record's text: a header, the hash, and each image with its length and byte hash.
 fn record_text(hash: u64, out_dir: &Path, outputs: &[Output]) -> String {
     let mut text = format!("anim-render-record {RECORD_VERSION}\nhash {hash:016x}\n");

@@ -3,7 +3,8 @@
 //! one shard of the frames when asked, and a summary at the end.
 
 use super::cache::{
-    frame_hash, is_up_to_date, record_path, settings_fingerprint, write_record, CACHE_DIR,
+    frame_hash, is_up_to_date, prune_orphan_records, record_path, settings_fingerprint,
+    write_record, CACHE_DIR,
 };
 use super::scene_file::{render_scene_file, NoProgress};
 use super::Shard;
@@ -152,6 +153,9 @@ pub fn render_dir(
     let _lock = lock_frames(&out_dir, observer)?;
     // Temporary files of runs that were killed mid-write; the lock keeps live ones of another
     // run of this directory away, and other processes' temporary files are kept.
+    if let Err(e) = prune_orphan_records(dir, &out_dir) {
+        observer.note(&format!("cannot remove old render records: {e}"));
+    }
     if let Err(e) = remove_stale_temp_files(&out_dir) {
         observer.note(&format!(
             "cannot clear old temporary files in {}: {e}",

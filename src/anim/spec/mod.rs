@@ -1,0 +1,27 @@
+//! The RON keyframe spec: serde types as the user writes them ([`raw`]), the text with the
+//! position of every value ([`source`]), and the checks ([`validate`]) that turn them into an
+//! [`Animation`] ([`model`]) whose every problem is reported at its line and column.
+//!
+//! The format is documented for users in `README.md`.
+
+mod model;
+mod raw;
+mod source;
+mod validate;
+
+pub use model::{Animation, Channel, NamePattern, Orbit, SceneNames, TargetKind, Track};
+pub use raw::{KeySpec, Length, OrbitSpec, Rgb, Scale, SceneSource, SpecFile, TrackSpec, V3};
+pub use source::Source;
+pub use validate::validate;
+
+use crate::diag::Diagnostic;
+
+/// Reads the spec's RON text. ron stops at the first problem: `Err` holds it, located in
+/// `source`.
+pub fn parse(source: &Source) -> Result<SpecFile, Vec<Diagnostic>> {
+    let options =
+        ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+    options
+        .from_str::<SpecFile>(&source.text)
+        .map_err(|e| vec![source.ron_error(&e)])
+}

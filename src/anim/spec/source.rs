@@ -1,0 +1,241 @@
+//! The spec's text with the position of every value in it, and ron's errors turned into
+//! located diagnostics in the user's terms.
+
+use crate::anim::locate::{Locations, Pos};
+use crate::diag::{suggest, Diagnostic, Loc, Severity};
+use std::path::Path;
+use std::sync::Arc;
+
+/// A spec's text and where each value stands in it.
+pub struct Source {
+    pub path: Arc<Path>,
+    pub text: String,
+    pub locations: Locations,
+}
+
+impl Source {
+    pub fn new(path: &Path, text: String) -> Source {
+        let locations = Locations::scan(&text);
+        Source {
+            path: Arc::from(path),
+            text,
+            locations,
+        }
+    }
+
+    fn line_text(&self, line: u32) -> Option<&str> {
+        self.text.lines().nth(line.checked_sub(1)? as usize)
+    }
+
+    /// A diagnostic at `pos`, quoting the line.
+    pub fn at_pos(
+        &self,
+        severity: Severity,
+        pos: Pos,
+        width: u32,
+        message: impl Into<String>,
+    ) -> Diagnostic {
+        let loc = Loc {
+            file: self.path.clone(),
+            line: pos.line,
+            col: pos.col,
+        };
+        let d = Diagnostic::new(severity, loc, message);
+        match self.line_text(pos.line) {
+            Some(src) => d.with_source(src, width),
+            None => d,
+        }
+    }
+
+    /// An error at the value found at the first existing path of `paths` (more specific
+    /// first); at the whole file if none exists.
+    pub fn error(&self, paths: &[&str], message: impl Into<String>) -> Diagnostic {
+        match self.locations.first(paths) {
+            Some((pos, width)) => self.at_pos(Severity::Error, pos, width, message),
+            None => Diagnostic::file_error(&self.path, message),
+        }
+    }
+
+    /// Turns ron's error into a located diagnostic in the user's terms.
+    pub fn ron_error(&self, e: &ron::error::SpannedError) -> Diagnostic {
+        use ron::error::Error as E;
+        let (pos, width) = self.span_of(&e.span);
+        let line_text = self.line_text(pos.line).unwrap_or("");
+        let names_a_name = matches!(
+            e.code,
+            E::NoSuchStructField { .. } | E::NoSuchEnumVariant { .. }
+        );
+        let (message, help) = describe_ron_error(&e.code);
+        // ron reads `64.5` where a whole number belongs as `64` followed by a stray `.5`, and
+        // complains about what follows; the real problem is the number.
+        let (pos, message, width) = match decimal_before(line_text, byte_index(line_text, pos.col))
+        {
+            Some((start, text)) => (
+                Pos {
+                    line: pos.line,
+                    col: line_text[..start].chars().count() as u32 + 1,
+                },
+                format!("expected a whole number, found `{text}`"),
+                text.chars().count() as u32,
+            ),
+            None => (pos, message, width),
+        };
+        let message = match self.locations_at(pos) {
+            Some((path, _)) if !names_a_name && !path.is_empty() => {
+                format!("{message} (in `{path}`)")
+            }
+            _ => message,
+        };
+        let d = self.at_pos(Severity::Error, pos, width, message);
+        match help {
+            Some(h) => d.with_help(h),
+            None => d,
+        }
+    }
+
+    /// Where ron's error span starts and how many characters of its first line it covers.
+    /// ron starts some spans at the whitespace before the offending value, which is skipped;
+    /// an empty span (a missing comma, a missing field) takes the width of the value there.
+    fn span_of(&self, span: &ron::error::Span) -> (Pos, u32) {
+        let line = span.start.line.max(1) as u32;
+        let chars: Vec<char> = self.line_text(line).unwrap_or("").chars().collect();
+        let mut start = (span.start.col.max(1) - 1).min(chars.len());
+        let end = if span.end.line == span.start.line {
+            (span.end.col.max(1) - 1).clamp(start, chars.len())
+        } else {
+            chars.len()
+        };
+        while start < end && chars[start].is_whitespace() {
+            start += 1;
+        }
+        let pos = if start == chars.len() && span.end.line > span.start.line {
+            Pos {
+                line: span.end.line as u32,
+                col: span.end.col.max(1) as u32,
+            }
+        } else {
+            Pos {
+                line,
+                col: start as u32 + 1,
+            }
+        };
+        let width = if pos.line == line && end > start {
+            (end - start) as u32
+        } else {
+            self.locations_at(pos).map_or(1, |(_, w)| w)
+        };
+        (pos, width)
+    }
+
+    /// The deepest value starting exactly at `pos`.
+    fn locations_at(&self, pos: Pos) -> Option<(String, u32)> {
+        self.locations.starting_at(pos)
+    }
+}
+
+/// If `line[at]` is the `.` of a decimal number (`64.5`), the number's start and text.
+fn decimal_before(line: &str, at: usize) -> Option<(usize, &str)> {
+    let bytes = line.as_bytes();
+    if bytes.get(at) != Some(&b'.') || !at.checked_sub(1).is_some_and(|p| bytes[p].is_ascii_digit())
+    {
+        return None;
+    }
+    let start = line[..at]
+        .rfind(|c: char| !(c.is_ascii_digit() || c == '-' || c == '+'))
+        .map_or(0, |i| i + 1);
+    let end = at
+        + 1
+        + line[at + 1..]
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '-' || c == '+'))
+            .unwrap_or(line.len() - at - 1);
+    Some((start, &line[start..end]))
+}
+
+/// What the user calls each serde type in messages.
+fn user_name(outer: &Option<String>) -> &'static str {
+    match outer.as_deref() {
+        Some("SpecFile") => "the spec",
+        Some("OrbitSpec") => "`orbit`",
+        Some("TrackSpec") => "a track",
+        Some("KeySpec") => "a key",
+        Some("SceneSource") => "`scene`",
+        Some("Length") => "`length`",
+        Some("Interp") => "`interp`",
+        _ => "this value",
+    }
+}
+
+fn list(names: &[&str]) -> String {
+    names
+        .iter()
+        .map(|n| format!("`{n}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn describe_ron_error(code: &ron::error::Error) -> (String, Option<String>) {
+    use ron::error::Error as E;
+    match code {
+        E::NoSuchStructField {
+            expected,
+            found,
+            outer,
+        } => {
+            let help = match suggest(found, expected.iter().copied()) {
+                Some(s) => format!("did you mean `{s}`?"),
+                None => format!("the fields of {} are {}", user_name(outer), list(expected)),
+            };
+            (
+                format!("unknown field `{found}` in {}", user_name(outer)),
+                Some(help),
+            )
+        }
+        E::NoSuchEnumVariant {
+            expected,
+            found,
+            outer,
+        } => {
+            let help = match suggest(found, expected.iter().copied()) {
+                Some(s) => format!("did you mean `{s}`?"),
+                None => format!("expected one of {}", list(expected)),
+            };
+            (
+                format!("unknown variant `{found}` for {}", user_name(outer)),
+                Some(help),
+            )
+        }
+        E::MissingStructField { field, outer } => (
+            format!("{} is missing the field `{field}`", user_name(outer)),
+            None,
+        ),
+        E::DuplicateStructField { field, outer } => (
+            format!("the field `{field}` is given twice in {}", user_name(outer)),
+            None,
+        ),
+        E::ExpectedInteger => ("expected a whole number".to_string(), None),
+        E::ExpectedFloat => ("expected a number".to_string(), None),
+        E::ExpectedString => ("expected a string in double quotes".to_string(), None),
+        E::ExpectedBoolean => ("expected `true` or `false`".to_string(), None),
+        E::InvalidValueForType { expected, found } => {
+            (format!("expected {expected}, found {found}"), None)
+        }
+        E::Message(m) => (lower_first(m), None),
+        // ron's own wording ("Expected closing `)`"), in the lower case of the rest.
+        other => (lower_first(&other.to_string()), None),
+    }
+}
+
+fn lower_first(text: &str) -> String {
+    let mut chars = text.chars();
+    match chars.next() {
+        Some(c) => c.to_lowercase().collect::<String>() + chars.as_str(),
+        None => String::new(),
+    }
+}
+
+/// The byte index of 1-based character column `col` in `line` (its end if past it).
+fn byte_index(line: &str, col: u32) -> usize {
+    line.char_indices()
+        .nth(col.saturating_sub(1) as usize)
+        .map_or(line.len(), |(i, _)| i)
+}

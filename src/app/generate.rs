@@ -1,0 +1,59 @@
+//! `anim generate SPEC.ron`: one SDF file per frame of a keyframe spec.
+
+use crate::anim::{self, GenerateConfig};
+use std::process::ExitCode;
+
+/// Prints warnings (unless `quiet`), errors and what was written.
+pub fn run(config: &GenerateConfig, quiet: bool) -> ExitCode {
+    match anim::run_generate(config) {
+        Ok(report) => {
+            if !quiet {
+                for w in &report.warnings {
+                    eprintln!("{w}");
+                }
+                let length = format!(
+                    "{} s at {} fps",
+                    anim::tidy::tidy(report.frames as f64 / report.fps as f64),
+                    report.fps
+                );
+                let mut line = if report.written == report.frames {
+                    format!(
+                        "wrote {} frames ({length}) to {}",
+                        report.frames,
+                        report.dir.display()
+                    )
+                } else {
+                    format!(
+                        "wrote {} of {} frames ({length}) to {}; the others were unchanged",
+                        report.written,
+                        report.frames,
+                        report.dir.display()
+                    )
+                };
+                if report.removed > 0 {
+                    line += &format!(
+                        "; removed {} file{} of frames the animation no longer has",
+                        report.removed,
+                        if report.removed == 1 { "" } else { "s" }
+                    );
+                }
+                println!("{line}");
+            }
+            ExitCode::SUCCESS
+        }
+        Err(diags) => {
+            let errors = diags.iter().filter(|d| d.is_error()).count();
+            for d in &diags {
+                if d.is_error() || !quiet {
+                    eprintln!("{d}");
+                }
+            }
+            eprintln!(
+                "error: {} not generated: {errors} error{}",
+                config.spec.display(),
+                if errors == 1 { "" } else { "s" }
+            );
+            ExitCode::FAILURE
+        }
+    }
+}
