@@ -3,6 +3,8 @@
 //! directly in tests) and compiled by `crate::render::compile` into the render scene.
 
 use crate::diag::Loc;
+pub use crate::shape::Geometry;
+
 use crate::math::Transform;
 use glam::{DVec3, Vec3};
 use std::path::PathBuf;
@@ -37,39 +39,6 @@ impl Material {
             ior: 1.0,
         }
     }
-}
-
-/// A primitive as written in its own (object) space.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Geometry {
-    Sphere {
-        center: DVec3,
-        radius: f64,
-    },
-    /// Corners in any order.
-    Box {
-        p1: DVec3,
-        p2: DVec3,
-    },
-    Plane {
-        point: DVec3,
-        normal: DVec3,
-    },
-    Triangle {
-        vertices: [DVec3; 3],
-    },
-    /// Axis p1 → p2, both ends capped.
-    Cylinder {
-        p1: DVec3,
-        p2: DVec3,
-        radius: f64,
-    },
-    /// Radius at the base, apex at the tip, base capped.
-    Cone {
-        base: DVec3,
-        tip: DVec3,
-        radius: f64,
-    },
 }
 
 /// One leaf of the composite tree placed in the world. A shape listed in two composites

@@ -5,7 +5,7 @@
 //! all three extras: reflectivity, opacity, ior).
 
 use crate::diag::Loc;
-use crate::scene::Geometry;
+use crate::shape::Geometry;
 use glam::{DVec3, Vec3};
 use std::fmt;
 

@@ -10,11 +10,12 @@ use super::ast::{
     CameraDef, LightDef, MaterialDef, NameRef, Statement, StatementKind, TransformOp,
 };
 use super::lexer;
-use super::parser::{default_output, is_zero, parallel, SourceContext};
+use super::parser::{default_output, SourceContext};
 use super::{LoadOptions, TransformOrder};
 use crate::diag::{suggest, Diagnostic, Loc, Severity};
 use crate::math::Transform;
 use crate::scene::{Camera, Geometry, Instance, Light, Material, RenderJob, Scene};
+use crate::shape::geometry::{degeneracy, is_zero, parallel};
 use glam::{DVec3, Vec3};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -31,40 +32,6 @@ const MAX_DEPTH: usize = 256;
 const SUGGESTION_BUDGET: usize = 1_000_000;
 /// Image size for files without a render statement.
 const DEFAULT_SIZE: (u32, u32) = (800, 600);
-
-/// Why a shape cannot be drawn, if it cannot (it is then dropped with a warning).
-pub(crate) fn degeneracy(g: &Geometry) -> Option<&'static str> {
-    // A radius whose square underflows is as good as 0 to the intersection tests.
-    let no_radius = |r: f64| r * r == 0.0;
-    match *g {
-        Geometry::Sphere { radius, .. } if no_radius(radius) => Some("has radius 0"),
-        Geometry::Cylinder { p1, p2, radius }
-        | Geometry::Cone {
-            base: p1,
-            tip: p2,
-            radius,
-        } => {
-            if no_radius(radius) {
-                Some("has radius 0")
-            } else if is_zero(p2 - p1) {
-                Some("has coincident end points")
-            } else {
-                None
-            }
-        }
-        Geometry::Triangle {
-            vertices: [a, b, c],
-        } => {
-            if parallel(b - a, c - a) {
-                Some("has collinear vertices")
-            } else {
-                None
-            }
-        }
-        Geometry::Plane { normal, .. } if is_zero(normal) => Some("has a zero normal"),
-        _ => None,
-    }
-}
 
 /// Builds the render jobs of a statement list. `source` is present when the statements come
 /// from `parser::parse`, which has already checked (and reported) the values of every

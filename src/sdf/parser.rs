@@ -10,11 +10,11 @@
 use super::ast::{
     CameraDef, LightDef, MaterialDef, NameRef, RenderDef, Statement, StatementKind, TransformOp,
 };
-use super::build::degeneracy;
 use super::lexer::{self, looks_numeric, Line, NumberError};
 use super::{LoadOptions, MaterialField};
 use crate::diag::{suggest, Diagnostic, Loc, Severity};
-use crate::scene::Geometry;
+use crate::shape::geometry::{degeneracy, is_zero, parallel};
+use crate::shape::Geometry;
 use glam::{DVec3, Vec3};
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
@@ -1966,16 +1966,4 @@ fn unit_axis(k: usize) -> DVec3 {
         1 => DVec3::Y,
         _ => DVec3::Z,
     }
-}
-
-/// Whether two vectors are parallel (or one of them is zero), relative to their lengths.
-pub(crate) fn parallel(a: DVec3, b: DVec3) -> bool {
-    let scale = a.length() * b.length();
-    is_zero(a) || is_zero(b) || scale == 0.0 || a.cross(b).length() <= 1e-9 * scale
-}
-
-/// Whether a direction is zero, or so short that it cannot be normalised (its squared
-/// length underflows): either way it gives no direction.
-pub(crate) fn is_zero(v: DVec3) -> bool {
-    v.try_normalize().is_none()
 }
