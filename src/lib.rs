@@ -9,6 +9,7 @@
 pub mod accel;
 pub mod anim;
 pub mod bench;
+pub mod check;
 pub mod cli;
 pub mod diag;
 pub mod limits;

@@ -9,7 +9,7 @@ fn main() -> ExitCode {
     match cli.command {
         Command::Render(args) => with_threads(args.threads, || render_command(&args)),
         Command::Check(args) => {
-            anim::sdf::check_paths(&args.inputs, &args.scene.load_options(), args.quiet)
+            anim::check::check_paths(&args.inputs, &args.scene.load_options(), args.quiet)
         }
         Command::Generate(args) => anim::anim::generate_command(&args),
         Command::Bench(args) => anim::bench::run(&args),

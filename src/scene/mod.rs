@@ -1,10 +1,17 @@
 //! The scene description: what an SDF file means, with names resolved, transforms composed
-//! and the composite tree flattened into instances. It is produced by `crate::sdf` (or built
-//! directly in tests) and compiled by `crate::render::compile` into the render scene.
+//! and the composite tree flattened into instances. It is built here from the statements of
+//! `crate::sdf` (or directly in tests) and compiled by `crate::render::compile` into the
+//! render scene.
+
+mod build;
+mod load;
+#[cfg(test)]
+mod tests;
+
+pub use crate::shape::Geometry;
+pub use load::{build, load_file, load_str, Loaded};
 
 use crate::diag::Loc;
-pub use crate::shape::Geometry;
-
 use crate::math::Transform;
 use glam::{DVec3, Vec3};
 use std::path::PathBuf;

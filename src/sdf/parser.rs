@@ -13,6 +13,7 @@ use super::ast::{
 use super::lexer::{self, looks_numeric, Line, NumberError};
 use super::{LoadOptions, MaterialField};
 use crate::diag::{suggest, Diagnostic, Loc, Severity};
+use crate::limits::{self, DEFAULT_IMAGE_SIZE, FOV_RULE};
 use crate::shape::geometry::{degeneracy, is_zero, parallel};
 use crate::shape::Geometry;
 use glam::{DVec3, Vec3};
@@ -20,14 +21,8 @@ use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use std::sync::Arc;
 
-/// Largest image side a `render` line may ask for (the same limit as `--width`).
-const MAX_SIDE: f64 = 65536.0;
-/// Largest samples-per-pixel count a `render` line may ask for (the same limit as `--spp`).
-const MAX_SAMPLES: u32 = 4096;
 /// Smallest scale factor accepted (besides the error for 0 itself).
 const MIN_SCALE: f64 = 1e-9;
-/// Image size used when a render-like line gives none.
-const DEFAULT_SIZE: (u32, u32) = (800, 600);
 
 const FORM_MATERIAL: &str = "define material <name> [Ka] [Kd] [Ks] <m> [extras...]";
 const FORM_SPHERE: &str = "define shape sphere <name> [center] <radius> <material>";
@@ -75,7 +70,7 @@ const SHAPE_KINDS: [&str; 7] = [
 ];
 
 /// The statements of a file, the problems met, and what `build` needs to know about the text.
-pub(crate) struct Parsed {
+pub struct Parsed {
     pub statements: Vec<Statement>,
     pub diagnostics: Vec<Diagnostic>,
     pub source: SourceContext,
@@ -83,7 +78,7 @@ pub(crate) struct Parsed {
 
 /// What the builder needs from the source beyond the statements themselves.
 #[derive(Debug, Default)]
-pub(crate) struct SourceContext {
+pub struct SourceContext {
     /// The file's lines as written, for quoting them in diagnostics.
     pub lines: Vec<String>,
     /// Names whose definition was rejected or skipped (already reported): references to them
@@ -149,7 +144,7 @@ struct PendingRender {
     notes: Vec<String>,
 }
 
-pub(crate) fn parse(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
+pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
     let lines = lexer::lines(text);
     let mut p = Parser {
         file: Arc::from(path),
@@ -607,7 +602,7 @@ impl Parser<'_> {
 
     /// A value that must lie in [0, 1]: clamped with a warning.
     fn unit_interval(&mut self, line: &Line, at: At, what: &str, value: f64) -> f32 {
-        let clamped = value.clamp(0.0, 1.0);
+        let clamped = limits::clamp_fraction(value);
         if clamped != value {
             self.warn(
                 line,
@@ -782,7 +777,7 @@ impl Parser<'_> {
                     format!("negative radius {}; its absolute value is used", *radius),
                     None,
                 );
-                *radius = radius.abs();
+                *radius = limits::fixed_radius(*radius);
             }
         }
         if let Some(reason) = degeneracy(&geometry) {
@@ -1150,8 +1145,8 @@ impl Parser<'_> {
             ));
         }
         let fov = nums[0];
-        if !(fov > 0.0 && fov < 180.0) {
-            let fov_last = nums.len() == 10 && nums[9] > 0.0 && nums[9] < 180.0;
+        if !limits::fov_is_valid(fov) {
+            let fov_last = nums.len() == 10 && limits::fov_is_valid(nums[9]);
             let help = if fov_last {
                 format!("the fov comes first: `{FORM_CAMERA}`")
             } else {
@@ -1160,9 +1155,7 @@ impl Parser<'_> {
             return Err(self.error(
                 line,
                 At::Tok(first),
-                format!(
-                    "the horizontal field of view must be between 0 and 180 degrees, found {fov}"
-                ),
+                format!("the horizontal field of view must be {FOV_RULE}, found {fov}"),
                 Some(help),
             ));
         }
@@ -1538,9 +1531,9 @@ impl Parser<'_> {
             0 => {
                 notes.push(format!(
                     "no image size given: {}×{}",
-                    DEFAULT_SIZE.0, DEFAULT_SIZE.1
+                    DEFAULT_IMAGE_SIZE.0, DEFAULT_IMAGE_SIZE.1
                 ));
-                DEFAULT_SIZE
+                DEFAULT_IMAGE_SIZE
             }
             1 => {
                 self.error(
@@ -1552,8 +1545,12 @@ impl Parser<'_> {
                 return;
             }
             _ => {
-                let w = self.whole(line, names_end, nums[0], "image width", 1.0, MAX_SIDE);
-                let h = self.whole(line, names_end + 1, nums[1], "image height", 1.0, MAX_SIDE);
+                let (min, max) = (
+                    f64::from(*limits::IMAGE_SIDE.start()),
+                    f64::from(*limits::IMAGE_SIDE.end()),
+                );
+                let w = self.whole(line, names_end, nums[0], "image width", min, max);
+                let h = self.whole(line, names_end + 1, nums[1], "image height", min, max);
                 match (w, h) {
                     (Ok(w), Ok(h)) => (w, h),
                     _ => return,
@@ -1573,14 +1570,15 @@ impl Parser<'_> {
                     "0 samples per pixel; the default is used",
                     None,
                 );
-            } else if s > MAX_SAMPLES {
+            } else if !limits::SAMPLES.contains(&s) {
+                let most = *limits::SAMPLES.end();
                 self.warn(
                     line,
                     At::Tok(names_end + 2),
-                    format!("{s} samples per pixel is more than {MAX_SAMPLES}; {MAX_SAMPLES} used"),
+                    format!("{s} samples per pixel is more than {most}; {most} used"),
                     None,
                 );
-                samples = Some(MAX_SAMPLES);
+                samples = Some(most);
             } else {
                 samples = Some(s);
             }
@@ -1818,10 +1816,10 @@ impl Parser<'_> {
                     None => {
                         def.camera.name = "default".to_string();
                         need_default_camera = true;
-                        notes.push(
-                            "no camera named and none defined: a default camera (fov 60) is used"
-                                .to_string(),
-                        );
+                        notes.push(format!(
+                            "no camera named and none defined: a default camera (fov {}) is used",
+                            limits::DEFAULT_FOV_DEG
+                        ));
                     }
                 }
             }
@@ -1867,7 +1865,7 @@ impl Parser<'_> {
                 Statement {
                     kind: StatementKind::Camera(CameraDef {
                         name: "default".to_string(),
-                        fov_x_deg: 60.0,
+                        fov_x_deg: limits::DEFAULT_FOV_DEG,
                         eye: DVec3::ZERO,
                         dir: DVec3::NEG_Z,
                         up: DVec3::Y,
@@ -1910,7 +1908,7 @@ pub(crate) fn commented_definitions<'t>(lines: &[Line<'t>]) -> HashMap<&'t str, 
 }
 
 /// `<file-stem>.png`, the output for files that name none.
-pub(crate) fn default_output(path: &Path) -> String {
+pub fn default_output(path: &Path) -> String {
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

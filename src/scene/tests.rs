@@ -2,8 +2,8 @@
 //! render semantics and the canonical text round trip.
 
 use super::*;
-use crate::diag::Severity;
-use crate::scene::Geometry;
+use crate::diag::{Diagnostic, Severity};
+use crate::sdf::{ast, parse, LoadOptions, MaterialField, TransformOrder};
 use glam::{DVec3, Vec3};
 use std::path::Path;
 

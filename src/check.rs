@@ -1,7 +1,8 @@
 //! `anim check FILE|DIR...`: load scene files without rendering and report every problem.
 
-use super::{load_file, LoadOptions};
 use crate::diag::Diagnostic;
+use crate::scene::load_file;
+use crate::sdf::LoadOptions;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
