@@ -7,9 +7,9 @@
 
 pub mod ast;
 pub(crate) mod lexer;
-mod parser;
+mod parse;
 
-pub use parser::{default_output, Parsed, SourceContext};
+pub use parse::{default_output, Parsed, SourceContext};
 
 use crate::diag::{Diagnostic, Severity};
 use std::path::Path;
@@ -65,7 +65,7 @@ pub fn parse(
     path: &Path,
     opts: &LoadOptions,
 ) -> (Vec<ast::Statement>, Vec<Diagnostic>) {
-    let parsed = parser::parse(text, path, opts);
+    let parsed = parse::parse(text, path, opts);
     (
         parsed.statements,
         finish_diagnostics(parsed.diagnostics, opts),
@@ -75,7 +75,7 @@ pub fn parse(
 /// A file's text as the reader leaves it: canonical statements, the problems met, and what
 /// the scene builder needs to know about the text beyond the statements.
 pub fn parse_source(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
-    parser::parse(text, path, opts)
+    parse::parse(text, path, opts)
 }
 
 /// Orders diagnostics by position (file-wide ones last) and applies `--strict`.
