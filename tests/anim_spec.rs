@@ -24,7 +24,7 @@ fn loc() -> Loc {
 }
 
 fn st(kind: StatementKind) -> Statement {
-    Statement { kind, loc: loc() }
+    Statement::new(kind, loc())
 }
 
 fn name(n: &str) -> NameRef {

@@ -40,7 +40,8 @@ pub fn build(
 /// one is an error.
 pub fn load_str(text: &str, path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnostic>> {
     let parsed = sdf::parse_source(text, path, opts);
-    let (jobs, built) = build_jobs(&parsed.statements, path, opts, Some(&parsed.source));
+    let (jobs, mut built) = build_jobs(&parsed.statements, path, opts, Some(&parsed.omissions));
+    parsed.quote_source(&mut built);
     let mut diagnostics = parsed.diagnostics;
     diagnostics.extend(built);
     conclude(jobs, finish_diagnostics(diagnostics, opts))

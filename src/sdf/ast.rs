@@ -21,6 +21,37 @@ pub struct Statement {
     pub kind: StatementKind,
     /// Where the statement starts (its first token).
     pub loc: Loc,
+    /// Where the reader found the tokens that problems found after reading point at; `None`
+    /// for statements made by a program.
+    pub spans: Option<StatementSpans>,
+}
+
+impl Statement {
+    /// A statement made by a program rather than read from text.
+    pub fn new(kind: StatementKind, loc: Loc) -> Self {
+        Statement {
+            kind,
+            loc,
+            spans: None,
+        }
+    }
+}
+
+/// A token as written: where it starts and how many characters it covers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Span {
+    pub loc: Loc,
+    pub width: u32,
+}
+
+/// The tokens of a statement read from text that the scene builder may point at.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StatementSpans {
+    /// The width of the first token (the one at `Statement::loc`).
+    pub first_width: u32,
+    /// The name the statement is about: the one a definition gives (a material, shape,
+    /// composite, light or camera), or a transform's target.
+    pub name: Option<Span>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -9,7 +9,7 @@ pub mod ast;
 pub(crate) mod lexer;
 mod parse;
 
-pub use parse::{default_output, Parsed, SourceContext};
+pub use parse::{default_output, Omissions, Parsed};
 
 use crate::diag::{Diagnostic, Severity};
 use std::path::Path;
@@ -72,8 +72,8 @@ pub fn parse(
     )
 }
 
-/// A file's text as the reader leaves it: canonical statements, the problems met, and what
-/// the scene builder needs to know about the text beyond the statements.
+/// A file's text as the reader leaves it: canonical statements (with the spans later problems
+/// point at), the problems met, and what it left out.
 pub fn parse_source(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
     parse::parse(text, path, opts)
 }

@@ -1,7 +1,7 @@
 //! Every definition of a file, final versions, with its values checked when the statements
 //! did not come through the reader.
 
-use super::Builder;
+use super::{At, Builder};
 use crate::diag::Loc;
 use crate::limits::{clamp_fraction, fov_is_valid, FOV_RULE};
 use crate::scene::{Geometry, Material};
@@ -14,7 +14,8 @@ use std::collections::HashMap;
 /// A shape or composite.
 pub(super) struct Object<'s> {
     pub(super) name: &'s str,
-    pub(super) loc: &'s Loc,
+    /// The statement that defines it.
+    pub(super) statement: &'s Statement,
     pub(super) kind: ObjectKind<'s>,
 }
 
@@ -57,10 +58,9 @@ impl Builder<'_> {
         let mut ambient_set: Option<Vec3> = None;
         let mut ambient_added = Vec3::ZERO;
         for (index, stmt) in statements.iter().enumerate() {
-            if self.check_values && !finite_statement(&stmt.kind) {
+            if !self.from_reader && !finite_statement(&stmt.kind) {
                 self.error(
-                    &stmt.loc,
-                    None,
+                    At::Statement(stmt),
                     "statement holds a number that is not finite".to_string(),
                     None,
                 );
@@ -68,12 +68,12 @@ impl Builder<'_> {
             }
             match &stmt.kind {
                 StatementKind::Material(m) => {
-                    let material = self.material(m, &stmt.loc);
+                    let material = self.material(m, stmt);
                     material_first_def
                         .entry(m.name.as_str())
                         .or_insert((index, stmt.loc.line));
                     if let Some(&i) = d.material_index.get(m.name.as_str()) {
-                        self.duplicate(&stmt.loc, &m.name, "material");
+                        self.duplicate(stmt, &m.name, "material");
                         d.materials[i] = material;
                     } else {
                         d.material_index.insert(&m.name, d.materials.len());
@@ -82,10 +82,9 @@ impl Builder<'_> {
                 }
                 StatementKind::Shape { name, geometry, .. } => {
                     if let Some(reason) = degeneracy(geometry) {
-                        if self.check_values {
+                        if !self.from_reader {
                             self.warn(
-                                &stmt.loc,
-                                Some(name),
+                                At::Name(stmt),
                                 format!("shape `{name}` {reason}; shape dropped"),
                                 None,
                             );
@@ -97,7 +96,7 @@ impl Builder<'_> {
                     // The material is resolved below, once every material is known.
                     let object = Object {
                         name,
-                        loc: &stmt.loc,
+                        statement: stmt,
                         kind: ObjectKind::Shape {
                             geometry,
                             material: None,
@@ -111,7 +110,7 @@ impl Builder<'_> {
                         .or_insert((index, stmt.loc.line));
                     let object = Object {
                         name,
-                        loc: &stmt.loc,
+                        statement: stmt,
                         kind: ObjectKind::Composite {
                             children: Vec::new(),
                         },
@@ -120,7 +119,7 @@ impl Builder<'_> {
                 }
                 StatementKind::Light(l) => {
                     if let Some(&i) = d.light_index.get(l.name.as_str()) {
-                        self.duplicate(&stmt.loc, &l.name, "light");
+                        self.duplicate(stmt, &l.name, "light");
                         d.lights[i] = l;
                     } else {
                         d.light_index.insert(&l.name, d.lights.len());
@@ -128,11 +127,11 @@ impl Builder<'_> {
                     }
                 }
                 StatementKind::Camera(c) => {
-                    if self.check_values && !self.camera_ok(c, &stmt.loc) {
+                    if !self.from_reader && !self.camera_ok(c, stmt) {
                         continue;
                     }
                     if let Some(&i) = d.camera_index.get(c.name.as_str()) {
-                        self.duplicate(&stmt.loc, &c.name, "camera");
+                        self.duplicate(stmt, &c.name, "camera");
                         d.cameras[i] = (c, &stmt.loc);
                     } else {
                         d.camera_index.insert(&c.name, d.cameras.len());
@@ -161,7 +160,7 @@ impl Builder<'_> {
                     };
                     // Only the final definition of the name is drawn; earlier ones were
                     // still checked above.
-                    if std::ptr::eq(d.objects[i].loc, &stmt.loc) {
+                    if std::ptr::eq(d.objects[i].statement, stmt) {
                         d.objects[i].kind = ObjectKind::Shape {
                             geometry,
                             material: if degeneracy(geometry).is_some() {
@@ -176,7 +175,7 @@ impl Builder<'_> {
                     let resolved =
                         self.resolve_children(&d, &first_object_def, index, name, children);
                     if let Some(&i) = d.object_index.get(name.as_str()) {
-                        if std::ptr::eq(d.objects[i].loc, &stmt.loc) {
+                        if std::ptr::eq(d.objects[i].statement, stmt) {
                             d.objects[i].kind = ObjectKind::Composite { children: resolved };
                         }
                     }
@@ -193,10 +192,9 @@ impl Builder<'_> {
                 ObjectKind::Shape { .. } => "shape",
                 ObjectKind::Composite { .. } => "composite",
             };
-            let earlier_line = d.objects[i].loc.line;
+            let earlier_line = d.objects[i].statement.loc.line;
             self.warn(
-                object.loc,
-                Some(object.name),
+                At::Name(object.statement),
                 format!(
                     "{what} `{}` is already defined (line {earlier_line}); the later definition replaces it",
                     object.name
@@ -208,16 +206,15 @@ impl Builder<'_> {
         d.objects.push(object);
     }
 
-    pub(super) fn duplicate(&mut self, loc: &Loc, name: &str, what: &str) {
+    pub(super) fn duplicate(&mut self, stmt: &Statement, name: &str, what: &str) {
         self.warn(
-            loc,
-            Some(name),
+            At::Name(stmt),
             format!("{what} `{name}` is already defined; the later definition replaces it"),
             None,
         );
     }
 
-    pub(super) fn material(&mut self, m: &MaterialDef, loc: &Loc) -> Material {
+    pub(super) fn material(&mut self, m: &MaterialDef, stmt: &Statement) -> Material {
         let mut out = Material {
             name: m.name.clone(),
             ka: m.ka,
@@ -234,15 +231,14 @@ impl Builder<'_> {
         if out.ior <= 0.0 {
             out.ior = 1.0;
         }
-        if self.check_values
+        if !self.from_reader
             && (out.m != m.m
                 || out.ior != m.ior
                 || out.reflectivity != m.reflectivity
                 || out.opacity != m.opacity)
         {
             self.warn(
-                loc,
-                Some(&m.name),
+                At::Name(stmt),
                 format!(
                     "material `{}` has values out of range (m and ior must be positive, \
                      reflectivity and opacity in [0, 1]); repaired",
@@ -255,7 +251,7 @@ impl Builder<'_> {
     }
 
     /// Checks a camera made by a program (the parser checks those it reads).
-    pub(super) fn camera_ok(&mut self, c: &CameraDef, loc: &Loc) -> bool {
+    pub(super) fn camera_ok(&mut self, c: &CameraDef, stmt: &Statement) -> bool {
         let problem = if !fov_is_valid(c.fov_x_deg) {
             Some(format!("a field of view {FOV_RULE}"))
         } else if is_zero(c.dir) {
@@ -268,8 +264,7 @@ impl Builder<'_> {
         match problem {
             Some(need) => {
                 self.error(
-                    loc,
-                    Some(&c.name),
+                    At::Name(stmt),
                     format!("camera `{}` needs {need}", c.name),
                     None,
                 );

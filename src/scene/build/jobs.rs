@@ -3,7 +3,7 @@
 
 use super::definitions::{Definitions, ObjectKind};
 use super::transforms::{finite_transform, Snapshot, Space};
-use super::{Builder, MAX_INSTANCES, MAX_TOTAL_INSTANCES};
+use super::{At, Builder, MAX_INSTANCES, MAX_TOTAL_INSTANCES};
 use crate::diag::Diagnostic;
 use crate::diag::Severity;
 use crate::limits::{self, DEFAULT_IMAGE_SIZE, MAX_NESTING};
@@ -44,8 +44,8 @@ impl Builder<'_> {
                     }
                 }
                 None => {
-                    if self.source.render_lines > 0
-                        || (self.source.cameras_rejected && d.cameras.is_empty())
+                    if self.omissions.render_lines > 0
+                        || (self.omissions.cameras_rejected && d.cameras.is_empty())
                     {
                         // The render line or the camera was rejected, with an error: no stand-in.
                         continue;
@@ -199,8 +199,7 @@ impl Builder<'_> {
         if !finite_transform(&world) {
             if self.reported_composites.insert(name.to_string()) {
                 self.error(
-                    object.loc,
-                    Some(name),
+                    At::Name(object.statement),
                     format!(
                         "the transforms above `{name}` multiply out beyond floating-point range"
                     ),
@@ -233,7 +232,7 @@ impl Builder<'_> {
                                 "write one file per frame (as `anim generate` does) instead of many render lines",
                             )
                         };
-                        self.error(object.loc, Some(name), message, Some(help.to_string()));
+                        self.error(At::Name(object.statement), message, Some(help.to_string()));
                     }
                     return;
                 }
@@ -251,7 +250,7 @@ impl Builder<'_> {
                     geometry,
                     material,
                     transform: world,
-                    loc: Some(object.loc.clone()),
+                    loc: Some(object.statement.loc.clone()),
                 });
             }
             ObjectKind::Composite { children } => {
@@ -260,8 +259,7 @@ impl Builder<'_> {
                         let mut cycle: Vec<&str> = stack[pos..].to_vec();
                         cycle.push(name);
                         self.error(
-                            object.loc,
-                            Some(name),
+                            At::Name(object.statement),
                             format!("composite `{name}` contains itself ({})", cycle.join(" → ")),
                             None,
                         );
@@ -271,8 +269,7 @@ impl Builder<'_> {
                 if stack.len() >= MAX_NESTING {
                     if self.reported_composites.insert(name.to_string()) {
                         self.error(
-                            object.loc,
-                            Some(name),
+                            At::Name(object.statement),
                             format!("composites are nested more than {MAX_NESTING} deep"),
                             None,
                         );

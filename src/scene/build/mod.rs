@@ -14,8 +14,7 @@ mod transforms;
 use crate::diag::{suggest, Diagnostic, Loc, Severity};
 use crate::scene::RenderJob;
 use crate::sdf::ast::{NameRef, Statement};
-use crate::sdf::lexer;
-use crate::sdf::{LoadOptions, SourceContext};
+use crate::sdf::{LoadOptions, Omissions};
 use std::collections::HashSet;
 use std::path::Path;
 
@@ -28,21 +27,22 @@ const MAX_TOTAL_INSTANCES: usize = 2_000_000;
 /// work at worst).
 const SUGGESTION_BUDGET: usize = 1_000_000;
 
-/// Builds the render jobs of a statement list. `source` is present when the statements come
-/// from `sdf::parse_source`, which has already checked (and reported) the values of every
-/// statement; without it (statements made by a program) those checks are made here.
+/// Builds the render jobs of a statement list. `omissions` is present when the statements
+/// come from `sdf::parse_source` in this same load, which has already checked (and reported)
+/// the values of every statement; without it (statements made by a program) those checks are
+/// made here.
 pub(super) fn build_jobs(
     statements: &[Statement],
     path: &Path,
     opts: &LoadOptions,
-    source: Option<&SourceContext>,
+    omissions: Option<&Omissions>,
 ) -> (Vec<RenderJob>, Vec<Diagnostic>) {
-    let empty = SourceContext::default();
+    let empty = Omissions::default();
     let mut b = Builder {
         path,
         opts,
-        check_values: source.is_none(),
-        source: source.unwrap_or(&empty),
+        from_reader: omissions.is_some(),
+        omissions: omissions.unwrap_or(&empty),
         diagnostics: Vec::new(),
         reported_composites: HashSet::new(),
         too_many_reported: false,
@@ -56,13 +56,26 @@ pub(super) fn build_jobs(
     (jobs, b.diagnostics)
 }
 
+/// What a builder diagnostic points at.
+#[derive(Clone, Copy)]
+enum At<'s> {
+    /// A statement's first token.
+    Statement(&'s Statement),
+    /// The name a statement is about: the one a definition gives, or a transform's target.
+    Name(&'s Statement),
+    /// A name used to refer to a definition.
+    Ref(&'s NameRef),
+}
+
 struct Builder<'a> {
     path: &'a Path,
     opts: &'a LoadOptions,
-    /// Whether to check values (radii, scale factors, cameras): only for statements that did
-    /// not come through the parser, which checks them with exact columns.
-    check_values: bool,
-    source: &'a SourceContext,
+    /// Whether the statements were read from text in this same load: the reader has then
+    /// checked their values (radii, scale factors, cameras) and recorded where their names
+    /// are written. Other statements (made by a program, or read earlier) have their values
+    /// checked here and their problems placed at the start of the statement.
+    from_reader: bool,
+    omissions: &'a Omissions,
     diagnostics: Vec<Diagnostic>,
     /// Composites whose cycle or depth problem has been reported (once, not once per job).
     reported_composites: HashSet<String>,
@@ -77,70 +90,56 @@ struct Builder<'a> {
 impl<'a> Builder<'a> {
     // ----- diagnostics -------------------------------------------------------------------
 
-    /// A diagnostic at `loc`, moved onto the token `name` when the line is known and `loc`
-    /// is the start of a statement rather than the name itself.
-    fn report(
-        &mut self,
-        severity: Severity,
-        loc: &Loc,
-        name: Option<&str>,
-        message: String,
-        help: Option<String>,
-    ) {
-        let mut loc = loc.clone();
-        let mut d = match self.source.line(loc.line) {
-            Some(text) => {
-                let tokens = lexer::tokenize(text);
-                let width = match name {
-                    Some(name) => {
-                        match tokens
-                            .iter()
-                            .skip(1)
-                            .find(|t| t.text == name && t.col >= loc.col)
-                        {
-                            Some(t) => {
-                                loc.col = t.col;
-                                t.width
-                            }
-                            None => name.chars().count() as u32,
-                        }
-                    }
-                    None => tokens
-                        .iter()
-                        .find(|t| t.col == loc.col)
-                        .map_or(1, |t| t.width),
-                };
-                Diagnostic::new(severity, loc, message).with_source(text, width)
+    /// Where `at` lies and how wide its caret is. Statements read in this same load point at
+    /// the tokens the reader recorded; the others at where they start (they have no text).
+    fn place(&self, at: At) -> (Loc, u32) {
+        match at {
+            At::Ref(r) => (r.loc.clone(), r.name.chars().count() as u32),
+            At::Name(stmt) if self.from_reader => {
+                match stmt.spans.as_ref().and_then(|s| s.name.as_ref()) {
+                    Some(name) => (name.loc.clone(), name.width),
+                    None => self.place(At::Statement(stmt)),
+                }
             }
-            None => Diagnostic::new(severity, loc, message),
-        };
+            At::Name(stmt) | At::Statement(stmt) => (
+                stmt.loc.clone(),
+                stmt.spans.as_ref().map_or(1, |s| s.first_width),
+            ),
+        }
+    }
+
+    fn report(&mut self, severity: Severity, at: At, message: String, help: Option<String>) {
+        let (loc, width) = self.place(at);
+        let mut d = Diagnostic::new(severity, loc, message);
+        // The source line is quoted by the loader, which has the text.
+        d.width = width.max(1);
         if let Some(h) = help {
             d = d.with_help(h);
         }
         self.diagnostics.push(d);
     }
 
-    fn warn(&mut self, loc: &Loc, name: Option<&str>, message: String, help: Option<String>) {
-        self.report(Severity::Warning, loc, name, message, help);
+    fn warn(&mut self, at: At, message: String, help: Option<String>) {
+        self.report(Severity::Warning, at, message, help);
     }
 
-    fn error(&mut self, loc: &Loc, name: Option<&str>, message: String, help: Option<String>) {
-        self.report(Severity::Error, loc, name, message, help);
+    fn error(&mut self, at: At, message: String, help: Option<String>) {
+        self.report(Severity::Error, at, message, help);
     }
 
     /// An error or warning about a name reference (the location is the name itself).
     fn at_ref(&mut self, severity: Severity, r: &NameRef, message: String, help: Option<String>) {
-        self.report(severity, &r.loc, Some(&r.name), message, help);
+        self.report(severity, At::Ref(r), message, help);
     }
 
     fn skipped(&self, name: &str) -> bool {
-        self.source.skipped.contains(name)
+        self.omissions.skipped.contains(name)
     }
 
     /// The line of a commented-out definition of `name` (`# define shape box b ...`), for
     /// the common case of a definition disabled while its uses were left in.
     fn commented_definition(&self, name: &str) -> Option<u32> {
-        self.source.commented.get(name).copied()
+        self.omissions.commented.get(name).copied()
     }
 
     /// A pointer to a commented-out definition of `name`, else "did you mean" among

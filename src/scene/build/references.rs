@@ -2,7 +2,7 @@
 //! composite graph as a whole (which must not contain itself).
 
 use super::definitions::{Definitions, ObjectKind};
-use super::Builder;
+use super::{At, Builder};
 use crate::diag::Severity;
 use crate::sdf::ast::NameRef;
 use std::collections::HashMap;
@@ -154,8 +154,7 @@ impl Builder<'_> {
                             let object = &d.objects[child];
                             if self.reported_composites.insert(object.name.to_string()) {
                                 self.error(
-                                    object.loc,
-                                    Some(object.name),
+                                    At::Name(object.statement),
                                     format!(
                                         "composite `{}` contains itself ({})",
                                         object.name,

@@ -2,8 +2,8 @@
 //! target at each render statement.
 
 use super::definitions::Definitions;
-use super::Builder;
-use crate::diag::{Loc, Severity};
+use super::{At, Builder};
+use crate::diag::Severity;
 use crate::math::Transform;
 use crate::sdf::ast::{NameRef, Statement, StatementKind, TransformOp};
 use crate::sdf::TransformOrder;
@@ -95,12 +95,7 @@ impl Builder<'_> {
     }
 
     /// The transform of one operation, or `None` (reported) when it has no inverse.
-    pub(super) fn op_transform(
-        &mut self,
-        op: &TransformOp,
-        loc: &Loc,
-        target: &str,
-    ) -> Option<Transform> {
+    pub(super) fn op_transform(&mut self, op: &TransformOp, stmt: &Statement) -> Option<Transform> {
         let t = match *op {
             TransformOp::Translate(v) => Some(Transform::translate(v)),
             TransformOp::Rotate { degrees, axis } => Transform::rotate(degrees, axis),
@@ -108,8 +103,7 @@ impl Builder<'_> {
         };
         if t.is_none() {
             self.error(
-                loc,
-                Some(target),
+                At::Name(stmt),
                 "scale by 0 or rotation about a zero axis: the transform has no inverse"
                     .to_string(),
                 None,
@@ -138,9 +132,7 @@ impl Builder<'_> {
                 StatementKind::Transform { target, ops } => {
                     if renders > 1 && renders_seen == renders && !late_transform_reported {
                         late_transform_reported = true;
-                        self.warn(
-                            &stmt.loc,
-                            None,
+                        self.warn(At::Statement(stmt),
                             "transform after the last render statement has no effect".to_string(),
                             Some(format!(
                                 "this file has {renders} render statements; each renders the transforms written before it"
@@ -153,7 +145,7 @@ impl Builder<'_> {
                     let key = (space, target.name.as_str());
                     let mut m = current.get(&key).copied().unwrap_or(Transform::IDENTITY);
                     for op in ops {
-                        let Some(t) = self.op_transform(op, &stmt.loc, &target.name) else {
+                        let Some(t) = self.op_transform(op, stmt) else {
                             continue;
                         };
                         let next = match self.opts.transform_order {
@@ -161,9 +153,7 @@ impl Builder<'_> {
                             TransformOrder::Local => m.then_after(&t),
                         };
                         if !finite_transform(&next) {
-                            self.error(
-                                &stmt.loc,
-                                Some(&target.name),
+                            self.error(At::Name(stmt),
                                 format!(
                                     "the transforms of `{}` multiply out beyond floating-point range",
                                     target.name

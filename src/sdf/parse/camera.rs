@@ -125,7 +125,7 @@ impl Parser<'_> {
                 ));
             }
         }
-        self.emit(line, StatementKind::Camera(def));
+        self.emit_named(line, name_at, StatementKind::Camera(def));
         Ok(())
     }
 }

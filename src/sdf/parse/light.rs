@@ -76,11 +76,11 @@ impl Parser<'_> {
         match nums.len() {
             7 => {
                 let l = light(c(3), nums[6] as f32);
-                self.emit(line, StatementKind::Light(l));
+                self.emit_named(line, name_at, StatementKind::Light(l));
             }
             6 => {
                 let l = light(c(3), 1.0);
-                self.emit(line, StatementKind::Light(l));
+                self.emit_named(line, name_at, StatementKind::Light(l));
             }
             9 => {
                 let last = c(6);
@@ -97,7 +97,7 @@ impl Parser<'_> {
                             Some(format!("read as `{}`", StatementKind::Light(l.clone()))),
                         );
                     }
-                    self.emit(line, StatementKind::Light(l));
+                    self.emit_named(line, name_at, StatementKind::Light(l));
                 } else {
                     let ambient = c(3);
                     let diffuse = last;
@@ -122,7 +122,7 @@ impl Parser<'_> {
                         self.skipped.insert(name);
                     } else {
                         let l = light(diffuse, 1.0);
-                        self.emit(line, StatementKind::Light(l));
+                        self.emit_named(line, name_at, StatementKind::Light(l));
                     }
                 }
             }

@@ -145,7 +145,7 @@ impl Parser<'_> {
                     .to_string(),
             );
         }
-        self.emit(line, StatementKind::Material(def));
+        self.emit_named(line, 2, StatementKind::Material(def));
         Ok(())
     }
 

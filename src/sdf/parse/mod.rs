@@ -17,7 +17,7 @@ mod transform;
 
 pub use resolve::default_output;
 
-use super::ast::{NameRef, Statement, StatementKind};
+use super::ast::{NameRef, Span, Statement, StatementKind, StatementSpans};
 use super::lexer::{self, looks_numeric, Line, NumberError};
 use super::LoadOptions;
 use crate::diag::{suggest, Diagnostic, Loc, Severity};
@@ -55,18 +55,36 @@ const SHAPE_KINDS: [&str; 7] = [
     "composite",
 ];
 
-/// The statements of a file, the problems met, and what `build` needs to know about the text.
+/// The statements of a file, the problems met, what the reader left out, and the lines as
+/// written (for quoting them in diagnostics found later).
 pub struct Parsed {
     pub statements: Vec<Statement>,
     pub diagnostics: Vec<Diagnostic>,
-    pub source: SourceContext,
+    pub omissions: Omissions,
+    pub lines: Vec<String>,
 }
 
-/// What the builder needs from the source beyond the statements themselves.
+impl Parsed {
+    /// Quotes the source line of every diagnostic located in this file that lacks it.
+    pub fn quote_source(&self, diagnostics: &mut [Diagnostic]) {
+        for d in diagnostics {
+            let Some(loc) = &d.loc else { continue };
+            let line = usize::try_from(loc.line)
+                .ok()
+                .and_then(|n| n.checked_sub(1))
+                .and_then(|i| self.lines.get(i));
+            if let (None, Some(line)) = (&d.source_line, line) {
+                d.source_line = Some(line.clone());
+            }
+        }
+    }
+}
+
+/// What the reader left out of the statements that building must still account for: its
+/// problems are reported already, and must neither be reported again as follow-on errors nor
+/// be covered up by a stand-in.
 #[derive(Debug, Default)]
-pub struct SourceContext {
-    /// The file's lines as written, for quoting them in diagnostics.
-    pub lines: Vec<String>,
+pub struct Omissions {
     /// Names whose definition was rejected or skipped (already reported): references to them
     /// are ignored instead of being reported again as undefined.
     pub skipped: HashSet<String>,
@@ -77,13 +95,6 @@ pub struct SourceContext {
     pub cameras_rejected: bool,
     /// Names defined only in commented-out lines → the line (see `commented_definitions`).
     pub commented: HashMap<String, u32>,
-}
-
-impl SourceContext {
-    pub fn line(&self, number: u32) -> Option<&str> {
-        let i = usize::try_from(number).ok()?.checked_sub(1)?;
-        self.lines.get(i).map(String::as_str)
-    }
 }
 
 /// An error has been reported; the statement is dropped.
@@ -134,8 +145,8 @@ pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
     Parsed {
         statements: p.statements,
         diagnostics: p.diagnostics,
-        source: SourceContext {
-            lines: lines.iter().map(|l| l.text.to_string()).collect(),
+        lines: lines.iter().map(|l| l.text.to_string()).collect(),
+        omissions: Omissions {
             skipped: p.skipped,
             render_lines: p.render_lines,
             cameras_rejected: p.cameras_rejected,
@@ -260,8 +271,33 @@ impl Parser<'_> {
     }
 
     fn emit(&mut self, line: &Line, kind: StatementKind) {
+        self.push(line, kind, None);
+    }
+
+    /// A statement about a name (the one a definition gives, a transform's target), with
+    /// where that name (token `name_at`) is written: problems found once the whole file is
+    /// known (a duplicate, a cycle) point at it.
+    fn emit_named(&mut self, line: &Line, name_at: usize, kind: StatementKind) {
+        let (col, width) = Self::place(line, At::Tok(name_at));
+        let name = Span {
+            loc: Loc {
+                file: self.file.clone(),
+                line: line.number,
+                col,
+            },
+            width,
+        };
+        self.push(line, kind, Some(name));
+    }
+
+    fn push(&mut self, line: &Line, kind: StatementKind, name: Option<Span>) {
         let loc = self.loc(line, At::Tok(0));
-        self.statements.push(Statement { kind, loc });
+        let first_width = Self::place(line, At::Tok(0)).1;
+        self.statements.push(Statement {
+            kind,
+            loc,
+            spans: Some(StatementSpans { first_width, name }),
+        });
     }
 
     fn name_ref(&self, line: &Line, i: usize) -> NameRef {

@@ -186,8 +186,8 @@ impl Parser<'_> {
             };
             self.statements.insert(
                 0,
-                Statement {
-                    kind: StatementKind::Camera(CameraDef {
+                Statement::new(
+                    StatementKind::Camera(CameraDef {
                         name: "default".to_string(),
                         fov_x_deg: limits::DEFAULT_FOV_DEG,
                         eye: DVec3::ZERO,
@@ -195,7 +195,7 @@ impl Parser<'_> {
                         up: DVec3::Y,
                     }),
                     loc,
-                },
+                ),
             );
         }
     }

@@ -96,7 +96,7 @@ impl Parser<'_> {
                 format!("read as `{kind_stmt}`"),
             );
         }
-        self.emit(line, kind_stmt);
+        self.emit_named(line, kind_at + 1, kind_stmt);
         Ok(())
     }
 
@@ -257,7 +257,7 @@ impl Parser<'_> {
                 None,
             );
         }
-        self.emit(line, StatementKind::Composite { name, children });
+        self.emit_named(line, name_at, StatementKind::Composite { name, children });
         Ok(())
     }
 }

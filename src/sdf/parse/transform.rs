@@ -126,7 +126,7 @@ impl Parser<'_> {
         }
         let kind = StatementKind::Transform { target, ops };
         self.explain_variants(line, notes, &kind);
-        self.emit(line, kind);
+        self.emit_named(line, target_at, kind);
     }
 
     /// Warns once about the variant spellings of a line, each explained once per file.
