@@ -24,9 +24,9 @@ pub struct Material {
     pub ks: Vec3,
     /// Phong exponent.
     pub m: f32,
-    /// ρ in SPEC.md §4, in [0, 1].
+    /// ρ of the shading model: the share of light reflected as by a mirror, in [0, 1].
     pub reflectivity: f32,
-    /// α in SPEC.md §4, in [0, 1]; 1 is opaque.
+    /// α of the shading model: the share of light the surface stops, in [0, 1]; 1 is opaque.
     pub opacity: f32,
     /// η, index of refraction; the medium outside every object is air (1).
     pub ior: f32,

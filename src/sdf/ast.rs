@@ -1,5 +1,5 @@
 //! SDF statements as parsed, each with its source location, and their canonical text form.
-//! Variants accepted by the reader (DIALECT.md) are normalised into these canonical
+//! Variants of the scene language accepted by the reader are normalised into these canonical
 //! statements, so writing a statement list back out gives a plain-dialect file that loads to
 //! the same scene (read with the default `--material-fields`, as materials are written with
 //! all three extras: reflectivity, opacity, ior).
@@ -108,6 +108,20 @@ pub struct CameraDef {
     pub eye: DVec3,
     pub dir: DVec3,
     pub up: DVec3,
+}
+
+impl CameraDef {
+    /// A camera at the origin looking along -z with y up: the pose of a camera whose line
+    /// gives no eye, direction or up vector.
+    pub fn at_origin(name: &str, fov_x_deg: f64) -> Self {
+        CameraDef {
+            name: name.to_string(),
+            fov_x_deg,
+            eye: DVec3::ZERO,
+            dir: DVec3::NEG_Z,
+            up: DVec3::Y,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -6,8 +6,9 @@
 //! errors stop it (`--strict` makes every warning an error).
 
 pub mod ast;
-pub(crate) mod lexer;
+mod lexer;
 mod parse;
+pub mod repair;
 
 pub use parse::{default_output, Omissions, Parsed};
 

@@ -6,6 +6,7 @@ use crate::diag::Loc;
 use crate::limits::{clamp_fraction, fov_is_valid, FOV_RULE};
 use crate::scene::{Geometry, Material};
 use crate::sdf::ast::{CameraDef, LightDef, MaterialDef, Statement, StatementKind, TransformOp};
+use crate::sdf::repair;
 use crate::shape::degeneracy;
 use crate::shape::geometry::{is_zero, parallel};
 use glam::{DVec3, Vec3};
@@ -225,12 +226,8 @@ impl Builder<'_> {
             opacity: clamp_fraction(f64::from(m.opacity)) as f32,
             ior: m.ior,
         };
-        // m = 0 is kept (pow(x, 0) = 1 is well defined); a negative m would send the
-        // highlight to infinity where R·V = 0.
-        out.m = out.m.abs();
-        if out.ior <= 0.0 {
-            out.ior = 1.0;
-        }
+        out.m = repair::phong_exponent(out.m);
+        out.ior = repair::usable_ior(f64::from(out.ior)).map_or(repair::AIR_IOR, |ior| ior as f32);
         if !self.from_reader
             && (out.m != m.m
                 || out.ior != m.ior

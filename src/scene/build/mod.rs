@@ -2,8 +2,8 @@
 //!
 //! Definitions are global to a file (statement order is free in most real files); transforms
 //! apply in the order written, composed by the rule of `TransformOrder`; each `render` line
-//! sees the transforms DIALECT.md gives it (all of them when the file has one render line,
-//! those written before it when it has several). The composite tree is flattened into
+//! sees the transforms the scene language gives it (all of them when the file has one render
+//! line, those written before it when it has several). The composite tree is flattened into
 //! instances, so a shape listed in two composites is drawn twice.
 
 mod definitions;

@@ -93,13 +93,7 @@ impl Parser<'_> {
                 )),
             );
         }
-        let mut def = CameraDef {
-            name,
-            fov_x_deg: fov,
-            eye: DVec3::ZERO,
-            dir: DVec3::NEG_Z,
-            up: DVec3::Y,
-        };
+        let mut def = CameraDef::at_origin(&name, fov);
         if nums.len() == 4 {
             def.eye = DVec3::new(nums[1], nums[2], nums[3]);
         }

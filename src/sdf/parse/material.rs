@@ -5,7 +5,7 @@ use super::{At, PResult, Parser};
 use crate::limits;
 use crate::sdf::ast::{MaterialDef, StatementKind};
 use crate::sdf::lexer::Line;
-use crate::sdf::MaterialField;
+use crate::sdf::{repair, MaterialField};
 use glam::Vec3;
 
 const FORM_MATERIAL: &str = "define material <name> [Ka] [Kd] [Ks] <m> [extras...]";
@@ -75,7 +75,7 @@ impl Parser<'_> {
             m: nums[9] as f32,
             reflectivity: 0.0,
             opacity: 1.0,
-            ior: 1.0,
+            ior: repair::AIR_IOR,
         };
         if def.m < 0.0 {
             self.warn(
@@ -87,7 +87,7 @@ impl Parser<'_> {
                 ),
                 None,
             );
-            def.m = def.m.abs();
+            def.m = repair::phong_exponent(def.m);
         } else if def.m == 0.0 {
             // Kept: pow(x, 0) = 1 is well defined, and it is what the file's own renderer drew.
             self.warn(
@@ -112,20 +112,18 @@ impl Parser<'_> {
                 MaterialField::Transparency => {
                     def.opacity = 1.0 - self.unit_interval(line, at, "transparency", value);
                 }
-                MaterialField::Ior => {
-                    if value <= 0.0 {
-                        self.warn(
-                            line,
-                            at,
-                            format!(
-                                "the index of refraction must be positive, found {value}; 1 used"
-                            ),
-                            None,
-                        );
-                    } else {
-                        def.ior = value as f32;
-                    }
-                }
+                MaterialField::Ior => match repair::usable_ior(value) {
+                    Some(ior) => def.ior = ior as f32,
+                    None => self.warn(
+                        line,
+                        at,
+                        format!(
+                            "the index of refraction must be positive, found {value}; {} used",
+                            repair::AIR_IOR
+                        ),
+                        None,
+                    ),
+                },
                 MaterialField::Roughness => {}
             }
         }

@@ -7,7 +7,6 @@ use crate::diag::{Diagnostic, Loc, Severity};
 use crate::limits;
 use crate::sdf::ast::{CameraDef, NameRef, Statement, StatementKind};
 use crate::sdf::lexer::{self, Line};
-use glam::DVec3;
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
@@ -187,13 +186,7 @@ impl Parser<'_> {
             self.statements.insert(
                 0,
                 Statement::new(
-                    StatementKind::Camera(CameraDef {
-                        name: "default".to_string(),
-                        fov_x_deg: limits::DEFAULT_FOV_DEG,
-                        eye: DVec3::ZERO,
-                        dir: DVec3::NEG_Z,
-                        up: DVec3::Y,
-                    }),
+                    StatementKind::Camera(CameraDef::at_origin("default", limits::DEFAULT_FOV_DEG)),
                     loc,
                 ),
             );
