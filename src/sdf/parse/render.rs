@@ -41,22 +41,7 @@ impl Parser<'_> {
         self.render_lines += 1;
         let toks = &line.tokens;
         let mut notes: Vec<String> = variant.map(str::to_string).into_iter().collect();
-        // Names (camera, file) come first, then the numbers. A file name may start with a
-        // digit (`001.png`) and a camera may be named by a number (`render 1 out.png ...`):
-        // a token is a name if it is not number-like, looks like a file name, or is the
-        // first one and a name follows it.
-        let is_name =
-            |t: &str| !looks_numeric(t) || (file_like(t) && lexer::parse_number(t).is_err());
-        let names_end = {
-            let mut j = from;
-            while j < toks.len()
-                && (is_name(toks[j].text)
-                    || (j == from && toks.get(j + 1).is_some_and(|t| is_name(t.text))))
-            {
-                j += 1;
-            }
-            j
-        };
+        let names_end = names_end(line, from);
         let nums_end = Self::number_run_end(line, names_end);
         let mut tail = nums_end..toks.len();
         let names = from..names_end;
@@ -111,71 +96,12 @@ impl Parser<'_> {
         let Ok(nums) = self.numbers(line, names_end, nums_end) else {
             return;
         };
-        let (width, height) = match nums.len() {
-            0 => {
-                notes.push(format!(
-                    "no image size given: {}×{}",
-                    DEFAULT_IMAGE_SIZE.0, DEFAULT_IMAGE_SIZE.1
-                ));
-                DEFAULT_IMAGE_SIZE
-            }
-            1 => {
-                self.error(
-                    line,
-                    At::End,
-                    "expected the image height, found end of line",
-                    Some(format!("canonical form: `{FORM_RENDER}`")),
-                );
-                return;
-            }
-            _ => {
-                let (min, max) = (
-                    f64::from(*limits::IMAGE_SIDE.start()),
-                    f64::from(*limits::IMAGE_SIDE.end()),
-                );
-                let w = self.whole(line, names_end, nums[0], "image width", min, max);
-                let h = self.whole(line, names_end + 1, nums[1], "image height", min, max);
-                match (w, h) {
-                    (Ok(w), Ok(h)) => (w, h),
-                    _ => return,
-                }
-            }
+        let Ok((width, height)) = self.image_size(line, names_end, &nums, &mut notes) else {
+            return;
         };
-        let mut samples = None;
-        if nums.len() == 3 {
-            let Ok(s) = self.whole(line, names_end + 2, nums[2], "sample count", 0.0, f64::MAX)
-            else {
-                return;
-            };
-            if s == 0 {
-                self.warn(
-                    line,
-                    At::Tok(names_end + 2),
-                    "0 samples per pixel; the default is used",
-                    None,
-                );
-            } else if !limits::SAMPLES.contains(&s) {
-                let most = *limits::SAMPLES.end();
-                self.warn(
-                    line,
-                    At::Tok(names_end + 2),
-                    format!("{s} samples per pixel is more than {most}; {most} used"),
-                    None,
-                );
-                samples = Some(most);
-            } else {
-                samples = Some(s);
-            }
-        } else if nums.len() > 3 {
-            self.warn(
-                line,
-                At::Span(names_end + 2, nums_end - 1),
-                format!("{} numbers after the image size ignored", nums.len() - 2),
-                Some(format!(
-                    "anim reads at most one: samples per pixel. canonical form: `{FORM_RENDER}`"
-                )),
-            );
-        }
+        let Ok(samples) = self.samples(line, names_end, nums_end, &nums) else {
+            return;
+        };
         if !tail.is_empty() {
             self.warn(
                 line,
@@ -215,6 +141,86 @@ impl Parser<'_> {
             notes,
         });
         self.emit(line, StatementKind::Render(def));
+    }
+
+    /// The image size from the numbers `nums` starting at token `at`; the default (with a
+    /// note) when there are none.
+    fn image_size(
+        &mut self,
+        line: &Line,
+        at: usize,
+        nums: &[f64],
+        notes: &mut Vec<String>,
+    ) -> PResult<(u32, u32)> {
+        match nums.len() {
+            0 => {
+                notes.push(format!(
+                    "no image size given: {}×{}",
+                    DEFAULT_IMAGE_SIZE.0, DEFAULT_IMAGE_SIZE.1
+                ));
+                Ok(DEFAULT_IMAGE_SIZE)
+            }
+            1 => Err(self.error(
+                line,
+                At::End,
+                "expected the image height, found end of line",
+                Some(format!("canonical form: `{FORM_RENDER}`")),
+            )),
+            _ => {
+                let (min, max) = (
+                    f64::from(*limits::IMAGE_SIDE.start()),
+                    f64::from(*limits::IMAGE_SIDE.end()),
+                );
+                let w = self.whole(line, at, nums[0], "image width", min, max);
+                let h = self.whole(line, at + 1, nums[1], "image height", min, max);
+                Ok((w?, h?))
+            }
+        }
+    }
+
+    /// The samples per pixel after the image size in `nums` (tokens `at..nums_end`), if
+    /// given and usable.
+    fn samples(
+        &mut self,
+        line: &Line,
+        at: usize,
+        nums_end: usize,
+        nums: &[f64],
+    ) -> PResult<Option<u32>> {
+        if nums.len() > 3 {
+            self.warn(
+                line,
+                At::Span(at + 2, nums_end - 1),
+                format!("{} numbers after the image size ignored", nums.len() - 2),
+                Some(format!(
+                    "anim reads at most one: samples per pixel. canonical form: `{FORM_RENDER}`"
+                )),
+            );
+        }
+        if nums.len() != 3 {
+            return Ok(None);
+        }
+        let s = self.whole(line, at + 2, nums[2], "sample count", 0.0, f64::MAX)?;
+        if s == 0 {
+            self.warn(
+                line,
+                At::Tok(at + 2),
+                "0 samples per pixel; the default is used",
+                None,
+            );
+            return Ok(None);
+        }
+        if !limits::SAMPLES.contains(&s) {
+            let most = *limits::SAMPLES.end();
+            self.warn(
+                line,
+                At::Tok(at + 2),
+                format!("{s} samples per pixel is more than {most}; {most} used"),
+                None,
+            );
+            return Ok(Some(most));
+        }
+        Ok(Some(s))
     }
 
     /// The output file name from the tokens `pieces`; a name broken by spaces around its
@@ -281,4 +287,21 @@ fn file_like(t: &str) -> bool {
         || t.rsplit_once('.').is_some_and(|(_, ext)| {
             ext.len() >= 2 && ext.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
         })
+}
+
+/// The index just past the names (camera, file) of a render line whose arguments start at
+/// `from`. Names come first, then the numbers. A file name may start with a digit (`001.png`)
+/// and a camera may be named by a number (`render 1 out.png ...`): a token is a name if it is
+/// not number-like, looks like a file name, or is the first one and a name follows it.
+fn names_end(line: &Line, from: usize) -> usize {
+    let toks = &line.tokens;
+    let is_name = |t: &str| !looks_numeric(t) || (file_like(t) && lexer::parse_number(t).is_err());
+    let mut j = from;
+    while j < toks.len()
+        && (is_name(toks[j].text)
+            || (j == from && toks.get(j + 1).is_some_and(|t| is_name(t.text))))
+    {
+        j += 1;
+    }
+    j
 }
