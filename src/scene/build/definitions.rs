@@ -2,7 +2,6 @@
 //! did not come through the reader.
 
 use super::{At, Builder};
-use crate::diag::Loc;
 use crate::limits::{clamp_fraction, fov_is_valid, FOV_RULE};
 use crate::scene::{Geometry, Material};
 use crate::sdf::ast::{CameraDef, LightDef, MaterialDef, Statement, StatementKind, TransformOp};
@@ -39,7 +38,7 @@ pub(super) struct Definitions<'s> {
     pub(super) objects: Vec<Object<'s>>,
     /// Name → index into `objects` of its final definition.
     pub(super) object_index: HashMap<&'s str, usize>,
-    pub(super) cameras: Vec<(&'s CameraDef, &'s Loc)>,
+    pub(super) cameras: Vec<&'s CameraDef>,
     pub(super) camera_index: HashMap<&'s str, usize>,
     pub(super) lights: Vec<&'s LightDef>,
     pub(super) light_index: HashMap<&'s str, usize>,
@@ -133,10 +132,10 @@ impl Builder<'_> {
                     }
                     if let Some(&i) = d.camera_index.get(c.name.as_str()) {
                         self.duplicate(stmt, &c.name, "camera");
-                        d.cameras[i] = (c, &stmt.loc);
+                        d.cameras[i] = c;
                     } else {
                         d.camera_index.insert(&c.name, d.cameras.len());
-                        d.cameras.push((c, &stmt.loc));
+                        d.cameras.push(c);
                     }
                 }
                 StatementKind::Ambient(rgb) => ambient_set = Some(*rgb),

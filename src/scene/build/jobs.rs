@@ -51,7 +51,7 @@ impl Builder<'_> {
                         continue;
                     }
                     let camera = match d.cameras.first() {
-                        Some((c, _)) => place_camera(c, snapshot),
+                        Some(c) => place_camera(c, snapshot),
                         None => Camera::default_with_fov("default", limits::DEFAULT_FOV_DEG),
                     };
                     let output = default_output(self.path);
@@ -88,7 +88,7 @@ impl Builder<'_> {
         snapshot: &Snapshot,
     ) -> Option<Camera> {
         match d.camera_index.get(name.name.as_str()) {
-            Some(&i) => Some(place_camera(d.cameras[i].0, snapshot)),
+            Some(&i) => Some(place_camera(d.cameras[i], snapshot)),
             None => {
                 if !self.skipped(&name.name) {
                     let help = self
@@ -96,7 +96,7 @@ impl Builder<'_> {
                         .or_else(|| {
                             d.cameras
                                 .first()
-                                .map(|(c, _)| format!("the file defines camera `{}`", c.name))
+                                .map(|c| format!("the file defines camera `{}`", c.name))
                         });
                     self.at_ref(
                         Severity::Error,

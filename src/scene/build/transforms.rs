@@ -65,7 +65,7 @@ impl Builder<'_> {
                     .copied();
                 let mut help = self.name_help(name, candidates);
                 if help.is_none() && name == "camera" && d.cameras.len() == 1 {
-                    help = Some(format!("the camera is named `{}`", d.cameras[0].0.name));
+                    help = Some(format!("the camera is named `{}`", d.cameras[0].name));
                 }
                 self.at_ref(
                     Severity::Error,
