@@ -5,8 +5,9 @@
 
 use crate::cli::BenchArgs;
 use crate::render::{self, film, HdrImage, RenderSettings};
+use crate::scene;
 use crate::scene::RenderJob;
-use crate::sdf::{self, LoadOptions};
+use crate::sdf::LoadOptions;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::process::ExitCode;
@@ -18,7 +19,7 @@ pub const ASSIGNMENT_SCENE: &str = include_str!("../scenes/assignment.sdf");
 pub const SHOWCASE_SCENE: &str = include_str!("../scenes/showcase.sdf");
 
 fn job_for(text: &str) -> Result<RenderJob, String> {
-    let loaded = sdf::load_str(
+    let loaded = scene::load_str(
         text,
         Path::new("scenes/assignment.sdf"),
         &LoadOptions::default(),

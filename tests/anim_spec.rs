@@ -416,7 +416,7 @@ fn frame(text: &str, i: usize) -> RenderJob {
         .frame_text(i)
         .expect("frame");
     let mut loaded =
-        anim::sdf::load_str(&frame_text, Path::new("frame.sdf"), &LoadOptions::default())
+        anim::scene::load_str(&frame_text, Path::new("frame.sdf"), &LoadOptions::default())
             .unwrap_or_else(|e| panic!("{frame_text}\n{e:?}"));
     assert_eq!(loaded.jobs.len(), 1);
     loaded.jobs.remove(0)

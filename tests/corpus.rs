@@ -4,7 +4,8 @@
 mod common;
 
 use anim::diag::Diagnostic;
-use anim::sdf::{load_file, LoadOptions};
+use anim::scene::load_file;
+use anim::sdf::LoadOptions;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
@@ -96,12 +97,12 @@ fn canonical_text_of_corpus_files_loads_to_the_same_jobs() {
             continue;
         };
         let text = String::from_utf8_lossy(&bytes);
-        let Ok(original) = anim::sdf::load_str(&text, file, &opts) else {
+        let Ok(original) = anim::scene::load_str(&text, file, &opts) else {
             continue;
         };
         let (statements, _) = anim::sdf::parse(&text, file, &opts);
         let canonical: String = statements.iter().map(|s| format!("{s}\n")).collect();
-        let again = anim::sdf::load_str(&canonical, file, &opts).unwrap_or_else(|ds| {
+        let again = anim::scene::load_str(&canonical, file, &opts).unwrap_or_else(|ds| {
             panic!(
                 "{}: canonical text rejected:\n{}\n{canonical}",
                 file.display(),

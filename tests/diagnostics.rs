@@ -3,7 +3,8 @@
 //! library; a handful of error rows also run through the real `anim render` binary.
 
 use anim::diag::{Diagnostic, Severity};
-use anim::sdf::{load_str, LoadOptions};
+use anim::scene::load_str;
+use anim::sdf::LoadOptions;
 use assert_cmd::Command;
 use std::path::Path;
 

@@ -5,7 +5,8 @@
 mod common;
 
 use anim::render::{render_job, RenderSettings};
-use anim::sdf::{load_file, LoadOptions};
+use anim::scene::load_file;
+use anim::sdf::LoadOptions;
 use std::path::{Path, PathBuf};
 
 fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {

@@ -257,10 +257,7 @@ impl<'a> Generator<'a> {
     }
 
     fn statement(&self, kind: StatementKind) -> Statement {
-        Statement {
-            kind,
-            loc: self.loc(),
-        }
+        Statement::new(kind, self.loc())
     }
 
     /// The statements of frame `i`.

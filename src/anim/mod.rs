@@ -179,7 +179,7 @@ fn load_base(
     // Building the scene finds what parsing alone cannot (an unknown material, a composite
     // child defined nowhere), located in the base scene rather than in a generated frame.
     if !diags.iter().any(Diagnostic::is_error) {
-        if let Err(built) = crate::sdf::build(&statements, &path, &opts) {
+        if let Err(built) = crate::scene::build(&statements, &path, &opts) {
             diags.extend(built.into_iter().filter(Diagnostic::is_error));
         }
     }
@@ -232,7 +232,7 @@ fn checked_frame_text(
 ) -> Result<String, Vec<Diagnostic>> {
     let text = generator.frame_text(i)?;
     let path: Arc<Path> = Arc::from(dir.join(anim.output.sdf(i, anim.digits())).as_path());
-    if let Err(diags) = crate::sdf::load_str(&text, &path, &LoadOptions::default()) {
+    if let Err(diags) = crate::scene::load_str(&text, &path, &LoadOptions::default()) {
         // A frame that does not load is a bug or a combination the spec checks missed;
         // show the loader's own words with the frame text they are about.
         let mut out = vec![Diagnostic::file_error(

@@ -1,7 +1,9 @@
 //! `anim check FILE|DIR...`: load scene files without rendering and report every problem.
 
+use crate::diag::Diagnostic;
+use crate::scene::load_file;
 use crate::sdf::LoadOptions;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Everything `anim check` was asked to do.
@@ -12,6 +14,87 @@ pub struct CheckConfig {
     pub quiet: bool,
 }
 
+/// Checks every input (directories recursively: files ending in `.sdf` or `.txt`, or
+/// without an extension). Prints each diagnostic to stderr (only errors when `quiet`) and a
+/// summary line to stdout. Exit status 1 if any file was rejected or an input is unreadable.
 pub fn run(config: &CheckConfig) -> ExitCode {
-    crate::sdf::check_paths(&config.inputs, &config.load, config.quiet)
+    let (inputs, opts, quiet) = (&config.inputs, &config.load, config.quiet);
+    let mut files = Vec::new();
+    let mut failed = false;
+    for input in inputs {
+        if input.is_dir() {
+            let mut found = Vec::new();
+            if let Err(e) = collect(input, &mut found) {
+                eprintln!(
+                    "{}",
+                    Diagnostic::file_error(input, format!("cannot read directory: {e}"))
+                );
+                failed = true;
+            }
+            found.sort();
+            files.extend(found);
+        } else {
+            // A file named explicitly is checked whatever its extension (and reported if it
+            // does not exist).
+            files.push(input.clone());
+        }
+    }
+    let (mut ok, mut warned, mut rejected) = (0usize, 0usize, 0usize);
+    for file in &files {
+        match load_file(file, opts) {
+            Ok(loaded) => {
+                if loaded.diagnostics.is_empty() {
+                    ok += 1;
+                } else {
+                    warned += 1;
+                }
+                if !quiet {
+                    for d in &loaded.diagnostics {
+                        eprintln!("{d}");
+                    }
+                }
+            }
+            Err(diagnostics) => {
+                rejected += 1;
+                for d in diagnostics.iter().filter(|d| !quiet || d.is_error()) {
+                    eprintln!("{d}");
+                }
+            }
+        }
+    }
+    println!(
+        "{} files: {ok} ok, {warned} with warnings, {rejected} rejected",
+        files.len()
+    );
+    if failed || rejected > 0 {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// Whether a file found in a directory is a scene file to check.
+fn is_scene_file(path: &Path) -> bool {
+    match path.extension().and_then(|e| e.to_str()) {
+        None => true,
+        Some(ext) => ext.eq_ignore_ascii_case("sdf") || ext.eq_ignore_ascii_case("txt"),
+    }
+}
+
+/// Scene files below `dir`, skipping hidden entries (`.git`, editor files).
+fn collect(dir: &Path, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        let path = entry.path();
+        if entry.file_name().to_string_lossy().starts_with('.') {
+            continue;
+        }
+        let kind = entry.file_type()?;
+        if kind.is_dir() {
+            collect(&path, out)?;
+        } else if kind.is_file() && is_scene_file(&path) {
+            out.push(path);
+        }
+    }
+    Ok(())
 }

@@ -124,7 +124,7 @@ pub fn render_scene_file(
     settings: &RenderSettings,
     progress: &dyn ImageProgress,
 ) -> Result<FileOutcome, Vec<Diagnostic>> {
-    let loaded = crate::sdf::load_file(path, load)?;
+    let loaded = crate::scene::load_file(path, load)?;
     let mut warnings = loaded.diagnostics;
     // Resolve every output before rendering anything, so a bad name fails fast.
     let mut targets = Vec::with_capacity(loaded.jobs.len());

@@ -2,7 +2,7 @@
 //! kept in object space with its transform.
 
 use crate::math::{Aabb, Ray, Transform};
-use crate::scene::Geometry;
+use crate::shape::Geometry;
 use crate::shape::{AaBox, Cone, Cylinder, Plane, Shape, ShapeHit, Sphere, Triangle};
 use glam::{Affine3A, DMat3, DVec3, Mat3A, Vec3A};
 

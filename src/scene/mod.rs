@@ -1,6 +1,15 @@
 //! The scene description: what an SDF file means, with names resolved, transforms composed
-//! and the composite tree flattened into instances. It is produced by `crate::sdf` (or built
-//! directly in tests) and compiled by `crate::render::compile` into the render scene.
+//! and the composite tree flattened into instances. It is built here from the statements of
+//! `crate::sdf` (or directly in tests) and compiled by `crate::render::compile` into the
+//! render scene.
+
+mod build;
+mod load;
+#[cfg(test)]
+mod tests;
+
+pub use crate::shape::Geometry;
+pub use load::{build, load_file, load_str, Loaded};
 
 use crate::diag::Loc;
 use crate::math::Transform;
@@ -15,9 +24,9 @@ pub struct Material {
     pub ks: Vec3,
     /// Phong exponent.
     pub m: f32,
-    /// ρ in SPEC.md §4, in [0, 1].
+    /// ρ of the shading model: the share of light reflected as by a mirror, in [0, 1].
     pub reflectivity: f32,
-    /// α in SPEC.md §4, in [0, 1]; 1 is opaque.
+    /// α of the shading model: the share of light the surface stops, in [0, 1]; 1 is opaque.
     pub opacity: f32,
     /// η, index of refraction; the medium outside every object is air (1).
     pub ior: f32,
@@ -37,39 +46,6 @@ impl Material {
             ior: 1.0,
         }
     }
-}
-
-/// A primitive as written in its own (object) space.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Geometry {
-    Sphere {
-        center: DVec3,
-        radius: f64,
-    },
-    /// Corners in any order.
-    Box {
-        p1: DVec3,
-        p2: DVec3,
-    },
-    Plane {
-        point: DVec3,
-        normal: DVec3,
-    },
-    Triangle {
-        vertices: [DVec3; 3],
-    },
-    /// Axis p1 → p2, both ends capped.
-    Cylinder {
-        p1: DVec3,
-        p2: DVec3,
-        radius: f64,
-    },
-    /// Radius at the base, apex at the tip, base capped.
-    Cone {
-        base: DVec3,
-        tip: DVec3,
-        radius: f64,
-    },
 }
 
 /// One leaf of the composite tree placed in the world. A shape listed in two composites

@@ -1,11 +1,11 @@
 //! SDF statements as parsed, each with its source location, and their canonical text form.
-//! Variants accepted by the reader (DIALECT.md) are normalised into these canonical
+//! Variants of the scene language accepted by the reader are normalised into these canonical
 //! statements, so writing a statement list back out gives a plain-dialect file that loads to
 //! the same scene (read with the default `--material-fields`, as materials are written with
 //! all three extras: reflectivity, opacity, ior).
 
 use crate::diag::Loc;
-use crate::scene::Geometry;
+use crate::shape::Geometry;
 use glam::{DVec3, Vec3};
 use std::fmt;
 
@@ -21,6 +21,37 @@ pub struct Statement {
     pub kind: StatementKind,
     /// Where the statement starts (its first token).
     pub loc: Loc,
+    /// Where the reader found the tokens that problems found after reading point at; `None`
+    /// for statements made by a program.
+    pub spans: Option<StatementSpans>,
+}
+
+impl Statement {
+    /// A statement made by a program rather than read from text.
+    pub fn new(kind: StatementKind, loc: Loc) -> Self {
+        Statement {
+            kind,
+            loc,
+            spans: None,
+        }
+    }
+}
+
+/// A token as written: where it starts and how many characters it covers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Span {
+    pub loc: Loc,
+    pub width: u32,
+}
+
+/// The tokens of a statement read from text that the scene builder may point at.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StatementSpans {
+    /// The width of the first token (the one at `Statement::loc`).
+    pub first_width: u32,
+    /// The name the statement is about: the one a definition gives (a material, shape,
+    /// composite, light or camera), or a transform's target.
+    pub name: Option<Span>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -77,6 +108,20 @@ pub struct CameraDef {
     pub eye: DVec3,
     pub dir: DVec3,
     pub up: DVec3,
+}
+
+impl CameraDef {
+    /// A camera at the origin looking along -z with y up: the pose of a camera whose line
+    /// gives no eye, direction or up vector.
+    pub fn at_origin(name: &str, fov_x_deg: f64) -> Self {
+        CameraDef {
+            name: name.to_string(),
+            fov_x_deg,
+            eye: DVec3::ZERO,
+            dir: DVec3::NEG_Z,
+            up: DVec3::Y,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

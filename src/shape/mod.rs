@@ -12,6 +12,7 @@
 mod aabox;
 mod cone;
 mod cylinder;
+pub mod geometry;
 mod plane;
 mod sphere;
 mod triangle;
@@ -19,6 +20,7 @@ mod triangle;
 pub use aabox::AaBox;
 pub use cone::Cone;
 pub use cylinder::Cylinder;
+pub use geometry::{degeneracy, Geometry};
 pub use plane::Plane;
 pub use sphere::Sphere;
 pub use triangle::Triangle;

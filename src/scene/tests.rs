@@ -2,8 +2,8 @@
 //! render semantics and the canonical text round trip.
 
 use super::*;
-use crate::diag::Severity;
-use crate::scene::Geometry;
+use crate::diag::{Diagnostic, Severity};
+use crate::sdf::{ast, parse, LoadOptions, MaterialField, TransformOrder};
 use glam::{DVec3, Vec3};
 use std::path::Path;
 
@@ -565,8 +565,8 @@ fn build_checks_statements_made_by_a_program() {
     assert_eq!(build(&statements, path, &opts).unwrap().jobs.len(), 1);
     // A generator writing a zero scale gets an error from `build`, not a broken matrix.
     let loc = statements[1].loc.clone();
-    statements.push(ast::Statement {
-        kind: ast::StatementKind::Transform {
+    statements.push(ast::Statement::new(
+        ast::StatementKind::Transform {
             target: ast::NameRef {
                 name: "s".to_string(),
                 loc: loc.clone(),
@@ -574,7 +574,7 @@ fn build_checks_statements_made_by_a_program() {
             ops: vec![ast::TransformOp::Scale(DVec3::ZERO)],
         },
         loc,
-    });
+    ));
     let ds = build(&statements, path, &opts).unwrap_err();
     assert!(ds.iter().any(|d| d.is_error()));
 }

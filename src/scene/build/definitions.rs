@@ -1,0 +1,309 @@
+//! Every definition of a file, final versions, with its values checked when the statements
+//! did not come through the reader.
+
+use super::{At, Builder};
+use crate::limits::{clamp_fraction, fov_is_valid, FOV_RULE};
+use crate::scene::{Geometry, Material};
+use crate::sdf::ast::{CameraDef, LightDef, MaterialDef, Statement, StatementKind, TransformOp};
+use crate::sdf::repair;
+use crate::shape::degeneracy;
+use crate::shape::geometry::{is_zero, parallel};
+use glam::{DVec3, Vec3};
+use std::collections::HashMap;
+
+/// A shape or composite.
+pub(super) struct Object<'s> {
+    pub(super) name: &'s str,
+    /// The statement that defines it.
+    pub(super) statement: &'s Statement,
+    pub(super) kind: ObjectKind<'s>,
+}
+
+pub(super) enum ObjectKind<'s> {
+    /// `material` is `None` when it could not be resolved (reported) or the shape is
+    /// degenerate: the shape is then not drawn.
+    Shape {
+        geometry: &'s Geometry,
+        material: Option<usize>,
+    },
+    /// The children that resolved.
+    Composite { children: Vec<&'s str> },
+}
+
+/// Every definition of the file, final versions (a later duplicate replaces the earlier).
+#[derive(Default)]
+pub(super) struct Definitions<'s> {
+    pub(super) materials: Vec<Material>,
+    pub(super) material_index: HashMap<&'s str, usize>,
+    pub(super) objects: Vec<Object<'s>>,
+    /// Name → index into `objects` of its final definition.
+    pub(super) object_index: HashMap<&'s str, usize>,
+    pub(super) cameras: Vec<&'s CameraDef>,
+    pub(super) camera_index: HashMap<&'s str, usize>,
+    pub(super) lights: Vec<&'s LightDef>,
+    pub(super) light_index: HashMap<&'s str, usize>,
+    pub(super) ambient: Vec3,
+    pub(super) background: Vec3,
+}
+
+impl Builder<'_> {
+    // ----- definitions -------------------------------------------------------------------
+
+    pub(super) fn definitions<'s>(&mut self, statements: &'s [Statement]) -> Definitions<'s> {
+        let mut d = Definitions::default();
+        // Where each object name was first defined, for "a child must be defined before the
+        // composite": statement index and line.
+        let mut first_object_def: HashMap<&str, (usize, u32)> = HashMap::new();
+        let mut material_first_def: HashMap<&str, (usize, u32)> = HashMap::new();
+        let mut ambient_set: Option<Vec3> = None;
+        let mut ambient_added = Vec3::ZERO;
+        for (index, stmt) in statements.iter().enumerate() {
+            if !self.from_reader && !finite_statement(&stmt.kind) {
+                self.error(
+                    At::Statement(stmt),
+                    "statement holds a number that is not finite".to_string(),
+                    None,
+                );
+                continue;
+            }
+            match &stmt.kind {
+                StatementKind::Material(m) => {
+                    let material = self.material(m, stmt);
+                    material_first_def
+                        .entry(m.name.as_str())
+                        .or_insert((index, stmt.loc.line));
+                    if let Some(&i) = d.material_index.get(m.name.as_str()) {
+                        self.duplicate(stmt, &m.name, "material");
+                        d.materials[i] = material;
+                    } else {
+                        d.material_index.insert(&m.name, d.materials.len());
+                        d.materials.push(material);
+                    }
+                }
+                StatementKind::Shape { name, geometry, .. } => {
+                    if let Some(reason) = degeneracy(geometry) {
+                        if !self.from_reader {
+                            self.warn(
+                                At::Name(stmt),
+                                format!("shape `{name}` {reason}; shape dropped"),
+                                None,
+                            );
+                        }
+                    }
+                    first_object_def
+                        .entry(name.as_str())
+                        .or_insert((index, stmt.loc.line));
+                    // The material is resolved below, once every material is known.
+                    let object = Object {
+                        name,
+                        statement: stmt,
+                        kind: ObjectKind::Shape {
+                            geometry,
+                            material: None,
+                        },
+                    };
+                    self.define_object(&mut d, object);
+                }
+                StatementKind::Composite { name, .. } => {
+                    first_object_def
+                        .entry(name.as_str())
+                        .or_insert((index, stmt.loc.line));
+                    let object = Object {
+                        name,
+                        statement: stmt,
+                        kind: ObjectKind::Composite {
+                            children: Vec::new(),
+                        },
+                    };
+                    self.define_object(&mut d, object);
+                }
+                StatementKind::Light(l) => {
+                    if let Some(&i) = d.light_index.get(l.name.as_str()) {
+                        self.duplicate(stmt, &l.name, "light");
+                        d.lights[i] = l;
+                    } else {
+                        d.light_index.insert(&l.name, d.lights.len());
+                        d.lights.push(l);
+                    }
+                }
+                StatementKind::Camera(c) => {
+                    if !self.from_reader && !self.camera_ok(c, stmt) {
+                        continue;
+                    }
+                    if let Some(&i) = d.camera_index.get(c.name.as_str()) {
+                        self.duplicate(stmt, &c.name, "camera");
+                        d.cameras[i] = c;
+                    } else {
+                        d.camera_index.insert(&c.name, d.cameras.len());
+                        d.cameras.push(c);
+                    }
+                }
+                StatementKind::Ambient(rgb) => ambient_set = Some(*rgb),
+                StatementKind::AmbientAdd(rgb) => ambient_added += *rgb,
+                StatementKind::Background(rgb) => d.background = *rgb,
+                StatementKind::Transform { .. } | StatementKind::Render(_) => {}
+            }
+        }
+        d.ambient = ambient_set.unwrap_or(Vec3::ZERO) + ambient_added;
+
+        // Shapes' materials and composites' children, now that every name is known.
+        for (index, stmt) in statements.iter().enumerate() {
+            match &stmt.kind {
+                StatementKind::Shape {
+                    name,
+                    geometry,
+                    material,
+                } => {
+                    let resolved = self.resolve_material(&d, &material_first_def, index, material);
+                    let Some(&i) = d.object_index.get(name.as_str()) else {
+                        continue;
+                    };
+                    // Only the final definition of the name is drawn; earlier ones were
+                    // still checked above.
+                    if std::ptr::eq(d.objects[i].statement, stmt) {
+                        d.objects[i].kind = ObjectKind::Shape {
+                            geometry,
+                            material: if degeneracy(geometry).is_some() {
+                                None
+                            } else {
+                                resolved
+                            },
+                        };
+                    }
+                }
+                StatementKind::Composite { name, children } => {
+                    let resolved =
+                        self.resolve_children(&d, &first_object_def, index, name, children);
+                    if let Some(&i) = d.object_index.get(name.as_str()) {
+                        if std::ptr::eq(d.objects[i].statement, stmt) {
+                            d.objects[i].kind = ObjectKind::Composite { children: resolved };
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
+        d
+    }
+
+    pub(super) fn define_object<'s>(&mut self, d: &mut Definitions<'s>, object: Object<'s>) {
+        if let Some(&i) = d.object_index.get(object.name) {
+            let what = match object.kind {
+                ObjectKind::Shape { .. } => "shape",
+                ObjectKind::Composite { .. } => "composite",
+            };
+            let earlier_line = d.objects[i].statement.loc.line;
+            self.warn(
+                At::Name(object.statement),
+                format!(
+                    "{what} `{}` is already defined (line {earlier_line}); the later definition replaces it",
+                    object.name
+                ),
+                None,
+            );
+        }
+        d.object_index.insert(object.name, d.objects.len());
+        d.objects.push(object);
+    }
+
+    pub(super) fn duplicate(&mut self, stmt: &Statement, name: &str, what: &str) {
+        self.warn(
+            At::Name(stmt),
+            format!("{what} `{name}` is already defined; the later definition replaces it"),
+            None,
+        );
+    }
+
+    pub(super) fn material(&mut self, m: &MaterialDef, stmt: &Statement) -> Material {
+        let mut out = Material {
+            name: m.name.clone(),
+            ka: m.ka,
+            kd: m.kd,
+            ks: m.ks,
+            m: m.m,
+            reflectivity: clamp_fraction(f64::from(m.reflectivity)) as f32,
+            opacity: clamp_fraction(f64::from(m.opacity)) as f32,
+            ior: m.ior,
+        };
+        out.m = repair::phong_exponent(out.m);
+        out.ior = repair::usable_ior(f64::from(out.ior)).map_or(repair::AIR_IOR, |ior| ior as f32);
+        if !self.from_reader
+            && (out.m != m.m
+                || out.ior != m.ior
+                || out.reflectivity != m.reflectivity
+                || out.opacity != m.opacity)
+        {
+            self.warn(
+                At::Name(stmt),
+                format!(
+                    "material `{}` has values out of range (m and ior must be positive, \
+                     reflectivity and opacity in [0, 1]); repaired",
+                    m.name
+                ),
+                None,
+            );
+        }
+        out
+    }
+
+    /// Checks a camera made by a program (the parser checks those it reads).
+    pub(super) fn camera_ok(&mut self, c: &CameraDef, stmt: &Statement) -> bool {
+        let problem = if !fov_is_valid(c.fov_x_deg) {
+            Some(format!("a field of view {FOV_RULE}"))
+        } else if is_zero(c.dir) {
+            Some("a non-zero viewing direction".to_string())
+        } else if parallel(c.dir, c.up) {
+            Some("an up vector that is not parallel to the viewing direction".to_string())
+        } else {
+            None
+        };
+        match problem {
+            Some(need) => {
+                self.error(
+                    At::Name(stmt),
+                    format!("camera `{}` needs {need}", c.name),
+                    None,
+                );
+                false
+            }
+            None => true,
+        }
+    }
+}
+
+/// Whether every number of a statement is finite (statements made by programs may not be).
+pub(super) fn finite_statement(kind: &StatementKind) -> bool {
+    let v = |v: &DVec3| v.is_finite();
+    let c = |c: &Vec3| c.is_finite();
+    match kind {
+        StatementKind::Material(m) => {
+            c(&m.ka)
+                && c(&m.kd)
+                && c(&m.ks)
+                && m.m.is_finite()
+                && m.reflectivity.is_finite()
+                && m.opacity.is_finite()
+                && m.ior.is_finite()
+        }
+        StatementKind::Shape { geometry, .. } => match geometry {
+            Geometry::Sphere { center, radius } => v(center) && radius.is_finite(),
+            Geometry::Box { p1, p2 } => v(p1) && v(p2),
+            Geometry::Plane { point, normal } => v(point) && v(normal),
+            Geometry::Triangle { vertices } => vertices.iter().all(v),
+            Geometry::Cylinder { p1, p2, radius } => v(p1) && v(p2) && radius.is_finite(),
+            Geometry::Cone { base, tip, radius } => v(base) && v(tip) && radius.is_finite(),
+        },
+        StatementKind::Light(l) => v(&l.position) && c(&l.color) && l.brightness.is_finite(),
+        StatementKind::Ambient(rgb)
+        | StatementKind::AmbientAdd(rgb)
+        | StatementKind::Background(rgb) => c(rgb),
+        StatementKind::Camera(cam) => {
+            cam.fov_x_deg.is_finite() && v(&cam.eye) && v(&cam.dir) && v(&cam.up)
+        }
+        StatementKind::Transform { ops, .. } => ops.iter().all(|op| match op {
+            TransformOp::Translate(t) | TransformOp::Scale(t) => v(t),
+            TransformOp::Rotate { degrees, axis } => degrees.is_finite() && v(axis),
+        }),
+        StatementKind::Composite { .. } | StatementKind::Render(_) => true,
+    }
+}

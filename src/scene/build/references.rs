@@ -1,0 +1,176 @@
+//! Names a definition refers to: a shape's material, a composite's children, and the
+//! composite graph as a whole (which must not contain itself).
+
+use super::definitions::{Definitions, ObjectKind};
+use super::{At, Builder};
+use crate::diag::Severity;
+use crate::sdf::ast::NameRef;
+use std::collections::HashMap;
+
+impl Builder<'_> {
+    pub(super) fn resolve_material(
+        &mut self,
+        d: &Definitions,
+        first_def: &HashMap<&str, (usize, u32)>,
+        index: usize,
+        material: &NameRef,
+    ) -> Option<usize> {
+        let name = material.name.as_str();
+        match d.material_index.get(name) {
+            Some(&i) => {
+                if let Some(&(def_index, def_line)) = first_def.get(name) {
+                    if def_index > index {
+                        self.at_ref(
+                            Severity::Warning,
+                            material,
+                            format!(
+                                "material `{name}` is used before its definition (line {def_line})"
+                            ),
+                            Some("define materials before the shapes that use them".to_string()),
+                        );
+                    }
+                }
+                Some(i)
+            }
+            None => {
+                if !self.skipped(name) {
+                    let help = self.name_help(name, d.material_index.keys().copied());
+                    self.at_ref(
+                        Severity::Error,
+                        material,
+                        format!("unknown material `{name}`"),
+                        help,
+                    );
+                }
+                None
+            }
+        }
+    }
+
+    pub(super) fn resolve_children<'s>(
+        &mut self,
+        d: &Definitions<'s>,
+        first_def: &HashMap<&str, (usize, u32)>,
+        index: usize,
+        composite: &str,
+        children: &'s [NameRef],
+    ) -> Vec<&'s str> {
+        let mut out = Vec::with_capacity(children.len());
+        for child in children {
+            let name = child.name.as_str();
+            if name == composite {
+                self.at_ref(
+                    Severity::Warning,
+                    child,
+                    format!("composite `{composite}` cannot contain itself; child skipped"),
+                    None,
+                );
+                continue;
+            }
+            match first_def.get(name) {
+                Some(&(def_index, _)) if def_index < index => out.push(name),
+                Some(&(_, def_line)) => self.at_ref(
+                    Severity::Warning,
+                    child,
+                    format!(
+                        "child `{name}` is defined after this composite (line {def_line}); skipped"
+                    ),
+                    Some("a composite's children must be defined before it".to_string()),
+                ),
+                None if self.skipped(name) => {}
+                None => {
+                    let other = if d.camera_index.contains_key(name) {
+                        Some("a camera")
+                    } else if d.light_index.contains_key(name) {
+                        Some("a light")
+                    } else if d.material_index.contains_key(name) {
+                        Some("a material")
+                    } else {
+                        None
+                    };
+                    let (message, help) = match other {
+                        Some(what) => (
+                            format!("child `{name}` is {what}, not a shape; skipped"),
+                            None,
+                        ),
+                        None => (
+                            format!("undefined child `{name}`; skipped"),
+                            self.name_help(name, d.object_index.keys().copied()),
+                        ),
+                    };
+                    self.at_ref(Severity::Warning, child, message, help);
+                }
+            }
+        }
+        out
+    }
+
+    /// Reports every composite that contains itself, directly or through others. (Cycles
+    /// are also stopped while flattening, but a cycle that no root reaches would go unseen.)
+    pub(super) fn check_cycles(&mut self, d: &Definitions) {
+        #[derive(Clone, Copy, PartialEq)]
+        enum Mark {
+            New,
+            Open,
+            Done,
+        }
+        let mut mark = vec![Mark::New; d.objects.len()];
+        let children_of = |i: usize| -> Vec<usize> {
+            match &d.objects[i].kind {
+                ObjectKind::Composite { children } => children
+                    .iter()
+                    .filter_map(|c| d.object_index.get(c).copied())
+                    .collect(),
+                ObjectKind::Shape { .. } => Vec::new(),
+            }
+        };
+        let mut finals: Vec<usize> = d.object_index.values().copied().collect();
+        finals.sort_unstable();
+        for start in finals {
+            if mark[start] != Mark::New {
+                continue;
+            }
+            // Depth-first with an explicit stack (nesting depth is unbounded in the input):
+            // (object, its children, next child to visit).
+            let mut stack = vec![(start, children_of(start), 0usize)];
+            mark[start] = Mark::Open;
+            while let Some((node, children, next)) = stack.last_mut() {
+                let node = *node;
+                if let Some(&child) = children.get(*next) {
+                    *next += 1;
+                    match mark[child] {
+                        Mark::New => {
+                            mark[child] = Mark::Open;
+                            let grandchildren = children_of(child);
+                            stack.push((child, grandchildren, 0));
+                        }
+                        Mark::Open => {
+                            let from = stack.iter().position(|(n, _, _)| *n == child).unwrap_or(0);
+                            let mut cycle: Vec<&str> = stack[from..]
+                                .iter()
+                                .map(|(n, _, _)| d.objects[*n].name)
+                                .collect();
+                            cycle.push(d.objects[child].name);
+                            let object = &d.objects[child];
+                            if self.reported_composites.insert(object.name.to_string()) {
+                                self.error(
+                                    At::Name(object.statement),
+                                    format!(
+                                        "composite `{}` contains itself ({})",
+                                        object.name,
+                                        cycle.join(" → ")
+                                    ),
+                                    None,
+                                );
+                            }
+                        }
+                        Mark::Done => {}
+                    }
+                } else {
+                    mark[node] = Mark::Done;
+                    stack.pop();
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,234 @@
+//! Lights, ambient light and the background colour.
+
+use super::{At, PResult, Parser};
+use crate::sdf::ast::{LightDef, StatementKind};
+use crate::sdf::lexer::{looks_numeric, Line};
+use glam::{DVec3, Vec3};
+
+const FORM_LIGHT: &str = "define light <name> [pos] [color] <brightness>";
+const FORM_AMBIENT_LIGHT: &str = "define light ambient <name> [rgb]";
+const FORM_AMBIENT: &str = "ambient [rgb]";
+const FORM_BACKGROUND: &str = "background [rgb]";
+
+impl Parser<'_> {
+    pub(super) fn light(&mut self, line: &Line) {
+        let toks = &line.tokens;
+        // `define light ambient|diffuse <name> ...` is the typed form only when a name
+        // follows; `define light ambient 0 0 0 ...` is a point light named `ambient`.
+        let typed = toks
+            .get(2)
+            .filter(|t| matches!(t.text, "ambient" | "diffuse"))
+            .is_some_and(|_| toks.get(3).is_some_and(|n| !looks_numeric(n.text)));
+        let name_at = if typed { 3 } else { 2 };
+        let result = if typed && toks[2].text == "ambient" {
+            self.ambient_light(line, name_at)
+        } else {
+            self.point_light(line, name_at)
+        };
+        if result.is_err() {
+            self.skip_name(line, name_at);
+        }
+    }
+
+    fn ambient_light(&mut self, line: &Line, name_at: usize) -> PResult<()> {
+        let nums = self.numbers(line, name_at + 1, line.tokens.len())?;
+        let rgb = match nums.len() {
+            1 => Vec3::splat(nums[0] as f32),
+            3 => Vec3::new(nums[0] as f32, nums[1] as f32, nums[2] as f32),
+            n => {
+                return Err(self.error(
+                    line,
+                    At::Span(
+                        name_at + 1,
+                        line.tokens.len().saturating_sub(1).max(name_at + 1),
+                    ),
+                    format!("an ambient light takes 3 numbers (r g b), found {n}"),
+                    Some(format!("canonical form: `{FORM_AMBIENT_LIGHT}`")),
+                ))
+            }
+        };
+        // The name is not needed: ambient light is one value for the whole scene.
+        self.skipped.insert(line.tokens[name_at].text.to_string());
+        self.emit(line, StatementKind::Ambient(rgb));
+        Ok(())
+    }
+
+    fn point_light(&mut self, line: &Line, name_at: usize) -> PResult<()> {
+        let toks = &line.tokens;
+        let Some(name_tok) = toks.get(name_at) else {
+            return Err(self.error(
+                line,
+                At::End,
+                "expected the light's name, found end of line",
+                Some(format!("canonical form: `{FORM_LIGHT}`")),
+            ));
+        };
+        let name = name_tok.text.to_string();
+        let nums = self.numbers(line, name_at + 1, toks.len())?;
+        let v = |i: usize| DVec3::new(nums[i], nums[i + 1], nums[i + 2]);
+        let c = |i: usize| Vec3::new(nums[i] as f32, nums[i + 1] as f32, nums[i + 2] as f32);
+        let light = |color: Vec3, brightness: f32| LightDef {
+            name: name.clone(),
+            position: v(0),
+            color,
+            brightness,
+        };
+        match nums.len() {
+            7 => {
+                let l = light(c(3), nums[6] as f32);
+                self.emit_named(line, name_at, StatementKind::Light(l));
+            }
+            6 => {
+                let l = light(c(3), 1.0);
+                self.emit_named(line, name_at, StatementKind::Light(l));
+            }
+            9 => {
+                let last = c(6);
+                let nums_at = At::Span(name_at + 4, toks.len() - 1);
+                if last.max_element() > 1.0 {
+                    let l = light(c(3) * last, 1.0);
+                    if !self.nine_number_noted[0] {
+                        self.nine_number_noted[0] = true;
+                        self.warn(
+                            line,
+                            nums_at,
+                            "9-number light read as [pos] [color] [rgb-brightness] (a brightness above 1); \
+                             intensity = color × brightness per channel",
+                            Some(format!("read as `{}`", StatementKind::Light(l.clone()))),
+                        );
+                    }
+                    self.emit_named(line, name_at, StatementKind::Light(l));
+                } else {
+                    let ambient = c(3);
+                    let diffuse = last;
+                    if !self.nine_number_noted[1] {
+                        self.nine_number_noted[1] = true;
+                        self.warn(
+                            line,
+                            nums_at,
+                            "9-number light read as the lecture form [pos] [La] [Ld] (no number above 1): \
+                             La is added to the ambient light, Ld is the light's intensity",
+                            Some(format!(
+                                "for a brightness per channel, one of the last three numbers must exceed 1; \
+                                 canonical form: `{FORM_LIGHT}`"
+                            )),
+                        );
+                    }
+                    if ambient != Vec3::ZERO {
+                        self.emit(line, StatementKind::AmbientAdd(ambient));
+                    }
+                    if diffuse == Vec3::ZERO {
+                        // A pure ambient term: there is no point light to place.
+                        self.skipped.insert(name);
+                    } else {
+                        let l = light(diffuse, 1.0);
+                        self.emit_named(line, name_at, StatementKind::Light(l));
+                    }
+                }
+            }
+            4 => {
+                // No position: the only meaning left is an ambient term, colour × brightness
+                // (`define light ambient1 .3 .2 .6 5`), added like the lecture form's La.
+                let rgb = c(0) * nums[3] as f32;
+                self.warn(
+                    line,
+                    At::Span(name_at + 1, toks.len() - 1),
+                    "a light with 4 numbers has no position: read as ambient light [rgb] <brightness>, \
+                     added to the scene's ambient light",
+                    Some(format!(
+                        "write `{FORM_AMBIENT}` for ambient light, or `{FORM_LIGHT}` for a point light"
+                    )),
+                );
+                self.skipped.insert(name);
+                self.emit(line, StatementKind::AmbientAdd(rgb));
+            }
+            n => {
+                let at = if n > 7 {
+                    At::Span(name_at + 8, toks.len() - 1)
+                } else {
+                    At::End
+                };
+                let mut help = format!(
+                    "canonical form: `{FORM_LIGHT}`; 6 numbers (no brightness) and 9 are also read"
+                );
+                if matches!(n, 1 | 3) {
+                    help.push_str(&format!(
+                        ". An ambient light is written `{FORM_AMBIENT}` or `{FORM_AMBIENT_LIGHT}`"
+                    ));
+                }
+                return Err(self.error(
+                    line,
+                    at,
+                    format!("a light takes 7 numbers ([pos] [color] <brightness>), found {n}"),
+                    Some(help),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// `ambient [<name>] <s>|[rgb]`, `define ambient [<name>] [rgb] [<k>]`.
+    pub(super) fn ambient(&mut self, line: &Line, from: usize) {
+        let toks = &line.tokens;
+        let mut at = from;
+        if toks.get(at).is_some_and(|t| !looks_numeric(t.text)) {
+            at += 1; // an ambient light's name, not needed
+        }
+        let Ok(nums) = self.numbers(line, at, toks.len()) else {
+            return;
+        };
+        let c = |i: usize| Vec3::new(nums[i] as f32, nums[i + 1] as f32, nums[i + 2] as f32);
+        let rgb = match nums.len() {
+            1 => Vec3::splat(nums[0] as f32),
+            3 => c(0),
+            4 => c(0) * nums[3] as f32,
+            n => {
+                self.error(
+                    line,
+                    if n == 0 { At::End } else { At::Span(at, toks.len() - 1) },
+                    format!("ambient takes 3 numbers (r g b), found {n}"),
+                    Some(format!(
+                        "canonical form: `{FORM_AMBIENT}`; also read: `ambient <s>`, `define ambient <name> [rgb] <k>`"
+                    )),
+                );
+                return;
+            }
+        };
+        self.emit(line, StatementKind::Ambient(rgb));
+    }
+
+    pub(super) fn background(&mut self, line: &Line, from: usize) {
+        let toks = &line.tokens;
+        let Ok(nums) = self.numbers(line, from, toks.len()) else {
+            return;
+        };
+        match nums.len() {
+            3 => {
+                let rgb = Vec3::new(nums[0] as f32, nums[1] as f32, nums[2] as f32);
+                self.emit(line, StatementKind::Background(rgb));
+            }
+            1 => {
+                let kind = StatementKind::Background(Vec3::splat(nums[0] as f32));
+                self.warn(
+                    line,
+                    At::Tok(from),
+                    "background with one number read as a grey",
+                    Some(format!("read as `{kind}`")),
+                );
+                self.emit(line, kind);
+            }
+            n => {
+                self.error(
+                    line,
+                    if n == 0 {
+                        At::End
+                    } else {
+                        At::Span(from, toks.len() - 1)
+                    },
+                    format!("background takes 3 numbers (r g b), found {n}"),
+                    Some(format!("canonical form: `{FORM_BACKGROUND}`")),
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,463 @@
+//! Parsing: the tokens of each line → canonical statements (the scene language).
+//!
+//! Every accepted variant is normalised here, so the statement list that comes out only uses
+//! the canonical forms of `ast.rs`. Problems are reported with the line, the column of the
+//! offending token and, where it helps, the canonical form of the statement. A statement with
+//! an error is dropped (parsing goes on, to report every problem in one run); the names it
+//! would have defined are remembered so that later references to them do not pile up
+//! follow-on errors.
+
+mod camera;
+mod light;
+mod material;
+mod render;
+mod resolve;
+mod shape;
+mod transform;
+
+pub use resolve::default_output;
+
+use super::ast::{NameRef, Span, Statement, StatementKind, StatementSpans};
+use super::lexer::{self, looks_numeric, Line, NumberError};
+use super::LoadOptions;
+use crate::diag::{suggest, Diagnostic, Loc, Severity};
+use render::PendingRender;
+use resolve::commented_definitions;
+use std::collections::{HashMap, HashSet};
+use std::path::Path;
+use std::sync::Arc;
+
+const STATEMENT_KEYWORDS: [&str; 6] = [
+    "define",
+    "transform",
+    "render",
+    "camera",
+    "ambient",
+    "background",
+];
+const DEFINE_KINDS: [&str; 8] = [
+    "material",
+    "shape",
+    "light",
+    "camera",
+    "ambient",
+    "background",
+    "transform",
+    "render",
+];
+const SHAPE_KINDS: [&str; 7] = [
+    "sphere",
+    "box",
+    "triangle",
+    "cylinder",
+    "cone",
+    "plane",
+    "composite",
+];
+
+/// The statements of a file, the problems met, what the reader left out, and the lines as
+/// written (for quoting them in diagnostics found later).
+pub struct Parsed {
+    pub statements: Vec<Statement>,
+    pub diagnostics: Vec<Diagnostic>,
+    pub omissions: Omissions,
+    pub lines: Vec<String>,
+}
+
+impl Parsed {
+    /// Quotes the source line of every diagnostic located in this file that lacks it.
+    pub fn quote_source(&self, diagnostics: &mut [Diagnostic]) {
+        for d in diagnostics {
+            let Some(loc) = &d.loc else { continue };
+            let line = usize::try_from(loc.line)
+                .ok()
+                .and_then(|n| n.checked_sub(1))
+                .and_then(|i| self.lines.get(i));
+            if let (None, Some(line)) = (&d.source_line, line) {
+                d.source_line = Some(line.clone());
+            }
+        }
+    }
+}
+
+/// What the reader left out of the statements that building must still account for: its
+/// problems are reported already, and must neither be reported again as follow-on errors nor
+/// be covered up by a stand-in.
+#[derive(Debug, Default)]
+pub struct Omissions {
+    /// Names whose definition was rejected or skipped (already reported): references to them
+    /// are ignored instead of being reported again as undefined.
+    pub skipped: HashSet<String>,
+    /// Render-like lines met, including rejected ones: a file whose only render line was
+    /// rejected has not "no render statement".
+    pub render_lines: usize,
+    /// Whether a camera definition was rejected (so the default camera is no stand-in).
+    pub cameras_rejected: bool,
+    /// Names defined only in commented-out lines → the line (see `commented_definitions`).
+    pub commented: HashMap<String, u32>,
+}
+
+/// An error has been reported; the statement is dropped.
+struct Fail;
+type PResult<T> = Result<T, Fail>;
+
+/// Where on a line a diagnostic points.
+#[derive(Clone, Copy, Debug)]
+enum At {
+    /// One token.
+    Tok(usize),
+    /// Tokens `a..=b`.
+    Span(usize, usize),
+    /// Just after the last token (something is missing).
+    End,
+}
+
+/// A place in the source, kept after the line itself is gone (for checks done at the end).
+#[derive(Clone, Debug)]
+struct Anchor {
+    loc: Loc,
+    width: u32,
+    text: String,
+}
+
+pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
+    let lines = lexer::lines(text);
+    let mut p = Parser {
+        file: Arc::from(path),
+        path,
+        opts,
+        statements: Vec::new(),
+        diagnostics: Vec::new(),
+        skipped: HashSet::new(),
+        camera_names: Vec::new(),
+        pending: Vec::new(),
+        nine_number_noted: [false; 2],
+        variants_noted: HashSet::new(),
+        render_lines: 0,
+        cameras_rejected: false,
+    };
+    for line in &lines {
+        p.line(line);
+    }
+    p.resolve_renders();
+    p.prune_skipped_references();
+    p.drop_transforms_of_commented_definitions(&lines);
+    Parsed {
+        statements: p.statements,
+        diagnostics: p.diagnostics,
+        lines: lines.iter().map(|l| l.text.to_string()).collect(),
+        omissions: Omissions {
+            skipped: p.skipped,
+            render_lines: p.render_lines,
+            cameras_rejected: p.cameras_rejected,
+            commented: commented_definitions(&lines)
+                .into_iter()
+                .map(|(name, line)| (name.to_string(), line))
+                .collect(),
+        },
+    }
+}
+
+struct Parser<'a> {
+    file: Arc<Path>,
+    path: &'a Path,
+    opts: &'a LoadOptions,
+    statements: Vec<Statement>,
+    diagnostics: Vec<Diagnostic>,
+    skipped: HashSet<String>,
+    /// Every camera name defined in the file (also by lines that failed), in order.
+    camera_names: Vec<String>,
+    pending: Vec<PendingRender>,
+    /// Whether the 9-number light reading was already explained: [rgb-brightness, lecture].
+    nine_number_noted: [bool; 2],
+    /// Variant spellings already explained: each is warned about once per file, as the same
+    /// reading applies to every later line written that way.
+    variants_noted: HashSet<&'static str>,
+    render_lines: usize,
+    cameras_rejected: bool,
+}
+
+impl Parser<'_> {
+    // ----- diagnostics -------------------------------------------------------------------
+
+    /// Column and caret width of `at`.
+    fn place(line: &Line, at: At) -> (u32, u32) {
+        match at {
+            At::Tok(i) => line
+                .tokens
+                .get(i)
+                .map_or((line.end_col(), 1), |t| (t.col, t.width)),
+            At::Span(a, b) => match (line.tokens.get(a), line.tokens.get(b)) {
+                (Some(ta), Some(tb)) => (
+                    ta.col,
+                    tb.col
+                        .saturating_add(tb.width)
+                        .saturating_sub(ta.col)
+                        .max(1),
+                ),
+                _ => (line.end_col(), 1),
+            },
+            At::End => (line.end_col(), 1),
+        }
+    }
+
+    fn anchor(&self, line: &Line, at: At) -> Anchor {
+        let (col, width) = Self::place(line, at);
+        Anchor {
+            loc: Loc {
+                file: self.file.clone(),
+                line: line.number,
+                col,
+            },
+            width,
+            text: line.text.to_string(),
+        }
+    }
+
+    /// The location of `at` (without copying the line, as `anchor` does: name references
+    /// are made for every token of long composite lines).
+    fn loc(&self, line: &Line, at: At) -> Loc {
+        Loc {
+            file: self.file.clone(),
+            line: line.number,
+            col: Self::place(line, at).0,
+        }
+    }
+
+    fn report(
+        &mut self,
+        severity: Severity,
+        anchor: Anchor,
+        message: String,
+        help: Option<String>,
+    ) {
+        let mut d =
+            Diagnostic::new(severity, anchor.loc, message).with_source(anchor.text, anchor.width);
+        if let Some(h) = help {
+            d = d.with_help(h);
+        }
+        self.diagnostics.push(d);
+    }
+
+    fn error(
+        &mut self,
+        line: &Line,
+        at: At,
+        message: impl Into<String>,
+        help: Option<String>,
+    ) -> Fail {
+        let anchor = self.anchor(line, at);
+        self.report(Severity::Error, anchor, message.into(), help);
+        Fail
+    }
+
+    fn warn(&mut self, line: &Line, at: At, message: impl Into<String>, help: Option<String>) {
+        let anchor = self.anchor(line, at);
+        self.report(Severity::Warning, anchor, message.into(), help);
+    }
+
+    /// Explains a variant spelling the first time the file uses it.
+    fn variant(&mut self, line: &Line, at: At, key: &'static str, message: String, help: String) {
+        let help =
+            format!("{help} (later lines written this way are read the same, without a warning)");
+        self.warn_once(line, at, key, message, help);
+    }
+
+    /// A warning given only the first time its `key` comes up in the file.
+    fn warn_once(&mut self, line: &Line, at: At, key: &'static str, message: String, help: String) {
+        if self.variants_noted.insert(key) {
+            self.warn(line, at, message, Some(help));
+        }
+    }
+
+    fn emit(&mut self, line: &Line, kind: StatementKind) {
+        self.push(line, kind, None);
+    }
+
+    /// A statement about a name (the one a definition gives, a transform's target), with
+    /// where that name (token `name_at`) is written: problems found once the whole file is
+    /// known (a duplicate, a cycle) point at it.
+    fn emit_named(&mut self, line: &Line, name_at: usize, kind: StatementKind) {
+        let (col, width) = Self::place(line, At::Tok(name_at));
+        let name = Span {
+            loc: Loc {
+                file: self.file.clone(),
+                line: line.number,
+                col,
+            },
+            width,
+        };
+        self.push(line, kind, Some(name));
+    }
+
+    fn push(&mut self, line: &Line, kind: StatementKind, name: Option<Span>) {
+        let loc = self.loc(line, At::Tok(0));
+        let first_width = Self::place(line, At::Tok(0)).1;
+        self.statements.push(Statement {
+            kind,
+            loc,
+            spans: Some(StatementSpans { first_width, name }),
+        });
+    }
+
+    fn name_ref(&self, line: &Line, i: usize) -> NameRef {
+        NameRef {
+            name: line
+                .tokens
+                .get(i)
+                .map_or(String::new(), |t| t.text.to_string()),
+            loc: self.loc(line, At::Tok(i)),
+        }
+    }
+
+    /// Remembers that the definition of the name at token `i` was not taken, so references
+    /// to it stay quiet (the problem was reported here).
+    fn skip_name(&mut self, line: &Line, i: usize) {
+        if let Some(t) = line.tokens.get(i) {
+            self.skipped.insert(t.text.to_string());
+        }
+    }
+
+    // ----- numbers -----------------------------------------------------------------------
+
+    fn bad_number(&mut self, line: &Line, i: usize, e: NumberError) -> Fail {
+        let text = line.tokens.get(i).map_or("", |t| t.text).to_string();
+        let (message, help) = match e {
+            NumberError::Malformed => {
+                let help = if text.contains(['O', 'o'])
+                    && lexer::parse_number(&text.replace(['O', 'o'], "0")).is_ok()
+                {
+                    format!(
+                        "`{text}` contains the letter O; did you mean `{}`?",
+                        text.replace(['O', 'o'], "0")
+                    )
+                } else {
+                    "numbers look like 1, -1.5, .5, +100 or 1e-3".to_string()
+                };
+                (format!("expected a number, found '{text}'"), help)
+            }
+            NumberError::NotFinite => (
+                format!("expected a number, found '{text}'"),
+                "nan and inf are not allowed: every number must be finite".to_string(),
+            ),
+            NumberError::Suffix(plain) => (
+                format!("expected a number, found '{text}'"),
+                format!("SDF numbers take no type suffix: write `{plain}`"),
+            ),
+            NumberError::DecimalComma(dotted) => (
+                format!("expected a number, found '{text}'"),
+                format!("use a decimal point: `{dotted}`"),
+            ),
+            NumberError::TooLarge => (
+                format!("number '{text}' is out of range"),
+                format!(
+                    "numbers must lie between -{m:e} and {m:e}",
+                    m = lexer::MAX_MAGNITUDE
+                ),
+            ),
+        };
+        self.error(line, At::Tok(i), message, Some(help))
+    }
+
+    /// Reads tokens `from..to` as numbers, reporting every one that is not.
+    fn numbers(&mut self, line: &Line, from: usize, to: usize) -> PResult<Vec<f64>> {
+        let mut out = Vec::with_capacity(to.saturating_sub(from));
+        let mut failed = false;
+        for i in from..to.min(line.tokens.len()) {
+            match lexer::parse_number(line.tokens[i].text) {
+                Ok(v) => out.push(v),
+                Err(e) => {
+                    self.bad_number(line, i, e);
+                    failed = true;
+                }
+            }
+        }
+        if failed {
+            Err(Fail)
+        } else {
+            Ok(out)
+        }
+    }
+
+    /// The index just past the run of number-like tokens starting at `from`.
+    fn number_run_end(line: &Line, from: usize) -> usize {
+        let mut j = from;
+        while j < line.tokens.len() && looks_numeric(line.tokens[j].text) {
+            j += 1;
+        }
+        j
+    }
+
+    // ----- dispatch ----------------------------------------------------------------------
+
+    fn line(&mut self, line: &Line) {
+        let Some(first) = line.tokens.first() else {
+            return;
+        };
+        match first.text {
+            "define" => self.define(line),
+            "transform" => self.transform(line, 1, None),
+            "view" => self.transform(line, 1, Some("`view` read as `transform`")),
+            "render" => self.render(line, 1, true, None),
+            "renderer" => self.render(line, 1, false, Some("`renderer` read as `render`")),
+            "camera" => self.camera(line, 1),
+            "ambient" => self.ambient(line, 1),
+            "background" => self.background(line, 1),
+            other => {
+                let help = if other.starts_with("<<<<<<<")
+                    || other.starts_with("=======")
+                    || other.starts_with(">>>>>>>")
+                {
+                    Some("this looks like a merge-conflict marker".to_string())
+                } else {
+                    suggest(other, STATEMENT_KEYWORDS).map(|s| format!("did you mean `{s}`?"))
+                };
+                self.warn(
+                    line,
+                    At::Tok(0),
+                    format!("unknown statement '{other}'; line skipped"),
+                    help,
+                );
+            }
+        }
+    }
+
+    fn define(&mut self, line: &Line) {
+        let Some(kind) = line.tokens.get(1) else {
+            self.warn(
+                line,
+                At::Tok(0),
+                "`define` without anything to define; line skipped",
+                None,
+            );
+            return;
+        };
+        match kind.text {
+            "material" => self.material(line),
+            "shape" => self.shape(line, 2),
+            "light" => self.light(line),
+            "camera" => self.camera(line, 2),
+            "ambient" => self.ambient(line, 2),
+            "background" => self.background(line, 2),
+            "backgroundcolor" => self.background(line, 2),
+            "transform" => self.transform(line, 2, Some("`define transform` read as `transform`")),
+            "render" | "renderer" => {
+                let note = format!("`define {}` read as `render`", kind.text);
+                self.render(line, 2, false, Some(&note))
+            }
+            k if SHAPE_KINDS.contains(&k) => self.shape(line, 1),
+            other => {
+                let help = suggest(other, DEFINE_KINDS)
+                    .map(|s| format!("did you mean `{s}`?"))
+                    .unwrap_or_else(|| format!("known kinds: {}", DEFINE_KINDS.join(", ")));
+                self.warn(
+                    line,
+                    At::Tok(1),
+                    format!("unknown definition kind '{other}'; line skipped"),
+                    Some(help),
+                );
+                self.skip_name(line, 2);
+            }
+        }
+    }
+}

@@ -1,0 +1,239 @@
+//! The pass over the whole file once every line is read: render lines settled, references
+//! to skipped definitions pruned.
+
+use super::render::RenderCamera;
+use super::Parser;
+use crate::diag::{Diagnostic, Loc, Severity};
+use crate::limits;
+use crate::sdf::ast::{CameraDef, NameRef, Statement, StatementKind};
+use crate::sdf::lexer::{self, Line};
+use std::collections::{HashMap, HashSet};
+use std::path::Path;
+
+impl Parser<'_> {
+    /// Removes references to names whose definition was skipped (a mesh, an ambient light's
+    /// name, a line with an error): their transforms and composite entries mean nothing, and
+    /// the statement list must stand on its own when written back out as canonical text.
+    pub(super) fn prune_skipped_references(&mut self) {
+        if self.skipped.is_empty() {
+            return;
+        }
+        let defined: HashSet<String> = self
+            .statements
+            .iter()
+            .filter_map(|s| match &s.kind {
+                StatementKind::Shape { name, .. } | StatementKind::Composite { name, .. } => {
+                    Some(name.clone())
+                }
+                StatementKind::Light(l) => Some(l.name.clone()),
+                StatementKind::Camera(c) => Some(c.name.clone()),
+                _ => None,
+            })
+            .collect();
+        let gone = |name: &str| self.skipped.contains(name) && !defined.contains(name);
+        self.statements.retain_mut(|s| match &mut s.kind {
+            StatementKind::Transform { target, .. } => !gone(&target.name),
+            StatementKind::Composite { children, .. } => {
+                children.retain(|c| !gone(&c.name));
+                true
+            }
+            _ => true,
+        });
+    }
+
+    /// Drops (with one warning per name) the transforms of names that are defined only in a
+    /// commented-out line: a definition disabled while its transforms were left in, which
+    /// leaves them nothing to move (as for a composite's commented-out child).
+    pub(super) fn drop_transforms_of_commented_definitions(&mut self, lines: &[Line]) {
+        let commented = commented_definitions(lines);
+        if commented.is_empty() {
+            return;
+        }
+        let defined: HashSet<&str> = self
+            .statements
+            .iter()
+            .filter_map(|s| match &s.kind {
+                StatementKind::Shape { name, .. } | StatementKind::Composite { name, .. } => {
+                    Some(name.as_str())
+                }
+                StatementKind::Light(l) => Some(l.name.as_str()),
+                StatementKind::Camera(c) => Some(c.name.as_str()),
+                _ => None,
+            })
+            .collect();
+        let mut dropped: Vec<(usize, &NameRef, u32)> = Vec::new();
+        for (i, s) in self.statements.iter().enumerate() {
+            if let StatementKind::Transform { target, .. } = &s.kind {
+                if let Some(&line) = commented.get(target.name.as_str()) {
+                    if !defined.contains(target.name.as_str()) {
+                        dropped.push((i, target, line));
+                    }
+                }
+            }
+        }
+        let mut warned = HashSet::new();
+        let mut notes = Vec::new();
+        for &(_, target, comment_line) in &dropped {
+            if warned.insert(target.name.as_str()) {
+                let text = lines
+                    .get((target.loc.line as usize).saturating_sub(1))
+                    .map_or("", |l| l.text);
+                let d = Diagnostic::new(
+                    Severity::Warning,
+                    target.loc.clone(),
+                    format!(
+                        "`{}` is only defined in a comment (line {comment_line}); its transforms are skipped",
+                        target.name
+                    ),
+                )
+                .with_source(text, target.name.chars().count() as u32);
+                notes.push(d);
+            }
+        }
+        let gone: HashSet<usize> = dropped.iter().map(|&(i, _, _)| i).collect();
+        self.diagnostics.extend(notes);
+        let mut index = 0;
+        self.statements.retain(|_| {
+            index += 1;
+            !gone.contains(&(index - 1))
+        });
+    }
+
+    /// Settles the camera and output of render lines that left them open, now that every
+    /// camera of the file is known, and explains every variant read.
+    pub(super) fn resolve_renders(&mut self) {
+        let default_output = default_output(self.path);
+        let first_camera = self.camera_names.first().cloned();
+        let mut need_default_camera = false;
+        let mut rejected = Vec::new();
+        for pending in std::mem::take(&mut self.pending) {
+            let mut notes = pending.notes;
+            let Some(Statement {
+                kind: StatementKind::Render(def),
+                ..
+            }) = self.statements.get_mut(pending.index)
+            else {
+                continue;
+            };
+            let mut camera_missing = false;
+            match pending.camera {
+                RenderCamera::Named => {}
+                RenderCamera::Ambiguous(word) => {
+                    if self.camera_names.contains(&word) {
+                        def.camera.name = word;
+                    } else {
+                        def.output = word;
+                        camera_missing = true;
+                    }
+                }
+                RenderCamera::Missing => camera_missing = true,
+            }
+            if camera_missing {
+                match &first_camera {
+                    Some(c) => {
+                        def.camera.name = c.clone();
+                        notes.push(format!(
+                            "no camera named: the file's first camera `{c}` is used"
+                        ));
+                    }
+                    None => {
+                        def.camera.name = "default".to_string();
+                        need_default_camera = true;
+                        notes.push(format!(
+                            "no camera named and none defined: a default camera (fov {}) is used",
+                            limits::DEFAULT_FOV_DEG
+                        ));
+                    }
+                }
+            }
+            if def.output.is_empty() {
+                def.output = default_output.clone();
+                if !pending.output_given {
+                    notes.push(format!(
+                        "no output file named: `{default_output}` is written"
+                    ));
+                }
+            }
+            let output = def.output.clone();
+            let canonical = StatementKind::Render(def.clone()).to_string();
+            if is_scene_file(self.path, &output) {
+                rejected.push(pending.index);
+                self.report(
+                    Severity::Error,
+                    pending.output_anchor,
+                    format!("the render output `{output}` is this scene file itself"),
+                    Some("name an image file such as image.png".to_string()),
+                );
+            } else if !notes.is_empty() {
+                self.report(
+                    Severity::Warning,
+                    pending.anchor,
+                    notes.join("; "),
+                    Some(format!("read as `{canonical}`")),
+                );
+            }
+        }
+        // Indices were taken in increasing order; remove from the back so they stay valid.
+        for index in rejected.into_iter().rev() {
+            self.statements.remove(index);
+        }
+        if need_default_camera {
+            let loc = Loc {
+                file: self.file.clone(),
+                line: 1,
+                col: 1,
+            };
+            self.statements.insert(
+                0,
+                Statement::new(
+                    StatementKind::Camera(CameraDef::at_origin("default", limits::DEFAULT_FOV_DEG)),
+                    loc,
+                ),
+            );
+        }
+    }
+}
+
+/// Names defined in commented-out lines (`# define shape box b ...`, `//define light l ...`)
+/// → the line, for explaining references to them.
+pub(crate) fn commented_definitions<'t>(lines: &[Line<'t>]) -> HashMap<&'t str, u32> {
+    let mut index = HashMap::new();
+    for line in lines {
+        let body = line.text.trim_start();
+        let Some(body) = body.strip_prefix("//").or_else(|| body.strip_prefix('#')) else {
+            continue;
+        };
+        let tokens = lexer::tokenize(body.trim_start_matches(['#', '/']));
+        if tokens.first().is_some_and(|t| t.text == "define") {
+            // `define shape <kind> <name>` or `define <kind> <name>`.
+            for t in tokens.iter().skip(2).take(2) {
+                index.entry(t.text).or_insert(line.number);
+            }
+        }
+    }
+    index
+}
+
+/// `<file-stem>.png`, the output for files that name none.
+pub fn default_output(path: &Path) -> String {
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| "image".to_string());
+    format!("{stem}.png")
+}
+
+/// Whether the output path, resolved (as the renderer does) against the scene file's
+/// directory, is the scene file itself.
+fn is_scene_file(scene: &Path, output: &str) -> bool {
+    let out = Path::new(output);
+    if out.is_absolute() {
+        return out == scene;
+    }
+    let in_same_dir = out.parent().is_none_or(|p| {
+        p.components()
+            .all(|c| matches!(c, std::path::Component::CurDir))
+    });
+    in_same_dir && out.file_name().is_some() && out.file_name() == scene.file_name()
+}

@@ -1,0 +1,341 @@
+//! `define shape`: the geometric primitives and composites.
+
+use super::{At, PResult, Parser, SHAPE_KINDS};
+use crate::diag::suggest;
+use crate::limits;
+use crate::sdf::ast::StatementKind;
+use crate::sdf::lexer::{looks_numeric, Line};
+use crate::shape::geometry::degeneracy;
+use crate::shape::Geometry;
+use glam::DVec3;
+
+const FORM_SPHERE: &str = "define shape sphere <name> [center] <radius> <material>";
+const FORM_BOX: &str = "define shape box <name> [p1] [p2] <material>";
+const FORM_TRIANGLE: &str = "define shape triangle <name> [v1] [v2] [v3] <material>";
+const FORM_CYLINDER: &str = "define shape cylinder <name> [p1] [p2] <radius> <material>";
+const FORM_CONE: &str = "define shape cone <name> [base] [tip] <radius> <material>";
+const FORM_PLANE: &str = "define shape plane <name> [point] [normal] <material>";
+const FORM_COMPOSITE: &str = "define shape composite <name> <child> ...";
+
+impl Parser<'_> {
+    /// `define shape <kind> <name> ...` (`kind_at` = 2) or the variant without `shape`
+    /// (`kind_at` = 1).
+    pub(super) fn shape(&mut self, line: &Line, kind_at: usize) {
+        let Some(kind) = line.tokens.get(kind_at) else {
+            self.error(
+                line,
+                At::End,
+                "expected a shape kind, found end of line",
+                Some(format!("shapes: {}", SHAPE_KINDS.join(", "))),
+            );
+            return;
+        };
+        let name_at = kind_at + 1;
+        match kind.text {
+            "composite" => {
+                if self.composite(line, name_at).is_err() {
+                    self.skip_name(line, name_at);
+                }
+            }
+            "obj" => {
+                self.warn(
+                    line,
+                    At::Tok(kind_at),
+                    "mesh files (`define shape obj`) are not supported; shape skipped",
+                    None,
+                );
+                self.skip_name(line, name_at);
+            }
+            k if SHAPE_KINDS.contains(&k) => {
+                if self.geometric_shape(line, kind_at).is_err() {
+                    self.skip_name(line, name_at);
+                }
+            }
+            other => {
+                let help = suggest(other, SHAPE_KINDS)
+                    .map(|s| format!("did you mean `{s}`?"))
+                    .unwrap_or_else(|| format!("shapes: {}", SHAPE_KINDS.join(", ")));
+                self.warn(
+                    line,
+                    At::Tok(kind_at),
+                    format!("unknown shape kind '{other}'; line skipped"),
+                    Some(help),
+                );
+                self.skip_name(line, name_at);
+            }
+        }
+    }
+
+    fn geometric_shape(&mut self, line: &Line, kind_at: usize) -> PResult<()> {
+        let kind = line.tokens[kind_at].text;
+        let layout = Layout::of(kind);
+        let args = self.shape_arguments(line, kind_at, &layout)?;
+        let mut geometry = geometry_from(kind, &args.nums);
+        self.check_geometry(line, kind, &args, &mut geometry);
+        let material = self.name_ref(line, args.material_at);
+        let kind_stmt = StatementKind::Shape {
+            name: args.name,
+            geometry,
+            material,
+        };
+        if kind_at == 1 {
+            self.variant(
+                line,
+                At::Tok(1),
+                "define-without-shape",
+                format!("`define {kind}` without `shape`"),
+                format!("read as `{kind_stmt}`"),
+            );
+        }
+        if args.material_first {
+            self.variant(
+                line,
+                At::Tok(args.material_at),
+                "material-first",
+                "material written before the coordinates".to_string(),
+                format!("read as `{kind_stmt}`"),
+            );
+        }
+        self.emit_named(line, kind_at + 1, kind_stmt);
+        Ok(())
+    }
+
+    /// The name, numbers and material of a primitive's line, in either order of numbers and
+    /// material.
+    fn shape_arguments(
+        &mut self,
+        line: &Line,
+        kind_at: usize,
+        layout: &Layout,
+    ) -> PResult<ShapeArguments> {
+        let toks = &line.tokens;
+        let (kind, expected) = (layout.kind, layout.numbers);
+        let name_at = kind_at + 1;
+        let Some(name_tok) = toks.get(name_at) else {
+            return Err(self.error(
+                line,
+                At::End,
+                format!("expected the {kind}'s name, found end of line"),
+                Some(layout.canonical()),
+            ));
+        };
+        let name = name_tok.text.to_string();
+        let args = name_at + 1..toks.len();
+        if args.is_empty() {
+            return Err(self.error(
+                line,
+                At::End,
+                format!(
+                    "expected the {kind}'s {} and material, found end of line",
+                    layout.numbers_meaning
+                ),
+                Some(layout.canonical()),
+            ));
+        }
+        // The material normally comes last; some files write it right after the name.
+        let material_first = args.len() >= 2
+            && !looks_numeric(toks[args.start].text)
+            && toks[args.start + 1..].iter().all(|t| looks_numeric(t.text));
+        let (material_at, nums_from, nums_to) = if material_first {
+            (args.start, args.start + 1, toks.len())
+        } else {
+            (toks.len() - 1, args.start, toks.len() - 1)
+        };
+        if !material_first
+            && looks_numeric(toks[material_at].text)
+            && nums_to - nums_from + 1 == expected
+        {
+            return Err(self.error(
+                line,
+                At::End,
+                format!("expected a material name after the {kind}'s numbers, found end of line"),
+                Some(layout.canonical()),
+            ));
+        }
+        let nums = self.numbers(line, nums_from, nums_to)?;
+        if nums.len() != expected {
+            let at = if nums.len() > expected {
+                At::Span(nums_from + expected, nums_to - 1)
+            } else if material_first {
+                At::End
+            } else {
+                At::Tok(material_at)
+            };
+            return Err(self.error(
+                line,
+                at,
+                format!(
+                    "a {kind} takes {expected} numbers ({}), found {}",
+                    layout.numbers_meaning,
+                    nums.len()
+                ),
+                Some(layout.canonical()),
+            ));
+        }
+        Ok(ShapeArguments {
+            name,
+            nums,
+            nums_from,
+            nums_to,
+            material_at,
+            material_first,
+        })
+    }
+
+    /// Makes a negative radius positive and reports a shape that cannot be drawn, each with
+    /// a warning at the numbers concerned.
+    fn check_geometry(
+        &mut self,
+        line: &Line,
+        kind: &str,
+        args: &ShapeArguments,
+        geometry: &mut Geometry,
+    ) {
+        // The radius, where there is one, is the last number.
+        let radius_at = At::Tok(args.nums_to - 1);
+        if let Geometry::Sphere { radius, .. }
+        | Geometry::Cylinder { radius, .. }
+        | Geometry::Cone { radius, .. } = geometry
+        {
+            if *radius < 0.0 {
+                self.warn(
+                    line,
+                    radius_at,
+                    format!("negative radius {}; its absolute value is used", *radius),
+                    None,
+                );
+                *radius = limits::fixed_radius(*radius);
+            }
+        }
+        if let Some(reason) = degeneracy(geometry) {
+            let at = match geometry {
+                Geometry::Sphere { .. } | Geometry::Cylinder { .. } | Geometry::Cone { .. }
+                    if reason.contains("radius") =>
+                {
+                    radius_at
+                }
+                _ => At::Span(args.nums_from, args.nums_to - 1),
+            };
+            self.warn(
+                line,
+                at,
+                format!("{kind} `{}` {reason}; shape dropped", args.name),
+                None,
+            );
+        }
+    }
+
+    fn composite(&mut self, line: &Line, name_at: usize) -> PResult<()> {
+        let toks = &line.tokens;
+        let Some(name_tok) = toks.get(name_at) else {
+            return Err(self.error(
+                line,
+                At::End,
+                "expected the composite's name, found end of line",
+                Some(format!("canonical form: `{FORM_COMPOSITE}`")),
+            ));
+        };
+        let name = name_tok.text.to_string();
+        let mut children = Vec::new();
+        for (i, tok) in toks.iter().enumerate().skip(name_at + 1) {
+            if tok.text == name {
+                self.warn(
+                    line,
+                    At::Tok(i),
+                    format!("composite `{name}` cannot contain itself; child skipped"),
+                    None,
+                );
+                continue;
+            }
+            children.push(self.name_ref(line, i));
+        }
+        if toks.len() == name_at + 1 {
+            self.warn(
+                line,
+                At::Tok(name_at),
+                format!("composite `{name}` has no children"),
+                None,
+            );
+        }
+        self.emit_named(line, name_at, StatementKind::Composite { name, children });
+        Ok(())
+    }
+}
+
+/// How a primitive is written: how many numbers it takes and what they mean.
+struct Layout {
+    kind: &'static str,
+    numbers: usize,
+    numbers_meaning: &'static str,
+    form: &'static str,
+}
+
+impl Layout {
+    fn of(kind: &str) -> Layout {
+        let (kind, numbers, numbers_meaning, form) = match kind {
+            "sphere" => ("sphere", 4, "[center] <radius>", FORM_SPHERE),
+            "box" => ("box", 6, "[p1] [p2]", FORM_BOX),
+            "triangle" => ("triangle", 9, "[v1] [v2] [v3]", FORM_TRIANGLE),
+            "cylinder" => ("cylinder", 7, "[p1] [p2] <radius>", FORM_CYLINDER),
+            "cone" => ("cone", 7, "[base] [tip] <radius>", FORM_CONE),
+            _ => ("plane", 6, "[point] [normal]", FORM_PLANE),
+        };
+        Layout {
+            kind,
+            numbers,
+            numbers_meaning,
+            form,
+        }
+    }
+
+    fn canonical(&self) -> String {
+        let form = self.form;
+        if matches!(self.kind, "cylinder" | "cone") {
+            format!(
+                "canonical form: `{form}` (layouts such as `center height radius` or `pos axis radius height` are not read)"
+            )
+        } else {
+            format!("canonical form: `{form}`")
+        }
+    }
+}
+
+/// A primitive's line taken apart: numbers at tokens `nums_from..nums_to`, material at
+/// `material_at`.
+struct ShapeArguments {
+    name: String,
+    nums: Vec<f64>,
+    nums_from: usize,
+    nums_to: usize,
+    material_at: usize,
+    material_first: bool,
+}
+
+/// The primitive of kind `kind` from its numbers (as many as its layout takes).
+fn geometry_from(kind: &str, nums: &[f64]) -> Geometry {
+    let p = |i: usize| DVec3::new(nums[i], nums[i + 1], nums[i + 2]);
+    match kind {
+        "sphere" => Geometry::Sphere {
+            center: p(0),
+            radius: nums[3],
+        },
+        "box" => Geometry::Box { p1: p(0), p2: p(3) },
+        "triangle" => Geometry::Triangle {
+            vertices: [p(0), p(3), p(6)],
+        },
+        "cylinder" => Geometry::Cylinder {
+            p1: p(0),
+            p2: p(3),
+            radius: nums[6],
+        },
+        "cone" => Geometry::Cone {
+            base: p(0),
+            tip: p(3),
+            radius: nums[6],
+        },
+        _ => Geometry::Plane {
+            point: p(0),
+            normal: p(3),
+        },
+    }
+}
