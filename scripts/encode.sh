@@ -7,8 +7,12 @@
 # `anim render` writes them). OUTPUT defaults to animation.mp4, FPS to 24. The frames must
 # be complete and numbered consecutively from 0; odd image sizes are padded by one pixel
 # (yuv420p needs even sizes). The MP4 is written to a temporary file and moved into place,
-# so OUTPUT is never a half-written video. X264_PRESET (default veryfast) trades encoding
-# time for file size.
+# so OUTPUT is never a half-written video; it gets the permissions the umask gives a new
+# file. X264_PRESET (default veryfast) trades encoding time for file size.
+#
+# Each PNG is checked for completeness (its IEND chunk) and size, not for corrupted bytes in
+# between: `anim render DIR` verifies every image against the hash of the bytes it wrote and
+# renders a corrupted one again, so run it before encoding frames you did not just render.
 set -euo pipefail
 
 usage() {
@@ -44,6 +48,18 @@ fi
 if [ ! -d "$frames" ]; then
   echo "error: $frames is not a directory" >&2
   exit 1
+fi
+# Refused before anything is written: a name ffmpeg would read as an option, and a directory
+# (the video would otherwise end up hidden inside it).
+case $(basename -- "$output") in
+  -*)
+    echo "error: the output name '$output' starts with '-'; write ./$output" >&2
+    exit 2
+    ;;
+esac
+if [ -d "$output" ]; then
+  echo "error: $output is a directory; give the video's file name, e.g. $output/animation.mp4" >&2
+  exit 2
 fi
 
 # The frames: frame_<digits>.png. Their digit count comes from frame 0.
@@ -101,13 +117,19 @@ mkdir -p -- "$out_dir"
 tmp=$(mktemp "$out_dir/.$(basename -- "$output").XXXXXX")
 trap 'rm -f -- "$tmp"' EXIT
 
+# ffmpeg reads the input name as a pattern in which '%' is special: the folder's own '%'
+# characters are doubled so they stand for themselves.
+pattern_dir=${frames//%/%%}
+
 # pad: round width and height up to even numbers (yuv420p subsamples chroma 2x2).
 ffmpeg -hide_banner -loglevel error -nostdin -y \
-  -framerate "$fps" -start_number 0 -i "$frames/frame_%0${width}d.png" \
+  -framerate "$fps" -start_number 0 -i "$pattern_dir/frame_%0${width}d.png" \
   -frames:v "$count" \
   -vf "pad=ceil(iw/2)*2:ceil(ih/2)*2" \
   -c:v libx264 -preset "${X264_PRESET:-veryfast}" -pix_fmt yuv420p -r "$fps" -movflags +faststart \
   -f mp4 "$tmp"
+# mktemp makes the file private (0600); a video is a new file like any other.
+chmod "$(printf '%o' $((0666 & ~$(umask))))" "$tmp"
 mv -f -- "$tmp" "$output"
 trap - EXIT
 
