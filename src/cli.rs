@@ -1,5 +1,6 @@
 //! Command-line definitions (clap derive), resolved into configuration before any work starts.
 
+use crate::bench::{BenchConfig, PovMode, Preset};
 use crate::render::RenderSettings;
 use crate::sdf::{LoadOptions, MaterialField, TransformOrder};
 use clap::{Args, Parser, Subcommand, ValueEnum};
@@ -109,15 +110,74 @@ pub struct GenerateArgs {
 
 #[derive(Args, Debug, Clone)]
 pub struct BenchArgs {
-    /// Write the results as a Markdown table to this file as well as to stdout.
-    #[arg(long, value_name = "FILE")]
-    pub markdown: Option<PathBuf>,
-    /// Image width for the benchmark renders.
-    #[arg(long, default_value_t = 1920)]
-    pub width: u32,
-    /// Image height for the benchmark renders.
-    #[arg(long, default_value_t = 1080)]
-    pub height: u32,
+    /// Write bench.csv, bench.md and one time-vs-error-<scene>.png per scene here
+    /// (stress.csv and stress.md with --stress).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Small images and fewer settings (a couple of minutes on 2 cores).
+    #[arg(long)]
+    pub quick: bool,
+    /// Tiny images and the quick settings, for the test suite (overrides --quick).
+    #[arg(long, hide = true)]
+    pub tiny: bool,
+    /// Instead of time against error: render the scenes scaled by 1e-4…1e5 and moved by
+    /// 1e3…1e6 and compare each with the unchanged render.
+    #[arg(long)]
+    pub stress: bool,
+    /// The bench scenes: every .sdf file in DIR.
+    #[arg(long, value_name = "DIR", default_value = "scenes/bench")]
+    pub scenes: PathBuf,
+    /// Only this scene (file stem; repeat for several).
+    #[arg(long = "scene", value_name = "NAME")]
+    pub only: Vec<String>,
+    /// Converged reference images are cached here, keyed by scene content, size and version.
+    #[arg(long, value_name = "DIR", default_value = "target/anim-bench-cache")]
+    pub cache: PathBuf,
+    /// Folder with sdf2pov.py and povtonemap.py for POV-Ray's points.
+    #[arg(long, value_name = "DIR", default_value = "../shared/tools")]
+    pub pov_tools: PathBuf,
+    /// Leave POV-Ray out even when it is installed.
+    #[arg(long)]
+    pub no_pov: bool,
+    /// Image width (default 640; --quick 192).
+    #[arg(long, value_name = "W", value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub width: Option<u32>,
+    /// Image height (default 360; --quick 108).
+    #[arg(long, value_name = "H", value_parser = clap::value_parser!(u32).range(1..=16384))]
+    pub height: Option<u32>,
+    /// Samples per pixel of the converged anim reference.
+    #[arg(long, value_name = "N", default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1024..=65536))]
+    pub reference_spp: u32,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+}
+
+impl BenchArgs {
+    /// The benchmark's configuration; `threads` is the size of the pool it will run on.
+    pub fn config(&self, threads: usize) -> BenchConfig {
+        let preset = if self.tiny {
+            Preset::Tiny
+        } else if self.quick {
+            Preset::Quick
+        } else {
+            Preset::Full
+        };
+        let mut c = BenchConfig::preset(preset);
+        c.scenes_dir = self.scenes.clone();
+        c.only = self.only.clone();
+        c.cache_dir = self.cache.clone();
+        c.pov = if self.no_pov {
+            PovMode::Off
+        } else {
+            PovMode::Tools(self.pov_tools.clone())
+        };
+        c.width = self.width.unwrap_or(c.width);
+        c.height = self.height.unwrap_or(c.height);
+        c.reference_spp = self.reference_spp;
+        c.threads = threads;
+        c
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

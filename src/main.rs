@@ -1,4 +1,4 @@
-use anim::cli::{Cli, Command, RenderArgs};
+use anim::cli::{BenchArgs, Cli, Command, RenderArgs};
 use anim::render;
 use clap::Parser;
 use std::process::ExitCode;
@@ -12,7 +12,7 @@ fn main() -> ExitCode {
             anim::sdf::check_paths(&args.inputs, &args.scene.load_options(), args.quiet)
         }
         Command::Generate(args) => anim::anim::generate_command(&args),
-        Command::Bench(args) => anim::bench::run(&args),
+        Command::Bench(args) => with_threads(args.threads, || bench_command(&args)),
     }
 }
 
@@ -79,5 +79,42 @@ fn render_command(args: &RenderArgs) -> ExitCode {
         ExitCode::FAILURE
     } else {
         ExitCode::SUCCESS
+    }
+}
+
+/// `anim bench`: progress on stderr, the Markdown tables on stdout, files in `--out`.
+fn bench_command(args: &BenchArgs) -> ExitCode {
+    let config = args.config(rayon::current_num_threads());
+    let start = Instant::now();
+    let mut progress = |line: &str| eprintln!("{line}");
+    let result = if args.stress {
+        anim::bench::stress::run(&config, &mut progress).and_then(|report| {
+            print!("{}", anim::bench::stress::markdown(&report));
+            match &args.out {
+                Some(dir) => anim::bench::stress::write_outputs(&report, dir),
+                None => Ok(Vec::new()),
+            }
+        })
+    } else {
+        anim::bench::run(&config, &mut progress).and_then(|report| {
+            print!("{}", anim::bench::markdown(&report));
+            match &args.out {
+                Some(dir) => anim::bench::write_outputs(&report, dir),
+                None => Ok(Vec::new()),
+            }
+        })
+    };
+    match result {
+        Ok(written) => {
+            for path in written {
+                eprintln!("wrote {}", path.display());
+            }
+            eprintln!("bench took {:.1} s", start.elapsed().as_secs_f64());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
     }
 }
