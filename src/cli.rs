@@ -139,10 +139,10 @@ pub struct BenchArgs {
     /// Leave POV-Ray out even when it is installed.
     #[arg(long)]
     pub no_pov: bool,
-    /// Image width (default 640; --quick 192).
+    /// Image width (default 640; --quick 96).
     #[arg(long, value_name = "W", value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub width: Option<u32>,
-    /// Image height (default 360; --quick 108).
+    /// Image height (default 360; --quick 54).
     #[arg(long, value_name = "H", value_parser = clap::value_parser!(u32).range(1..=16384))]
     pub height: Option<u32>,
     /// Samples per pixel of the converged anim reference.
