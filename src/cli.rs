@@ -4,7 +4,7 @@ use crate::bench::{BenchConfig, PovMode, Preset};
 use crate::render::RenderSettings;
 use crate::sdf::{LoadOptions, MaterialField, TransformOrder};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -124,18 +124,20 @@ pub struct BenchArgs {
     /// 1e3…1e6 and compare each with the unchanged render.
     #[arg(long)]
     pub stress: bool,
-    /// The bench scenes: every .sdf file in DIR.
-    #[arg(long, value_name = "DIR", default_value = "scenes/bench")]
-    pub scenes: PathBuf,
+    /// The bench scenes: every .sdf file in DIR [default: scenes/bench in the repository].
+    #[arg(long, value_name = "DIR")]
+    pub scenes: Option<PathBuf>,
     /// Only this scene (file stem; repeat for several).
     #[arg(long = "scene", value_name = "NAME")]
     pub only: Vec<String>,
-    /// Converged reference images are cached here, keyed by scene content, size and version.
-    #[arg(long, value_name = "DIR", default_value = "target/anim-bench-cache")]
-    pub cache: PathBuf,
-    /// Folder with sdf2pov.py and povtonemap.py for POV-Ray's points.
-    #[arg(long, value_name = "DIR", default_value = "../shared/tools")]
-    pub pov_tools: PathBuf,
+    /// Converged reference images are cached here, keyed by scene content, size and version
+    /// [default: target/anim-bench-cache in the repository].
+    #[arg(long, value_name = "DIR")]
+    pub cache: Option<PathBuf>,
+    /// Folder with sdf2pov.py and povtonemap.py for POV-Ray's points
+    /// [default: ../shared/tools from the repository].
+    #[arg(long, value_name = "DIR")]
+    pub pov_tools: Option<PathBuf>,
     /// Leave POV-Ray out even when it is installed.
     #[arg(long)]
     pub no_pov: bool,
@@ -153,6 +155,19 @@ pub struct BenchArgs {
     pub threads: Option<u32>,
 }
 
+/// The nearest folder from the current one up that holds `.git` (a folder, or a file in a
+/// worktree); the current folder (as `.`) outside a repository.
+fn repository_root() -> PathBuf {
+    std::env::current_dir()
+        .ok()
+        .and_then(|cwd| {
+            cwd.ancestors()
+                .find(|d| d.join(".git").exists())
+                .map(Path::to_path_buf)
+        })
+        .unwrap_or_else(|| PathBuf::from("."))
+}
+
 impl BenchArgs {
     /// The benchmark's configuration; `threads` is the size of the pool it will run on.
     pub fn config(&self, threads: usize) -> BenchConfig {
@@ -164,13 +179,20 @@ impl BenchArgs {
             Preset::Full
         };
         let mut c = BenchConfig::preset(preset);
-        c.scenes_dir = self.scenes.clone();
+        // The defaults are paths in the repository, wherever in it the command runs.
+        let root = repository_root();
+        let or_default = |given: &Option<PathBuf>, default: &Path| {
+            given.clone().unwrap_or_else(|| root.join(default))
+        };
+        c.scenes_dir = or_default(&self.scenes, &c.scenes_dir);
+        c.cache_dir = or_default(&self.cache, &c.cache_dir);
         c.only = self.only.clone();
-        c.cache_dir = self.cache.clone();
-        c.pov = if self.no_pov {
-            PovMode::Off
-        } else {
-            PovMode::Tools(self.pov_tools.clone())
+        c.pov = match (&c.pov, self.no_pov) {
+            (_, true) => PovMode::Off,
+            (PovMode::Tools(default), false) => {
+                PovMode::Tools(or_default(&self.pov_tools, default))
+            }
+            (PovMode::Off, false) => PovMode::Off,
         };
         c.width = self.width.unwrap_or(c.width);
         c.height = self.height.unwrap_or(c.height);
