@@ -4,13 +4,18 @@
 # channel passes, tone-mapped with c/(c+1)), and the showcase's geometry as object-ID masks
 # (exact). The POV tools know neither `plane` nor `background`, so the copies compared here
 # replace the plane with a large slab and drop the background line.
-# Needs povray and python3; exits 0 with a note when either is missing.
+# Needs povray and python3; without them it says "skipped" and exits 0, except under CI
+# (CI set), where a missing tool is a failure: CI installs them.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 tools=${POV_TOOLS:-$root/../shared/tools}
 anim=${ANIM:-$root/target/release/anim}
 if ! command -v povray >/dev/null || ! command -v python3 >/dev/null || [ ! -d "$tools" ]; then
-  echo "compare-pov: povray, python3 or $tools missing; skipped"
+  if [ -n "${CI:-}" ]; then
+    echo "compare-pov: povray, python3 or $tools missing, and CI is set: failing" >&2
+    exit 1
+  fi
+  echo "compare-pov: skipped: povray, python3 or $tools missing"
   exit 0
 fi
 [ -x "$anim" ] || cargo build --release --quiet --manifest-path "$root/Cargo.toml"

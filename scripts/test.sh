@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# The test command (README "Run the tests"): every cargo test, the comparison with POV-Ray,
-# then the real Slurm run.
+# The test command (README "Run the tests"): formatting and lints, every cargo test, the
+# comparison with POV-Ray, then the real Slurm run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+cargo fmt --all -- --check
+cargo clippy --all-targets --quiet -- -D warnings
 cargo test --all-targets
 cargo build --release --quiet
 scripts/compare-pov.sh

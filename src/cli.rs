@@ -1,6 +1,9 @@
 //! Command-line definitions (clap derive), resolved into configuration before any work starts.
 
+use crate::app::{CheckConfig, RenderConfig};
 use crate::bench::{BenchConfig, PovMode, Preset};
+use crate::limits;
+use crate::pipeline::{FrameOptions, Shard};
 use crate::render::RenderSettings;
 use crate::sdf::{LoadOptions, MaterialField, TransformOrder};
 use clap::{Args, Parser, Subcommand, ValueEnum};
@@ -54,23 +57,31 @@ pub struct RenderArgs {
     pub out: Option<PathBuf>,
     /// Samples per pixel (k² gives a k×k stratified grid; 1 = one ray through the pixel
     /// centre). Overrides the render statement's own count. Default 4.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    #[arg(long, value_name = "N", value_parser = parse_samples)]
     pub spp: Option<u32>,
     /// Worker threads (default: one per core). The output does not depend on it.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
     /// Override every render statement's image width.
-    #[arg(long, value_name = "W", value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, value_name = "W", value_parser = parse_image_side)]
     pub width: Option<u32>,
     /// Override every render statement's image height.
-    #[arg(long, value_name = "H", value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, value_name = "H", value_parser = parse_image_side)]
     pub height: Option<u32>,
-    /// Maximum depth of reflected and refracted rays.
-    #[arg(long, value_name = "N", default_value_t = 8)]
+    /// Maximum depth of reflected and refracted rays (at most 10000).
+    #[arg(long, value_name = "N", default_value_t = limits::DEFAULT_MAX_DEPTH, value_parser = parse_max_depth)]
     pub max_depth: u32,
     /// Write .ppm files as ASCII (P3) instead of binary (P6).
     #[arg(long)]
     pub ppm_ascii: bool,
+    /// Write images where render lines say even outside the scene's folder (or --out):
+    /// absolute paths and paths climbing out with `..`.
+    #[arg(long)]
+    pub allow_any_output: bool,
+    /// Memory one image may take while it is made, e.g. 512M or 8G (default: half the
+    /// machine's memory). Bigger images are refused before anything is allocated.
+    #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
+    pub max_memory: Option<u64>,
     /// Render frames even if their input and settings are unchanged since the last run.
     #[arg(long)]
     pub force: bool,
@@ -142,13 +153,13 @@ pub struct BenchArgs {
     #[arg(long)]
     pub no_pov: bool,
     /// Image width (default 640; --quick 96).
-    #[arg(long, value_name = "W", value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_name = "W", value_parser = parse_image_side)]
     pub width: Option<u32>,
     /// Image height (default 360; --quick 54).
-    #[arg(long, value_name = "H", value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_name = "H", value_parser = parse_image_side)]
     pub height: Option<u32>,
     /// Samples per pixel of the converged anim reference.
-    #[arg(long, value_name = "N", default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1024..=65536))]
+    #[arg(long, value_name = "N", default_value_t = 1024, value_parser = parse_reference_samples)]
     pub reference_spp: u32,
     /// Worker threads (default: one per core).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
@@ -208,36 +219,6 @@ pub enum TransformOrderArg {
     Local,
 }
 
-/// One shard of an animation: K of N, K counting from 1 (as Slurm array task ids do).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Shard {
-    pub index: u32,
-    pub count: u32,
-}
-
-impl Shard {
-    /// Whether frame `i` (counting from 0) belongs to this shard.
-    pub fn contains(&self, i: usize) -> bool {
-        i % self.count as usize == (self.index - 1) as usize
-    }
-}
-
-fn parse_shard(s: &str) -> Result<Shard, String> {
-    let (k, n) = s.split_once('/').ok_or("expected K/N, e.g. 2/3")?;
-    let index: u32 = k
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{k}' is not a whole number"))?;
-    let count: u32 = n
-        .trim()
-        .parse()
-        .map_err(|_| format!("'{n}' is not a whole number"))?;
-    if count == 0 || index == 0 || index > count {
-        return Err(format!("K must be between 1 and N (got {index}/{count})"));
-    }
-    Ok(Shard { index, count })
-}
-
 pub fn parse_material_fields(s: &str) -> Result<MaterialField, String> {
     match s.trim() {
         "reflectivity" => Ok(MaterialField::Reflectivity),
@@ -251,7 +232,76 @@ pub fn parse_material_fields(s: &str) -> Result<MaterialField, String> {
     }
 }
 
+fn parse_shard(s: &str) -> Result<Shard, String> {
+    s.parse()
+}
+
+/// A whole number within `range` (one of the value rules of `limits`).
+fn whole_in(s: &str, range: std::ops::RangeInclusive<u32>) -> Result<u32, String> {
+    let n: u32 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{s}' is not a whole number"))?;
+    if range.contains(&n) {
+        Ok(n)
+    } else {
+        Err(format!("{n} is not in {}..={}", range.start(), range.end()))
+    }
+}
+
+fn parse_samples(s: &str) -> Result<u32, String> {
+    whole_in(s, limits::SAMPLES)
+}
+
+/// A converged reference takes at least 1024 samples, and no more than any render may.
+fn parse_reference_samples(s: &str) -> Result<u32, String> {
+    whole_in(s, 1024..=*limits::SAMPLES.end())
+}
+
+fn parse_image_side(s: &str) -> Result<u32, String> {
+    whole_in(s, limits::IMAGE_SIDE)
+}
+
+fn parse_max_depth(s: &str) -> Result<u32, String> {
+    whole_in(s, 0..=limits::MAX_DEPTH)
+}
+
+/// A byte count with an optional binary suffix: `4096`, `512K`, `512M`, `8G` (also `8GiB`).
+fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let digits = t.find(|c: char| !c.is_ascii_digit()).unwrap_or(t.len());
+    let (number, unit) = t.split_at(digits);
+    let n: u64 = number
+        .parse()
+        .map_err(|_| format!("'{s}' is not a size such as 512M or 8G"))?;
+    let shift = match unit.trim().to_ascii_uppercase().as_str() {
+        "" | "B" => 0,
+        "K" | "KB" | "KIB" => 10,
+        "M" | "MB" | "MIB" => 20,
+        "G" | "GB" | "GIB" => 30,
+        "T" | "TB" | "TIB" => 40,
+        _ => return Err(format!("'{s}' is not a size such as 512M or 8G")),
+    };
+    n.checked_mul(1 << shift)
+        .filter(|&b| b > 0)
+        .ok_or_else(|| format!("'{s}' is not a size between 1 byte and 16 EiB"))
+}
+
 impl RenderArgs {
+    /// What the command line asks `anim render` to do.
+    pub fn config(&self) -> RenderConfig {
+        RenderConfig {
+            inputs: self.inputs.clone(),
+            settings: self.settings(),
+            load: self.scene.load_options(),
+            frames: FrameOptions {
+                force: self.force,
+                shard: self.shard,
+            },
+            quiet: self.quiet,
+        }
+    }
+
     /// The settings that decide what the images look like and where they go.
     pub fn settings(&self) -> RenderSettings {
         RenderSettings {
@@ -261,6 +311,21 @@ impl RenderArgs {
             max_depth: self.max_depth,
             ppm_ascii: self.ppm_ascii,
             out_dir: self.out.clone(),
+            allow_any_output: self.allow_any_output,
+            max_memory: self
+                .max_memory
+                .unwrap_or_else(limits::default_memory_budget),
+        }
+    }
+}
+
+impl CheckArgs {
+    /// What the command line asks `anim check` to do.
+    pub fn config(&self) -> CheckConfig {
+        CheckConfig {
+            inputs: self.inputs.clone(),
+            load: self.scene.load_options(),
+            quiet: self.quiet,
         }
     }
 }
@@ -275,23 +340,5 @@ impl SceneArgs {
                 TransformOrderArg::Local => TransformOrder::Local,
             },
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn shards_partition_the_frames() {
-        let shards: Vec<Shard> = (1..=3)
-            .map(|k| parse_shard(&format!("{k}/3")).unwrap())
-            .collect();
-        for i in 0..10 {
-            assert_eq!(shards.iter().filter(|s| s.contains(i)).count(), 1);
-        }
-        assert!(parse_shard("0/3").is_err());
-        assert!(parse_shard("4/3").is_err());
-        assert!(parse_shard("1/0").is_err());
     }
 }

@@ -8,6 +8,7 @@
 
 pub mod accel;
 pub mod anim;
+pub mod app;
 pub mod bench;
 pub mod cli;
 pub mod diag;
@@ -18,3 +19,4 @@ pub mod render;
 pub mod scene;
 pub mod sdf;
 pub mod shape;
+pub mod util;

@@ -28,6 +28,32 @@ pub const FPS: RangeInclusive<u32> = 1..=1000;
 /// The default reflection/refraction depth (`--max-depth`).
 pub const DEFAULT_MAX_DEPTH: u32 = 8;
 
+/// The deepest `--max-depth` accepted. Each level is a stack frame of the integrator; the
+/// render threads get a stack big enough for this many (see [`RENDER_STACK_BYTES`]).
+pub const MAX_DEPTH: u32 = 10_000;
+
+/// Stack size of the render threads: about 1 KiB per recursion level at most, with room to
+/// spare (measured: depth 10 000 in a closed box of mirrors; the pages are only touched when
+/// the recursion is that deep).
+pub const RENDER_STACK_BYTES: usize = 64 << 20;
+
+/// Bytes an image costs per pixel while it is made: linear radiance (3 × f32), 8-bit RGB, and
+/// the encoded file (at most about as large again).
+pub const IMAGE_BYTES_PER_PIXEL: u64 = 12 + 3 + 3 + 6;
+
+/// The memory an image may take when neither `--max-memory` nor the machine says: 4 GiB.
+const FALLBACK_MEMORY_BUDGET: u64 = 4 << 30;
+
+/// The default memory budget: half the machine's memory, leaving the rest to everything else.
+pub fn default_memory_budget() -> u64 {
+    crate::util::physical_memory().map_or(FALLBACK_MEMORY_BUDGET, |m| m / 2)
+}
+
+/// Bytes needed to make a `width × height` image.
+pub fn image_memory(width: u32, height: u32) -> u64 {
+    u64::from(width) * u64::from(height) * IMAGE_BYTES_PER_PIXEL
+}
+
 /// The field-of-view rule in words, for messages.
 pub const FOV_RULE: &str = "between 0 and 180 degrees";
 

@@ -1,12 +1,12 @@
 //! Every real-world scene file of `../shared/corpus/wild` either loads or is rejected with
 //! located errors, and none makes the reader panic.
 
+mod common;
+
 use anim::diag::Diagnostic;
 use anim::sdf::{load_file, LoadOptions};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
-
-const CORPUS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/corpus/wild");
 
 fn files_below(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else {
@@ -29,11 +29,11 @@ fn is_io_problem(d: &Diagnostic) -> bool {
 
 #[test]
 fn every_corpus_file_loads_or_is_rejected_with_located_errors() {
-    let dir = Path::new(CORPUS);
-    if !dir.is_dir() {
-        println!("note: {CORPUS} not found; corpus test skipped");
+    let Some(shared) = common::shared_dir("corpus") else {
         return;
-    }
+    };
+    let corpus = shared.join("corpus/wild");
+    let dir = corpus.as_path();
     let mut files = Vec::new();
     files_below(dir, &mut files);
     files.sort();
@@ -81,11 +81,11 @@ fn every_corpus_file_loads_or_is_rejected_with_located_errors() {
 /// the animation generator does) loads to the same render jobs.
 #[test]
 fn canonical_text_of_corpus_files_loads_to_the_same_jobs() {
-    let dir = Path::new(CORPUS);
-    if !dir.is_dir() {
-        println!("note: {CORPUS} not found; corpus test skipped");
+    let Some(shared) = common::shared_dir("corpus") else {
         return;
-    }
+    };
+    let corpus = shared.join("corpus/wild");
+    let dir = corpus.as_path();
     let mut files = Vec::new();
     files_below(dir, &mut files);
     files.sort();

@@ -2,6 +2,8 @@
 //! scenes/, animations/ and the shared corpus that loads is rendered small, and its HDR
 //! buffer (before tone mapping could hide a NaN as 0) is checked.
 
+mod common;
+
 use anim::render::{render_job, RenderSettings};
 use anim::sdf::{load_file, LoadOptions};
 use std::path::{Path, PathBuf};
@@ -26,14 +28,8 @@ fn every_loadable_scene_renders_finite_pixels() {
     let mut files = Vec::new();
     scene_files(&root.join("scenes"), &mut files);
     scene_files(&root.join("animations"), &mut files);
-    let corpus = root.join("../shared/corpus/wild");
-    if corpus.is_dir() {
-        scene_files(&corpus, &mut files);
-    } else {
-        eprintln!(
-            "note: {} is missing; checking the project's own scenes only",
-            corpus.display()
-        );
+    if let Some(shared) = common::shared_dir("finite pixels (corpus part)") {
+        scene_files(&shared.join("corpus/wild"), &mut files);
     }
     files.sort();
     let settings = RenderSettings {

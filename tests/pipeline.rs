@@ -1,7 +1,8 @@
 //! The frame pipeline: `anim generate` → `anim render DIR` → `scripts/encode.sh`, with skipping
 //! of unchanged frames, resuming, shards and failures.
 
-use anim::cli::{Cli, Command as Sub, RenderArgs};
+use anim::app::RenderConfig;
+use anim::cli::{Cli, Command as Sub};
 use anim::pipeline::{self, record_path, Summary};
 use assert_cmd::Command;
 use clap::Parser;
@@ -33,7 +34,7 @@ fn frames(n: usize) -> tempfile::TempDir {
     dir
 }
 
-fn args(dir: &Path, extra: &[&str]) -> RenderArgs {
+fn args(dir: &Path, extra: &[&str]) -> RenderConfig {
     let mut argv: Vec<String> = vec![
         "anim".into(),
         "render".into(),
@@ -42,13 +43,24 @@ fn args(dir: &Path, extra: &[&str]) -> RenderArgs {
     ];
     argv.extend(extra.iter().map(|s| s.to_string()));
     match Cli::try_parse_from(argv).expect("arguments").command {
-        Sub::Render(a) => a,
+        Sub::Render(a) => a.config(),
         _ => unreachable!("a render command"),
     }
 }
 
+/// Renders a frame directory through the library, as `anim render DIR` does.
+fn run(dir: &Path, config: &RenderConfig) -> Result<Summary, Vec<anim::diag::Diagnostic>> {
+    pipeline::render_dir(
+        dir,
+        &config.settings,
+        &config.load,
+        &config.frames,
+        &pipeline::NoProgress,
+    )
+}
+
 fn render(dir: &Path, extra: &[&str]) -> Summary {
-    pipeline::run(dir, &args(dir, extra)).expect("the directory renders")
+    run(dir, &args(dir, extra)).expect("the directory renders")
 }
 
 #[test]
@@ -208,8 +220,8 @@ fn a_failing_frame_does_not_stop_the_others() {
 #[test]
 fn an_empty_directory_is_an_error() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let e = pipeline::run(dir.path(), &args(dir.path(), &[])).expect_err("no frames");
-    assert!(e.to_string().contains("no .sdf files"), "{e}");
+    let e = run(dir.path(), &args(dir.path(), &[])).expect_err("no frames");
+    assert!(e[0].to_string().contains("no .sdf files"), "{}", e[0]);
 }
 
 // ---------------------------------------------------------------------------------------------

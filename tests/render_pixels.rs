@@ -1,4 +1,4 @@
-//! Image tests: pixels compared with values derived here from SPEC.md's formulas, and
+//! Image tests: pixels compared with values derived here from the formulas of docs/shading.md, and
 //! transform equivalences, all through the real binary.
 
 mod common;

@@ -12,8 +12,8 @@ pub mod spec;
 
 use crate::cli::GenerateArgs;
 use crate::diag::{Diagnostic, Loc};
-use crate::render::film::write_atomically;
 use crate::sdf::LoadOptions;
+use crate::util::write_atomically;
 use generate::{BaseScene, Generator};
 use spec::{Animation, SceneSource, Source};
 use std::io::Write as _;

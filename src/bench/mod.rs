@@ -336,7 +336,7 @@ pub fn render_measured(job: &RenderJob, settings: &RenderSettings) -> Result<Tim
 
 /// Writes 8-bit RGB as binary PPM (the cache's format: no encoder, exact bytes).
 fn write_ppm(path: &Path, rgb: &[u8], width: u32, height: u32) -> Result<(), String> {
-    film::write_atomically(path, |w| {
+    crate::util::write_atomically(path, |w| {
         use std::io::Write;
         write!(w, "P6\n{width} {height}\n255\n")?;
         w.write_all(rgb)

@@ -4,7 +4,6 @@
 
 use super::report::series;
 use super::{Renderer, Row};
-use crate::render::film;
 use plotters::prelude::*;
 use std::path::Path;
 use std::sync::OnceLock;
@@ -106,7 +105,7 @@ pub fn time_vs_error(path: &Path, scene: &str, rows: &[&Row]) -> Result<(), Stri
     let mut png = std::io::Cursor::new(Vec::new());
     rgb.write_to(&mut png, image::ImageFormat::Png)
         .map_err(|e| format!("cannot encode {}: {e}", path.display()))?;
-    film::write_atomically(path, |w| std::io::Write::write_all(w, png.get_ref()))
+    crate::util::write_atomically(path, |w| std::io::Write::write_all(w, png.get_ref()))
         .map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 

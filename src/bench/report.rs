@@ -2,7 +2,6 @@
 //! tables) and one time-against-error plot per scene.
 
 use super::{plot, BenchReport, Renderer, Row};
-use crate::render::film;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -137,7 +136,7 @@ pub fn write_outputs(report: &BenchReport, dir: &Path) -> Result<Vec<PathBuf>, S
 }
 
 pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), String> {
-    film::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes()))
+    crate::util::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes()))
         .map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 

@@ -2,11 +2,11 @@
 //! atomic writes (a reader never sees a half-written image).
 
 use super::HdrImage;
-use std::fs;
-use std::io::{self, BufWriter, Write};
+
+use std::io::{self, Write};
 use std::path::Path;
 
-/// SPEC.md §1.5: `c_ldr = c_hdr / (c_hdr + 1)`, stored as `round(255·c_ldr)`. Negative or
+/// docs/shading.md §4: `c_ldr = c_hdr / (c_hdr + 1)`, stored as `round(255·c_ldr)`. Negative or
 /// non-finite input (which the renderer never produces) maps to 0 rather than wrapping.
 #[inline]
 pub fn tone_map_u8(c: f32) -> u8 {
@@ -39,6 +39,9 @@ impl ImageFormat {
     /// The format for a file name, by its extension (case-insensitive).
     pub fn for_path(path: &Path, ppm_ascii: bool) -> Option<ImageFormat> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        if !crate::limits::is_image_extension(&ext) {
+            return None;
+        }
         match ext.as_str() {
             "png" => Some(ImageFormat::Png),
             "ppm" if ppm_ascii => Some(ImageFormat::PpmAscii),
@@ -49,9 +52,6 @@ impl ImageFormat {
         }
     }
 }
-
-/// Extensions users may write, for error messages.
-pub const KNOWN_EXTENSIONS: &str = ".png, .ppm, .pgm, .pnm, .bmp, .jpg, .tga";
 
 fn encode(
     out: &mut impl Write,
@@ -95,42 +95,24 @@ fn encode(
     }
 }
 
-/// Writes `contents` to `path` through a temporary file in the same directory and a rename,
-/// so that `path` either keeps its old contents or has the complete new ones.
-pub fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&mut BufWriter<fs::File>) -> io::Result<()>,
-) -> io::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    fs::create_dir_all(dir)?;
-    let name = path
-        .file_name()
-        .ok_or_else(|| io::Error::other("output path has no file name"))?;
-    let tmp = dir.join(format!(
-        ".{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| {
-        let mut w = BufWriter::new(fs::File::create(&tmp)?);
-        write(&mut w)?;
-        // No fsync: the rename already guarantees that an interrupted process never leaves a
-        // partial image under the final name, and syncing every frame costs ~0.1 s each.
-        w.into_inner().map_err(|e| e.into_error())?;
-        fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result
+/// What was written to an image file: its length and a fingerprint of its exact bytes, so
+/// that a later run can tell the file is still the one this run wrote.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ImageBytes {
+    pub len: u64,
+    pub hash: u64,
 }
 
-pub fn write_image(path: &Path, img: &HdrImage, format: ImageFormat) -> io::Result<()> {
+/// Encodes `img` and writes it to `path` atomically.
+pub fn write_image(path: &Path, img: &HdrImage, format: ImageFormat) -> io::Result<ImageBytes> {
     let rgb = to_rgb8(img);
-    write_atomically(path, |w| encode(w, &rgb, img.width, img.height, format))
+    let mut encoded = Vec::new();
+    encode(&mut encoded, &rgb, img.width, img.height, format)?;
+    crate::util::write_atomically(path, |w| w.write_all(&encoded))?;
+    Ok(ImageBytes {
+        len: encoded.len() as u64,
+        hash: crate::util::Fnv64::of(&encoded),
+    })
 }
 
 #[cfg(test)]
@@ -175,10 +157,12 @@ mod tests {
             height: 1,
             pixels: vec![Vec3::new(1.0, 0.0, 3.0), Vec3::ZERO],
         };
-        write_image(&path, &img, ImageFormat::PpmBinary).unwrap();
-        let bytes = fs::read(&path).unwrap();
+        let written = write_image(&path, &img, ImageFormat::PpmBinary).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        assert_eq!(written.len, bytes.len() as u64);
+        assert_eq!(written.hash, crate::util::Fnv64::of(&bytes));
         assert_eq!(&bytes[..11], b"P6\n2 1\n255\n");
         assert_eq!(&bytes[11..], &[128, 0, 191, 0, 0, 0]);
-        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 }

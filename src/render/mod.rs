@@ -6,20 +6,13 @@ pub mod film;
 pub mod integrator;
 pub mod primitive;
 
-use crate::diag::{Diagnostic, Severity};
 use crate::scene::RenderJob;
-use crate::sdf::LoadOptions;
 use camera::{sample_offsets, CameraError, CameraRays};
 use compile::RenderScene;
-use film::ImageFormat;
 use glam::{Vec3, Vec3A};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use integrator::Integrator;
 use rayon::prelude::*;
-use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
+use std::path::PathBuf;
 
 /// Tile edge in pixels: small enough to balance two to many cores, big enough that the
 /// per-tile overhead (one allocation, one progress update) vanishes.
@@ -38,6 +31,11 @@ pub struct RenderSettings {
     pub ppm_ascii: bool,
     /// Images go here instead of beside the scene file.
     pub out_dir: Option<PathBuf>,
+    /// Honour render lines that write outside the output folder (absolute paths, `..`).
+    pub allow_any_output: bool,
+    /// Bytes one image may take while it is made; bigger images are refused before any
+    /// allocation.
+    pub max_memory: u64,
 }
 
 impl Default for RenderSettings {
@@ -46,9 +44,11 @@ impl Default for RenderSettings {
             spp: None,
             width: None,
             height: None,
-            max_depth: 8,
+            max_depth: crate::limits::DEFAULT_MAX_DEPTH,
             ppm_ascii: false,
             out_dir: None,
+            allow_any_output: false,
+            max_memory: crate::limits::default_memory_budget(),
         }
     }
 }
@@ -74,14 +74,6 @@ pub struct HdrImage {
     pub width: u32,
     pub height: u32,
     pub pixels: Vec<Vec3>,
-}
-
-/// What rendering one scene file produced.
-#[derive(Clone, Debug)]
-pub struct FileOutcome {
-    pub outputs: Vec<PathBuf>,
-    pub warnings: Vec<Diagnostic>,
-    pub rays: RayCounts,
 }
 
 impl std::ops::AddAssign for RayCounts {
@@ -175,177 +167,6 @@ pub fn render_job(
         rays: counts,
         dropped,
     })
-}
-
-/// Where a job's image goes: relative paths are taken against `--out` or the scene's folder.
-pub fn output_path(scene_file: &Path, job: &RenderJob, settings: &RenderSettings) -> PathBuf {
-    let base = settings.out_dir.clone().unwrap_or_else(|| {
-        scene_file
-            .parent()
-            .map(Path::to_path_buf)
-            .unwrap_or_default()
-    });
-    base.join(&job.output)
-}
-
-fn job_error(path: &Path, job: &RenderJob, message: String) -> Diagnostic {
-    match &job.loc {
-        Some(loc) => Diagnostic::new(Severity::Error, loc.clone(), message),
-        None => Diagnostic::file_error(path, message),
-    }
-}
-
-/// A progress bar on stderr that appears only once a render has run for about a second, and
-/// never when stderr is not a terminal.
-struct LazyProgress {
-    bar: Option<ProgressBar>,
-    start: Instant,
-    shown: AtomicBool,
-}
-
-impl LazyProgress {
-    fn new(enabled: bool, total: u64) -> Self {
-        let bar = (enabled && std::io::stderr().is_terminal()).then(|| {
-            let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden());
-            if let Ok(style) =
-                ProgressStyle::with_template("{spinner} {msg} [{bar:30}] {percent:>3}% ETA {eta}")
-            {
-                bar.set_style(style.progress_chars("=> "));
-            }
-            bar
-        });
-        LazyProgress {
-            bar,
-            start: Instant::now(),
-            shown: AtomicBool::new(false),
-        }
-    }
-
-    fn advance(&self, n: u64) {
-        if let Some(bar) = &self.bar {
-            bar.inc(n);
-            if self.start.elapsed() > Duration::from_secs(1)
-                && !self.shown.swap(true, Ordering::Relaxed)
-            {
-                bar.set_draw_target(ProgressDrawTarget::stderr());
-            }
-        }
-    }
-
-    fn set_message(&self, msg: String) {
-        if let Some(bar) = &self.bar {
-            bar.set_message(msg);
-        }
-    }
-
-    fn finish(&self) {
-        if let Some(bar) = &self.bar {
-            bar.finish_and_clear();
-        }
-    }
-}
-
-/// Loads a scene file, renders every image it asks for and writes them atomically.
-/// `show_progress`: draw a progress bar on a terminal for renders longer than about a second.
-pub fn render_file(
-    path: &Path,
-    load: &LoadOptions,
-    settings: &RenderSettings,
-    show_progress: bool,
-) -> Result<FileOutcome, Vec<Diagnostic>> {
-    let loaded = crate::sdf::load_file(path, load)?;
-    let mut warnings = loaded.diagnostics;
-    // Resolve every output before rendering anything, so a bad name fails fast.
-    let mut targets = Vec::with_capacity(loaded.jobs.len());
-    let mut errors = Vec::new();
-    for job in &loaded.jobs {
-        let out = output_path(path, job, settings);
-        match ImageFormat::for_path(&out, settings.ppm_ascii) {
-            Some(format) => targets.push((out, format)),
-            None => errors.push(
-                job_error(
-                    path,
-                    job,
-                    format!("cannot tell the image format of '{}'", job.output.display()),
-                )
-                .with_help(format!(
-                    "end the file name with one of {}",
-                    film::KNOWN_EXTENSIONS
-                )),
-            ),
-        }
-    }
-    if !errors.is_empty() {
-        warnings.extend(errors);
-        return Err(warnings);
-    }
-    let total: u64 = loaded
-        .jobs
-        .iter()
-        .map(|j| {
-            let (w, h, _) = settings.resolve(j);
-            w as u64 * h as u64
-        })
-        .sum();
-    let progress = LazyProgress::new(show_progress, total);
-    let mut outcome = FileOutcome {
-        outputs: Vec::new(),
-        warnings: Vec::new(),
-        rays: RayCounts::default(),
-    };
-    for (job, (out, format)) in loaded.jobs.iter().zip(targets) {
-        progress.set_message(
-            out.file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default(),
-        );
-        let Rendered {
-            image,
-            rays: counts,
-            dropped,
-        } = match render_job(job, settings, &|n| progress.advance(n)) {
-            Ok(r) => r,
-            Err(e) => {
-                progress.finish();
-                let what = match e {
-                    CameraError::Fov => format!(
-                        "camera '{}' has a field of view of {}°; it must be between 0 and 180",
-                        job.camera.name, job.camera.fov_x_deg
-                    ),
-                    CameraError::Orientation => format!(
-                        "camera '{}' has no usable orientation: its direction is zero or parallel to its up vector",
-                        job.camera.name
-                    ),
-                };
-                warnings.push(job_error(path, job, what));
-                return Err(warnings);
-            }
-        };
-        for d in dropped {
-            let message = format!(
-                "shape '{}' is degenerate once transformed (too thin or too small to intersect) and is not drawn",
-                d.instance
-            );
-            warnings.push(match d.loc {
-                Some(loc) => Diagnostic::new(Severity::Warning, loc, message),
-                None => job_error(path, job, message).with_severity(Severity::Warning),
-            });
-        }
-        if let Err(e) = film::write_image(&out, &image, format) {
-            progress.finish();
-            warnings.push(job_error(
-                path,
-                job,
-                format!("cannot write '{}': {e}", out.display()),
-            ));
-            return Err(warnings);
-        }
-        outcome.rays += counts;
-        outcome.outputs.push(out);
-    }
-    progress.finish();
-    outcome.warnings = warnings;
-    Ok(outcome)
 }
 
 #[cfg(test)]

@@ -1,0 +1,41 @@
+//! The command layer: the only code that prints, builds the thread pool and chooses the exit
+//! code. Each command gets a plain configuration (made from the command line by `cli`) and
+//! calls the library, which returns values and diagnostics.
+
+mod check;
+mod progress;
+mod render;
+
+pub use check::CheckConfig;
+pub use render::RenderConfig;
+
+use crate::limits;
+use std::process::ExitCode;
+
+/// A command with its configuration.
+#[derive(Clone, Debug)]
+pub enum Command {
+    Render(RenderConfig),
+    Check(CheckConfig),
+}
+
+/// Runs `command` on a rayon pool of `threads` workers (default: one per core), the one pool
+/// of the process: tiles of a frame and frames of a directory share it.
+pub fn run(command: Command, threads: Option<u32>) -> ExitCode {
+    // Deep mirror recursion (up to limits::MAX_DEPTH) runs on these threads.
+    let mut builder = rayon::ThreadPoolBuilder::new().stack_size(limits::RENDER_STACK_BYTES);
+    if let Some(n) = threads {
+        builder = builder.num_threads(n as usize);
+    }
+    let pool = match builder.build() {
+        Ok(pool) => pool,
+        Err(e) => {
+            eprintln!("error: cannot start worker threads: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    pool.install(|| match &command {
+        Command::Render(config) => render::run(config),
+        Command::Check(config) => check::run(config),
+    })
+}

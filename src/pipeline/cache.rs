@@ -1,0 +1,238 @@
+//! Render records: what lets `anim render DIR` skip a frame whose images are already right.
+//!
+//! After a frame's images are written (atomically), a small record
+//! `.anim-cache/<frame>.sdf.hash` is written (atomically too) beside them, holding a hash of the
+//! frame's SDF bytes, every setting that changes pixels and anim's version, and the length and a
+//! hash of the exact bytes this process wrote to each image (taken as they were written, not
+//! read back, so a concurrent writer cannot slip its image under this record). A frame is
+//! skipped only when its record matches and its images still hold exactly those bytes.
+//!
+//! The record is removed before a frame is rendered again and written only after its images
+//! are complete, so an interrupted run never leaves a record for an image that is not
+//! finished: the next run renders that frame again.
+
+use super::scene_file::Output;
+use crate::render::RenderSettings;
+use crate::sdf::LoadOptions;
+use crate::util::{write_atomically, Fnv64};
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Directory of render records, beside the images.
+pub const CACHE_DIR: &str = ".anim-cache";
+
+/// Bumped when the record format or the meaning of the hash changes.
+const RECORD_VERSION: u32 = 2;
+
+/// Where the render record of frame file `sdf_name` is kept, for images in `out_dir`.
+pub fn record_path(out_dir: &Path, sdf_name: &str) -> PathBuf {
+    out_dir.join(CACHE_DIR).join(format!("{sdf_name}.hash"))
+}
+
+/// Every setting that can change a frame's pixels (or whether it renders at all), as text.
+/// It is the whole of both settings structs, so a setting added to either is part of the key
+/// without anyone having to remember to list it here.
+pub fn settings_fingerprint(settings: &RenderSettings, load: &LoadOptions) -> String {
+    format!(
+        "record={RECORD_VERSION};anim={};{settings:?};{load:?}",
+        env!("CARGO_PKG_VERSION")
+    )
+}
+
+pub(super) fn frame_hash(sdf: &[u8], fingerprint: &str) -> u64 {
+    let mut h = Fnv64::default();
+    h.write(fingerprint.as_bytes());
+    // A separator that cannot occur in the fingerprint keeps the two parts apart.
+    h.write(&[0]);
+    h.write(sdf);
+    h.finish()
+}
+
+/// The record's text: a header, the hash, and each image with its length and byte hash.
+fn record_text(hash: u64, out_dir: &Path, outputs: &[Output]) -> String {
+    let mut text = format!("anim-render-record {RECORD_VERSION}\nhash {hash:016x}\n");
+    for out in outputs {
+        let rel = out.path.strip_prefix(out_dir).unwrap_or(&out.path);
+        text.push_str(&format!(
+            "image {} {:016x} {}\n",
+            out.bytes.len,
+            out.bytes.hash,
+            rel.display()
+        ));
+    }
+    text
+}
+
+pub(super) fn write_record(
+    record: &Path,
+    out_dir: &Path,
+    hash: u64,
+    outputs: &[Output],
+) -> std::io::Result<()> {
+    if let Some(parent) = record.parent() {
+        std::fs::create_dir_all(parent)?;
+    }
+    let text = record_text(hash, out_dir, outputs);
+    write_atomically(record, |w| w.write_all(text.as_bytes()))
+}
+
+/// Whether frame `name`'s record matches `hash` and every image it lists still holds exactly
+/// the bytes that were written (a truncated, corrupted or replaced image is rendered again).
+pub(super) fn is_up_to_date(out_dir: &Path, name: &str, hash: u64) -> bool {
+    let Ok(text) = std::fs::read_to_string(record_path(out_dir, name)) else {
+        return false;
+    };
+    let mut lines = text.lines();
+    if lines.next() != Some(format!("anim-render-record {RECORD_VERSION}").as_str()) {
+        return false;
+    }
+    if lines.next() != Some(format!("hash {hash:016x}").as_str()) {
+        return false;
+    }
+    let mut images = 0;
+    for line in lines {
+        let mut fields = line.splitn(4, ' ');
+        let (Some("image"), Some(len), Some(bytes_hash), Some(rel)) =
+            (fields.next(), fields.next(), fields.next(), fields.next())
+        else {
+            return false;
+        };
+        let (Ok(len), Ok(bytes_hash)) = (len.parse::<u64>(), u64::from_str_radix(bytes_hash, 16))
+        else {
+            return false;
+        };
+        let path = out_dir.join(rel);
+        let same_length = std::fs::metadata(&path).is_ok_and(|m| m.is_file() && m.len() == len);
+        // The length first: a changed size is caught without reading the image.
+        if !same_length || std::fs::read(&path).map(|b| Fnv64::of(&b)).ok() != Some(bytes_hash) {
+            return false;
+        }
+        images += 1;
+    }
+    images > 0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sdf::{MaterialField, TransformOrder};
+
+    /// Changing any one setting changes the key. The structs are taken apart field by field
+    /// without `..`, so a new setting does not compile here until it has a case of its own.
+    #[test]
+    fn every_setting_is_part_of_the_key() {
+        let base = RenderSettings::default();
+        let load = LoadOptions::default();
+        let RenderSettings {
+            spp,
+            width,
+            height,
+            max_depth,
+            ppm_ascii,
+            out_dir,
+            allow_any_output,
+            max_memory,
+        } = base.clone();
+        let LoadOptions {
+            strict,
+            material_fields,
+            transform_order,
+        } = load.clone();
+        let variants: Vec<(RenderSettings, LoadOptions)> = vec![
+            (
+                RenderSettings {
+                    spp: Some(spp.unwrap_or(1) + 1),
+                    ..base.clone()
+                },
+                load.clone(),
+            ),
+            (
+                RenderSettings {
+                    width: Some(width.unwrap_or(1) + 1),
+                    ..base.clone()
+                },
+                load.clone(),
+            ),
+            (
+                RenderSettings {
+                    height: Some(height.unwrap_or(1) + 1),
+                    ..base.clone()
+                },
+                load.clone(),
+            ),
+            (
+                RenderSettings {
+                    max_depth: max_depth + 1,
+                    ..base.clone()
+                },
+                load.clone(),
+            ),
+            (
+                RenderSettings {
+                    ppm_ascii: !ppm_ascii,
+                    ..base.clone()
+                },
+                load.clone(),
+            ),
+            (
+                RenderSettings {
+                    out_dir: Some(out_dir.unwrap_or_default().join("elsewhere")),
+                    ..base.clone()
+                },
+                load.clone(),
+            ),
+            (
+                RenderSettings {
+                    allow_any_output: !allow_any_output,
+                    ..base.clone()
+                },
+                load.clone(),
+            ),
+            (
+                RenderSettings {
+                    max_memory: max_memory / 2,
+                    ..base.clone()
+                },
+                load.clone(),
+            ),
+            (
+                base.clone(),
+                LoadOptions {
+                    strict: !strict,
+                    ..load.clone()
+                },
+            ),
+            (
+                base.clone(),
+                LoadOptions {
+                    material_fields: material_fields
+                        .iter()
+                        .copied()
+                        .chain([MaterialField::Roughness])
+                        .collect(),
+                    ..load.clone()
+                },
+            ),
+            (
+                base.clone(),
+                LoadOptions {
+                    transform_order: match transform_order {
+                        TransformOrder::World => TransformOrder::Local,
+                        TransformOrder::Local => TransformOrder::World,
+                    },
+                    ..load.clone()
+                },
+            ),
+        ];
+        let key =
+            |s: &RenderSettings, l: &LoadOptions| frame_hash(b"x", &settings_fingerprint(s, l));
+        let unchanged = key(&base, &load);
+        for (s, l) in &variants {
+            assert_ne!(key(s, l), unchanged, "{s:?} {l:?}");
+        }
+        assert_ne!(
+            key(&base, &load),
+            frame_hash(b"y", &settings_fingerprint(&base, &load))
+        );
+    }
+}

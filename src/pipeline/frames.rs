@@ -1,0 +1,334 @@
+//! `anim render DIR`: every `.sdf` file of a directory rendered as an animation frame —
+//! frames in parallel (and tiles within frames), unchanged frames skipped (see [`super::cache`]),
+//! one shard of the frames when asked, and a summary at the end.
+
+use super::cache::{
+    frame_hash, is_up_to_date, record_path, settings_fingerprint, write_record, CACHE_DIR,
+};
+use super::scene_file::{render_scene_file, NoProgress};
+use super::Shard;
+use crate::diag::Diagnostic;
+use crate::render::RenderSettings;
+use crate::sdf::LoadOptions;
+use crate::util::remove_stale_temp_files;
+use rayon::prelude::*;
+use std::cmp::Ordering;
+use std::collections::BTreeMap;
+use std::fs::{File, OpenOptions, TryLockError};
+use std::io::{Read as _, Seek as _, SeekFrom, Write as _};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+/// Which frames of a directory to render.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameOptions {
+    /// Render frames even when their record says they are up to date.
+    pub force: bool,
+    /// Render only this shard's frames.
+    pub shard: Option<Shard>,
+}
+
+/// What happened to the frames of one directory.
+#[derive(Debug, Default)]
+pub struct Summary {
+    /// `.sdf` files in the directory.
+    pub total: usize,
+    /// Frame file names rendered, skipped as unchanged, and failed (with their errors), each
+    /// in natural order.
+    pub rendered: Vec<String>,
+    pub skipped: Vec<String>,
+    pub failed: Vec<(String, Vec<Diagnostic>)>,
+    /// Warnings, one per distinct message, with the number of frames that had it.
+    pub warnings: Vec<(Diagnostic, usize)>,
+    pub rays: u64,
+    pub wall: Duration,
+    pub shard: Option<Shard>,
+}
+
+impl Summary {
+    /// Frames this run was responsible for (its shard).
+    pub fn selected(&self) -> usize {
+        self.rendered.len() + self.skipped.len() + self.failed.len()
+    }
+}
+
+/// How one frame ended.
+pub enum FrameOutcome {
+    Rendered {
+        rays: u64,
+        warnings: Vec<Diagnostic>,
+    },
+    Failed(Vec<Diagnostic>),
+}
+
+/// Nobody watches the frames either.
+impl FrameObserver for super::NoProgress {}
+
+/// Hears how the frames of a directory come along, for a progress display or a log. Frames
+/// finish on several threads at once, in any order.
+pub trait FrameObserver: Sync {
+    /// The frames to render are known: `to_render` will be rendered, `skipped` are unchanged.
+    fn planned(&self, _to_render: usize, _skipped: usize) {}
+    /// Frame `name` is done, after `took`.
+    fn finished(&self, _name: &str, _outcome: &FrameOutcome, _took: Duration) {}
+    /// Every frame is done.
+    fn end(&self) {}
+    /// Something worth saying that is not about one frame.
+    fn note(&self, _message: &str) {}
+}
+
+/// Holds the frame directory's lock file, `.anim-cache/lock`, for as long as it lives: two
+/// runs on one directory would otherwise write records that vouch for each other's images. A
+/// second run waits for the first, after saying which process it waits for.
+fn lock_frames(out_dir: &Path, observer: &dyn FrameObserver) -> Result<File, Vec<Diagnostic>> {
+    let path = out_dir.join(CACHE_DIR).join("lock");
+    let fail = |e: std::io::Error| {
+        vec![Diagnostic::file_error(
+            &path,
+            format!("cannot lock the frame directory: {e}"),
+        )]
+    };
+    std::fs::create_dir_all(out_dir.join(CACHE_DIR)).map_err(fail)?;
+    let mut file = OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(&path)
+        .map_err(fail)?;
+    match file.try_lock() {
+        Ok(()) => {}
+        Err(TryLockError::WouldBlock) => {
+            let mut holder = String::new();
+            let _ = file.read_to_string(&mut holder);
+            let holder = holder.trim();
+            observer.note(&format!(
+                "waiting for another anim render of this directory{} to finish",
+                if holder.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (process {holder})")
+                }
+            ));
+            file.lock().map_err(fail)?;
+        }
+        Err(TryLockError::Error(e)) => return Err(fail(e)),
+    }
+    // Who holds the lock, for the message of a run that has to wait.
+    file.set_len(0).map_err(fail)?;
+    file.seek(SeekFrom::Start(0)).map_err(fail)?;
+    write!(file, "{}", std::process::id()).map_err(fail)?;
+    Ok(file)
+}
+
+/// Renders the frames of `dir` on the current rayon pool. `Err` only when the directory itself
+/// is unusable; failing frames are listed in the summary.
+pub fn render_dir(
+    dir: &Path,
+    settings: &RenderSettings,
+    load: &LoadOptions,
+    options: &FrameOptions,
+    observer: &dyn FrameObserver,
+) -> Result<Summary, Vec<Diagnostic>> {
+    let start = Instant::now();
+    let frames = list_frames(dir).map_err(|e| {
+        vec![Diagnostic::file_error(
+            dir,
+            format!("cannot read the frame directory: {e}"),
+        )]
+    })?;
+    if frames.is_empty() {
+        return Err(vec![Diagnostic::file_error(
+            dir,
+            "no .sdf files in this directory",
+        )]);
+    }
+    let out_dir = settings
+        .out_dir
+        .clone()
+        .unwrap_or_else(|| dir.to_path_buf());
+    let fingerprint = settings_fingerprint(settings, load);
+    let _lock = lock_frames(&out_dir, observer)?;
+    // Temporary files of runs that were killed mid-write; the lock keeps live ones of another
+    // run of this directory away, and other processes' temporary files are kept.
+    if let Err(e) = remove_stale_temp_files(&out_dir) {
+        observer.note(&format!(
+            "cannot clear old temporary files in {}: {e}",
+            out_dir.display()
+        ));
+    }
+
+    let mut summary = Summary {
+        total: frames.len(),
+        shard: options.shard,
+        ..Summary::default()
+    };
+    // Decide what to render first: checking a record is cheap, and progress should count only
+    // real work.
+    let mut todo = Vec::new();
+    for (i, path) in frames.iter().enumerate() {
+        if options.shard.is_some_and(|s| !s.contains(i)) {
+            continue;
+        }
+        let name = file_name(path);
+        let hash = match std::fs::read(path) {
+            Ok(bytes) => frame_hash(&bytes, &fingerprint),
+            Err(e) => {
+                summary.failed.push((
+                    name,
+                    vec![Diagnostic::file_error(
+                        path,
+                        format!("cannot read file: {e}"),
+                    )],
+                ));
+                continue;
+            }
+        };
+        if !options.force && is_up_to_date(&out_dir, &name, hash) {
+            summary.skipped.push(name);
+        } else {
+            todo.push((path.clone(), name, hash));
+        }
+    }
+
+    observer.planned(todo.len(), summary.skipped.len());
+    let results: Mutex<Vec<(String, FrameOutcome)>> = Mutex::new(Vec::new());
+    // Frames are taken in natural order as threads free up (rather than rayon splitting the
+    // list in halves), so an interrupted run leaves a playable prefix behind.
+    todo.iter().par_bridge().for_each(|(path, name, hash)| {
+        let t0 = Instant::now();
+        let record = record_path(&out_dir, name);
+        // A stale record must not outlive an attempt to replace its images.
+        let _ = std::fs::remove_file(&record);
+        let outcome = match render_scene_file(path, load, settings, &NoProgress) {
+            Ok(file) => match write_record(&record, &out_dir, *hash, &file.outputs) {
+                Ok(()) => FrameOutcome::Rendered {
+                    rays: file.rays.total(),
+                    warnings: file.warnings,
+                },
+                Err(e) => FrameOutcome::Failed(vec![Diagnostic::file_error(
+                    &record,
+                    format!("rendered, but cannot record it: {e}"),
+                )]),
+            },
+            Err(diags) => FrameOutcome::Failed(diags),
+        };
+        observer.finished(name, &outcome, t0.elapsed());
+        if let Ok(mut r) = results.lock() {
+            r.push((name.clone(), outcome));
+        }
+    });
+    observer.end();
+
+    let mut results = results.into_inner().unwrap_or_else(|e| e.into_inner());
+    results.sort_by(|a, b| natural_cmp(&a.0, &b.0));
+    let mut warnings: BTreeMap<String, (Diagnostic, usize)> = BTreeMap::new();
+    for (name, outcome) in results {
+        match outcome {
+            FrameOutcome::Rendered { rays, warnings: w } => {
+                summary.rays += rays;
+                summary.rendered.push(name);
+                for d in w {
+                    // Frames of one animation repeat the same warning: show it once, with
+                    // the first frame's location and a count.
+                    warnings
+                        .entry(d.message.clone())
+                        .and_modify(|e| e.1 += 1)
+                        .or_insert((d, 1));
+                }
+            }
+            FrameOutcome::Failed(diags) => summary.failed.push((name, diags)),
+        }
+    }
+    summary.failed.sort_by(|a, b| natural_cmp(&a.0, &b.0));
+    summary.warnings = warnings.into_values().collect();
+    summary.wall = start.elapsed();
+    Ok(summary)
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// The `.sdf` files of `dir` (not hidden, not in subdirectories), in natural order.
+pub fn list_frames(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let mut frames: Vec<(String, PathBuf)> = Vec::new();
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let is_sdf = Path::new(&name)
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("sdf"));
+        if is_sdf && !name.starts_with('.') && entry.file_type()?.is_file() {
+            frames.push((name, entry.path()));
+        }
+    }
+    frames.sort_by(|a, b| natural_cmp(&a.0, &b.0));
+    Ok(frames.into_iter().map(|(_, p)| p).collect())
+}
+
+/// Natural order: runs of digits compare as numbers, so `frame_2` comes before `frame_10`.
+/// Names equal as numbers (`f01`, `f1`) fall back to plain text order, so the order is total.
+pub fn natural_cmp(a: &str, b: &str) -> Ordering {
+    let (mut x, mut y) = (a, b);
+    loop {
+        match (x.chars().next(), y.chars().next()) {
+            (None, None) => return a.cmp(b),
+            (None, Some(_)) => return Ordering::Less,
+            (Some(_), None) => return Ordering::Greater,
+            (Some(c), Some(d)) if c.is_ascii_digit() && d.is_ascii_digit() => {
+                let (nx, rx) = split_digits(x);
+                let (ny, ry) = split_digits(y);
+                let (tx, ty) = (nx.trim_start_matches('0'), ny.trim_start_matches('0'));
+                let ord = tx.len().cmp(&ty.len()).then_with(|| tx.cmp(ty));
+                if ord != Ordering::Equal {
+                    return ord;
+                }
+                x = rx;
+                y = ry;
+            }
+            (Some(c), Some(d)) => {
+                if c != d {
+                    return c.cmp(&d);
+                }
+                x = &x[c.len_utf8()..];
+                y = &y[d.len_utf8()..];
+            }
+        }
+    }
+}
+
+fn split_digits(s: &str) -> (&str, &str) {
+    let n = s.bytes().take_while(u8::is_ascii_digit).count();
+    s.split_at(n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn natural_order() {
+        let mut names = vec![
+            "frame_10.sdf",
+            "frame_2.sdf",
+            "frame_1.sdf",
+            "a.sdf",
+            "frame_02.sdf",
+        ];
+        names.sort_by(|a, b| natural_cmp(a, b));
+        assert_eq!(
+            names,
+            [
+                "a.sdf",
+                "frame_1.sdf",
+                "frame_02.sdf",
+                "frame_2.sdf",
+                "frame_10.sdf"
+            ]
+        );
+    }
+}

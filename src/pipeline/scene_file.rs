@@ -1,0 +1,278 @@
+//! One scene file from text to image files: load it, render every image its render lines ask
+//! for, and write each atomically (a reader never sees a half-written image).
+
+use crate::diag::{Diagnostic, Severity};
+use crate::limits;
+use crate::render::camera::CameraError;
+use crate::render::film::{self, ImageBytes, ImageFormat};
+use crate::render::{render_job, RayCounts, RenderSettings, Rendered};
+use crate::scene::RenderJob;
+use crate::sdf::LoadOptions;
+use std::path::{Component, Path, PathBuf};
+
+/// An image file written, with what was written to it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Output {
+    pub path: PathBuf,
+    pub bytes: ImageBytes,
+}
+
+/// What rendering one scene file produced.
+#[derive(Clone, Debug)]
+pub struct FileOutcome {
+    pub outputs: Vec<Output>,
+    pub warnings: Vec<Diagnostic>,
+    pub rays: RayCounts,
+}
+
+/// Hears how the images of one file come along, for a progress display.
+pub trait ImageProgress: Sync {
+    /// Called once, with the pixels of every image the file asks for.
+    fn begin(&self, _total_pixels: u64) {}
+    /// An image starts; `name` is its file name.
+    fn image(&self, _name: &str) {}
+    /// `pixels` more pixels are done.
+    fn advance(&self, _pixels: u64) {}
+    /// The file is done, or has failed.
+    fn end(&self) {}
+}
+
+/// Progress nobody watches (frames of a directory, tests).
+pub struct NoProgress;
+
+impl ImageProgress for NoProgress {}
+
+/// Where a job's image goes: relative paths are taken against `--out` or the scene's folder.
+/// A path that would leave that folder (absolute, or climbing out with `..`) is confined to it:
+/// its file name is written there instead, and the second value says so (an error under
+/// `--strict`). `--allow-any-output` honours every path as written.
+pub fn output_path(
+    scene_file: &Path,
+    job: &RenderJob,
+    settings: &RenderSettings,
+    strict: bool,
+) -> (PathBuf, Option<Diagnostic>) {
+    let base = settings.out_dir.clone().unwrap_or_else(|| {
+        scene_file
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default()
+    });
+    if settings.allow_any_output || stays_inside(&job.output) {
+        return (base.join(&job.output), None);
+    }
+    let Some(name) = job.output.file_name() else {
+        return (base.join(&job.output), None);
+    };
+    let confined = base.join(name);
+    let severity = if strict {
+        Severity::Error
+    } else {
+        Severity::Warning
+    };
+    let folder = if settings.out_dir.is_some() {
+        "the output folder (--out)"
+    } else {
+        "the scene's folder"
+    };
+    let diagnostic = job_error(
+        scene_file,
+        job,
+        format!(
+            "'{}' is outside {folder}; the image is written to '{}' instead",
+            job.output.display(),
+            confined.display()
+        ),
+    )
+    .with_severity(severity)
+    .with_help("pass --allow-any-output to write where the render line says");
+    (confined, Some(diagnostic))
+}
+
+/// Whether a relative path stays inside the folder it is taken against (`a/../b` does,
+/// `../b` and `/b` do not).
+fn stays_inside(path: &Path) -> bool {
+    let mut depth = 0usize;
+    for component in path.components() {
+        match component {
+            Component::Normal(_) => depth += 1,
+            Component::CurDir => {}
+            Component::ParentDir => {
+                let Some(up) = depth.checked_sub(1) else {
+                    return false;
+                };
+                depth = up;
+            }
+            Component::RootDir | Component::Prefix(_) => return false,
+        }
+    }
+    true
+}
+
+fn job_error(path: &Path, job: &RenderJob, message: String) -> Diagnostic {
+    match &job.loc {
+        Some(loc) => Diagnostic::new(Severity::Error, loc.clone(), message),
+        None => Diagnostic::file_error(path, message),
+    }
+}
+
+/// Loads a scene file, renders every image it asks for and writes them atomically. `Err` holds
+/// every diagnostic (warnings too) once one is an error; no image is written after an error.
+pub fn render_scene_file(
+    path: &Path,
+    load: &LoadOptions,
+    settings: &RenderSettings,
+    progress: &dyn ImageProgress,
+) -> Result<FileOutcome, Vec<Diagnostic>> {
+    let loaded = crate::sdf::load_file(path, load)?;
+    let mut warnings = loaded.diagnostics;
+    // Resolve every output before rendering anything, so a bad name fails fast.
+    let mut targets = Vec::with_capacity(loaded.jobs.len());
+    let mut errors = Vec::new();
+    for job in &loaded.jobs {
+        let (out, confined) = output_path(path, job, settings, load.strict);
+        if let Some(d) = confined {
+            if d.is_error() {
+                errors.push(d);
+            } else {
+                warnings.push(d);
+            }
+        }
+        let (width, height, _) = settings.resolve(job);
+        let needed = limits::image_memory(width, height);
+        if needed > settings.max_memory {
+            errors.push(
+                job_error(
+                    path,
+                    job,
+                    format!(
+                        "a {width}×{height} image needs about {} to render, more than the {} allowed",
+                        gib(needed),
+                        gib(settings.max_memory)
+                    ),
+                )
+                .with_help(
+                    "render it smaller, or in tiles (several cameras, each seeing part of the view); --max-memory raises the limit",
+                ),
+            );
+            continue;
+        }
+        match ImageFormat::for_path(&out, settings.ppm_ascii) {
+            Some(format) => targets.push((out, format)),
+            None => errors.push(
+                job_error(
+                    path,
+                    job,
+                    format!("cannot tell the image format of '{}'", job.output.display()),
+                )
+                .with_help(format!(
+                    "end the file name with one of {}",
+                    limits::image_extensions_list()
+                )),
+            ),
+        }
+    }
+    if !errors.is_empty() {
+        warnings.extend(errors);
+        return Err(warnings);
+    }
+    progress.begin(
+        loaded
+            .jobs
+            .iter()
+            .map(|j| {
+                let (w, h, _) = settings.resolve(j);
+                w as u64 * h as u64
+            })
+            .sum(),
+    );
+    let result = render_jobs(
+        path,
+        &loaded.jobs,
+        targets,
+        settings,
+        progress,
+        &mut warnings,
+    );
+    progress.end();
+    match result {
+        Ok((outputs, rays)) => Ok(FileOutcome {
+            outputs,
+            warnings,
+            rays,
+        }),
+        Err(()) => Err(warnings),
+    }
+}
+
+/// `bytes` in GiB, for messages.
+fn gib(bytes: u64) -> String {
+    format!("{:.1} GiB", bytes as f64 / (1u64 << 30) as f64)
+}
+
+/// Renders and writes each job; problems go to `diagnostics`, and an error stops the file.
+fn render_jobs(
+    path: &Path,
+    jobs: &[RenderJob],
+    targets: Vec<(PathBuf, ImageFormat)>,
+    settings: &RenderSettings,
+    progress: &dyn ImageProgress,
+    diagnostics: &mut Vec<Diagnostic>,
+) -> Result<(Vec<Output>, RayCounts), ()> {
+    let mut outputs = Vec::with_capacity(jobs.len());
+    let mut rays = RayCounts::default();
+    for (job, (out, format)) in jobs.iter().zip(targets) {
+        progress.image(
+            &out.file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+        );
+        let Rendered {
+            image,
+            rays: counts,
+            dropped,
+        } = match render_job(job, settings, &|n| progress.advance(n)) {
+            Ok(r) => r,
+            Err(e) => {
+                let what = match e {
+                    CameraError::Fov => format!(
+                        "camera '{}' has a field of view of {}°; it must be {}",
+                        job.camera.name,
+                        job.camera.fov_x_deg,
+                        limits::FOV_RULE
+                    ),
+                    CameraError::Orientation => format!(
+                        "camera '{}' has no usable orientation: its direction is zero or parallel to its up vector",
+                        job.camera.name
+                    ),
+                };
+                diagnostics.push(job_error(path, job, what));
+                return Err(());
+            }
+        };
+        for d in dropped {
+            let message = format!(
+                "shape '{}' is degenerate once transformed (too thin or too small to intersect) and is not drawn",
+                d.instance
+            );
+            diagnostics.push(match d.loc {
+                Some(loc) => Diagnostic::new(Severity::Warning, loc, message),
+                None => job_error(path, job, message).with_severity(Severity::Warning),
+            });
+        }
+        let bytes = match film::write_image(&out, &image, format) {
+            Ok(bytes) => bytes,
+            Err(e) => {
+                diagnostics.push(job_error(
+                    path,
+                    job,
+                    format!("cannot write '{}': {e}", out.display()),
+                ));
+                return Err(());
+            }
+        };
+        rays += counts;
+        outputs.push(Output { path: out, bytes });
+    }
+    Ok((outputs, rays))
+}

@@ -1,0 +1,176 @@
+//! Small helpers below everything else: atomic file writes and the clean-up of what an
+//! interrupted one leaves, a byte fingerprint, and the machine's memory.
+
+use std::fs;
+use std::io::{self, BufWriter};
+use std::path::Path;
+
+/// Suffix of the temporary files of [`write_atomically`]: `.NAME.PID.tmp`.
+const TEMP_SUFFIX: &str = ".tmp";
+
+/// Writes `contents` to `path` through a temporary file in the same directory and a rename,
+/// so that `path` either keeps its old contents or has the complete new ones. A symbolic link
+/// at `path` is replaced, never followed.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<fs::File>) -> io::Result<()>,
+) -> io::Result<()> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    fs::create_dir_all(dir)?;
+    let name = path
+        .file_name()
+        .ok_or_else(|| io::Error::other("output path has no file name"))?;
+    let tmp = dir.join(format!(
+        ".{}.{}{TEMP_SUFFIX}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let result = (|| {
+        let mut w = BufWriter::new(fs::File::create(&tmp)?);
+        write(&mut w)?;
+        // No fsync: the rename already guarantees that an interrupted process never leaves a
+        // partial image under the final name, and syncing every frame costs ~0.1 s each.
+        w.into_inner().map_err(|e| e.into_error())?;
+        fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Removes the temporary files that [`write_atomically`] calls of processes that no longer
+/// run (killed mid-write) from `dir`, and returns how many. Where the system cannot tell
+/// whether a process runs (no `/proc`), nothing is removed.
+pub fn remove_stale_temp_files(dir: &Path) -> io::Result<usize> {
+    if !Path::new("/proc/self").exists() {
+        return Ok(0);
+    }
+    let own = std::process::id();
+    let mut removed = 0;
+    for entry in fs::read_dir(dir)? {
+        let entry = entry?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some(pid) = temp_file_owner(&name) else {
+            continue;
+        };
+        let alive = pid == own || Path::new(&format!("/proc/{pid}")).exists();
+        if !alive && entry.file_type()?.is_file() {
+            fs::remove_file(entry.path())?;
+            removed += 1;
+        }
+    }
+    Ok(removed)
+}
+
+/// The process id in a temporary file name `.NAME.PID.tmp`.
+fn temp_file_owner(name: &str) -> Option<u32> {
+    let body = name.strip_prefix('.')?.strip_suffix(TEMP_SUFFIX)?;
+    let (file, pid) = body.rsplit_once('.')?;
+    if file.is_empty() || pid.is_empty() || !pid.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    pid.parse().ok()
+}
+
+/// FNV-1a, 64 bits: change detection, not security.
+#[derive(Clone, Copy, Debug)]
+pub struct Fnv64(u64);
+
+impl Default for Fnv64 {
+    fn default() -> Self {
+        Fnv64(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fnv64 {
+    pub fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 ^= b as u64;
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+
+    pub fn finish(&self) -> u64 {
+        self.0
+    }
+
+    pub fn of(bytes: &[u8]) -> u64 {
+        let mut h = Fnv64::default();
+        h.write(bytes);
+        h.finish()
+    }
+}
+
+/// The machine's physical memory in bytes, if the system says (Linux `/proc/meminfo`).
+pub fn physical_memory() -> Option<u64> {
+    let info = fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    kib.checked_mul(1024)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fnv_known_values() {
+        // Published FNV-1a 64 test vectors.
+        assert_eq!(Fnv64::default().finish(), 0xcbf29ce484222325);
+        assert_eq!(Fnv64::of(b"a"), 0xaf63dc4c8601ec8c);
+        assert_eq!(Fnv64::of(b"foobar"), 0x85944171f73967e8);
+    }
+
+    #[test]
+    fn temp_file_names_carry_their_owner() {
+        assert_eq!(temp_file_owner(".frame_0001.png.4242.tmp"), Some(4242));
+        assert_eq!(temp_file_owner(".x.1.tmp"), Some(1));
+        for not_ours in [
+            ".frame.png.tmp",
+            "frame.4242.tmp",
+            "..4242.tmp",
+            ".a.b.tmp",
+            ".a.12",
+        ] {
+            assert_eq!(temp_file_owner(not_ours), None, "{not_ours}");
+        }
+    }
+
+    #[test]
+    fn stale_temp_files_of_dead_processes_are_removed_and_others_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        // Process ids are below 2^22 on Linux: this one cannot be running.
+        let dead = dir.path().join(".frame.png.4294967.tmp");
+        let ours = dir
+            .path()
+            .join(format!(".frame.png.{}.tmp", std::process::id()));
+        let foreign = dir.path().join("holiday.4294967.tmp");
+        for f in [&dead, &ours, &foreign] {
+            fs::write(f, b"x").unwrap();
+        }
+        let removed = remove_stale_temp_files(dir.path()).unwrap();
+        if Path::new("/proc/self").exists() {
+            assert_eq!(removed, 1);
+            assert!(!dead.exists());
+        }
+        assert!(ours.exists() && foreign.exists());
+    }
+
+    #[test]
+    fn an_interrupted_write_leaves_the_old_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.txt");
+        fs::write(&path, b"old").unwrap();
+        let failed = write_atomically(&path, |w| {
+            io::Write::write_all(w, b"new, half")?;
+            Err(io::Error::other("interrupted"))
+        });
+        assert!(failed.is_err());
+        assert_eq!(fs::read(&path).unwrap(), b"old");
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+}

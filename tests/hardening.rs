@@ -1,0 +1,229 @@
+//! Hostile and unlucky inputs end quickly with a clear message or a correct result: deep mirror
+//! recursion, huge images, render lines that point outside the scene's folder, corrupted or
+//! half-written images and two runs on one frame directory.
+
+mod common;
+
+use common::anim;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+/// A closed box of perfect mirrors around the camera: every ray bounces to the depth limit.
+const MIRROR_BOX: &str = "define material mirror 0 0 0 0 0 0 0 0 0 1 1 1 1\n\
+    define shape box room -1 -1 -1 1 1 1 mirror\n\
+    define light l 0 0.5 0 1 1 1 1\n\
+    ambient 0.1 0.1 0.1\n\
+    define camera c 60 0 0 0.5 0 0 -1 0 1 0\n\
+    render c mirror.png 4 3\n";
+
+const SPHERE: &str = "define material red 0.2 0 0 0.8 0.1 0.1 0.5 0.5 0.5 20\n\
+    define shape sphere ball 0 0 -5 1 red\n\
+    define light sun 5 5 5 1 1 1 1\n\
+    define camera cam 60\n";
+
+fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn deep_mirror_recursion_renders_and_the_depth_has_a_stated_cap() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write(dir.path(), "mirror.sdf", MIRROR_BOX);
+    let out = anim()
+        .args(["render", "--quiet", "--max-depth", "10000"])
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.path().join("mirror.png").is_file());
+
+    let out = anim()
+        .args(["render", "--max-depth", "10001"])
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--max-depth") && stderr.contains("10000"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn an_image_too_big_for_memory_is_refused_before_anything_is_allocated() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write(
+        dir.path(),
+        "huge.sdf",
+        &format!("{SPHERE}render cam huge.png 65536 65536\n"),
+    );
+    let start = Instant::now();
+    let out = anim()
+        .args(["render", "--max-memory", "1G"])
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(start.elapsed() < Duration::from_secs(10));
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("huge.sdf:5:") && stderr.contains("65536×65536") && stderr.contains("GiB"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("huge.png").exists());
+}
+
+#[test]
+fn render_lines_cannot_write_outside_the_scene_folder() {
+    let root = tempfile::tempdir().unwrap();
+    let scenes = root.path().join("a/b");
+    std::fs::create_dir_all(&scenes).unwrap();
+    let absolute = root.path().join("elsewhere/abs.png");
+    let scene = write(
+        &scenes,
+        "escape.sdf",
+        &format!(
+            "{SPHERE}render cam ../../up.png 8 6\nrender cam {} 8 6\n",
+            absolute.display()
+        ),
+    );
+
+    let out = anim().arg("render").arg(&scene).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("escape.sdf:5:") && stderr.contains("outside"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("escape.sdf:6:"), "{stderr}");
+    assert!(!root.path().join("up.png").exists());
+    assert!(!absolute.exists());
+    assert!(scenes.join("up.png").is_file() && scenes.join("abs.png").is_file());
+
+    // Under --strict the escape is an error and nothing is written.
+    std::fs::remove_file(scenes.join("up.png")).unwrap();
+    let out = anim()
+        .args(["render", "--strict"])
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(!scenes.join("up.png").exists());
+
+    // --out with an absolute path confines to that folder just the same.
+    let out_dir = root.path().join("out");
+    let out = anim()
+        .arg("render")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert!(out_dir.join("up.png").is_file() && out_dir.join("abs.png").is_file());
+    assert!(!absolute.exists());
+
+    // --allow-any-output honours the paths as written.
+    let out = anim()
+        .args(["render", "--allow-any-output"])
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert!(root.path().join("up.png").is_file() && absolute.is_file());
+}
+
+fn frame_dir() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    for i in 0..3 {
+        write(
+            dir.path(),
+            &format!("frame_{i:04}.sdf"),
+            &format!("{SPHERE}render cam frame_{i:04}.png 8 6\n"),
+        );
+    }
+    dir
+}
+
+fn render_dir(dir: &Path) -> String {
+    let out = anim().arg("render").arg(dir).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{stderr}");
+    stderr
+}
+
+#[test]
+fn a_corrupted_image_of_the_right_size_is_rendered_again() {
+    let dir = frame_dir();
+    render_dir(dir.path());
+    let image = dir.path().join("frame_0001.png");
+    let good = std::fs::read(&image).unwrap();
+    let mut bad = good.clone();
+    let middle = bad.len() / 2;
+    bad[middle] ^= 0xff;
+    std::fs::write(&image, &bad).unwrap();
+    let stderr = render_dir(dir.path());
+    assert!(stderr.contains("1 rendered, 2 skipped"), "{stderr}");
+    assert_eq!(std::fs::read(&image).unwrap(), good);
+}
+
+#[test]
+fn temporary_files_of_killed_runs_are_cleared_and_foreign_files_kept() {
+    let dir = frame_dir();
+    // Process ids stay below 2^22 on Linux: this writer cannot be running.
+    let stale = write(dir.path(), ".frame_0000.png.4194999.tmp", "half an image");
+    let foreign = write(dir.path(), "notes.4194999.tmp", "mine");
+    render_dir(dir.path());
+    if Path::new("/proc/self").exists() {
+        assert!(!stale.exists());
+    }
+    assert!(foreign.exists());
+}
+
+#[test]
+fn a_second_run_on_the_same_directory_waits_for_the_first() {
+    let dir = frame_dir();
+    let cache = dir.path().join(".anim-cache");
+    std::fs::create_dir_all(&cache).unwrap();
+    let lock = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(cache.join("lock"))
+        .unwrap();
+    lock.lock().unwrap();
+    std::fs::write(cache.join("lock"), "4242").unwrap();
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("anim"))
+        .arg("render")
+        .arg(dir.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(500));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the second run went ahead while the directory was locked"
+    );
+    assert!(!dir.path().join("frame_0000.png").exists());
+    lock.unlock().unwrap();
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("waiting for another anim render") && stderr.contains("4242"),
+        "{stderr}"
+    );
+    assert!(dir.path().join("frame_0002.png").is_file());
+}
