@@ -1,12 +1,13 @@
 //! Command-line definitions (clap derive), resolved into configuration before any work starts.
 
 use crate::app::{CheckConfig, GenerateConfig, RenderConfig};
+use crate::bench::{BenchConfig, PovMode, Preset};
 use crate::limits;
 use crate::pipeline::{FrameOptions, Shard};
 use crate::render::RenderSettings;
 use crate::sdf::{LoadOptions, MaterialField, TransformOrder};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -120,15 +121,101 @@ pub struct GenerateArgs {
 
 #[derive(Args, Debug, Clone)]
 pub struct BenchArgs {
-    /// Write the results as a Markdown table to this file as well as to stdout.
-    #[arg(long, value_name = "FILE")]
-    pub markdown: Option<PathBuf>,
-    /// Image width for the benchmark renders.
-    #[arg(long, default_value_t = 1920)]
-    pub width: u32,
-    /// Image height for the benchmark renders.
-    #[arg(long, default_value_t = 1080)]
-    pub height: u32,
+    /// Write bench.csv, bench.md and one time-vs-error-<scene>.png per scene here
+    /// (stress.csv and stress.md with --stress).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Small images and fewer settings (a couple of minutes on 2 cores).
+    #[arg(long)]
+    pub quick: bool,
+    /// Tiny images and the quick settings, for the test suite (overrides --quick).
+    #[arg(long, hide = true)]
+    pub tiny: bool,
+    /// Instead of time against error: render the scenes scaled by 1e-4…1e5 and moved by
+    /// 1e3…1e6 and compare each with the unchanged render.
+    #[arg(long)]
+    pub stress: bool,
+    /// The bench scenes: every .sdf file in DIR [default: scenes/bench in the repository].
+    #[arg(long, value_name = "DIR")]
+    pub scenes: Option<PathBuf>,
+    /// Only this scene (file stem; repeat for several).
+    #[arg(long = "scene", value_name = "NAME")]
+    pub only: Vec<String>,
+    /// Converged reference images are cached here, keyed by scene content, size and version
+    /// [default: target/anim-bench-cache in the repository].
+    #[arg(long, value_name = "DIR")]
+    pub cache: Option<PathBuf>,
+    /// Folder with sdf2pov.py and povtonemap.py for POV-Ray's points
+    /// [default: ../shared/tools from the repository].
+    #[arg(long, value_name = "DIR")]
+    pub pov_tools: Option<PathBuf>,
+    /// Leave POV-Ray out even when it is installed.
+    #[arg(long)]
+    pub no_pov: bool,
+    /// Image width (default 640; --quick 96).
+    #[arg(long, value_name = "W", value_parser = parse_image_side)]
+    pub width: Option<u32>,
+    /// Image height (default 360; --quick 54).
+    #[arg(long, value_name = "H", value_parser = parse_image_side)]
+    pub height: Option<u32>,
+    /// Samples per pixel of the converged anim reference.
+    #[arg(long, value_name = "N", default_value_t = 1024, value_parser = parse_reference_samples)]
+    pub reference_spp: u32,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+}
+
+/// The nearest folder from the current one up that holds `.git` (a folder, or a file in a
+/// worktree); the current folder (as `.`) outside a repository.
+fn repository_root() -> PathBuf {
+    std::env::current_dir()
+        .ok()
+        .and_then(|cwd| {
+            cwd.ancestors()
+                .find(|d| d.join(".git").exists())
+                .map(Path::to_path_buf)
+        })
+        .unwrap_or_else(|| PathBuf::from("."))
+}
+
+impl BenchArgs {
+    /// The benchmark's configuration, for a pool of `--threads` workers (default: one per
+    /// core, as the command layer's pool has).
+    pub fn config(&self) -> BenchConfig {
+        let threads = self.threads.map_or_else(
+            || std::thread::available_parallelism().map_or(1, |n| n.get()),
+            |n| n as usize,
+        );
+        let preset = if self.tiny {
+            Preset::Tiny
+        } else if self.quick {
+            Preset::Quick
+        } else {
+            Preset::Full
+        };
+        let mut c = BenchConfig::preset(preset);
+        // The defaults are paths in the repository, wherever in it the command runs.
+        let root = repository_root();
+        let or_default = |given: &Option<PathBuf>, default: &Path| {
+            given.clone().unwrap_or_else(|| root.join(default))
+        };
+        c.scenes_dir = or_default(&self.scenes, &c.scenes_dir);
+        c.cache_dir = or_default(&self.cache, &c.cache_dir);
+        c.only = self.only.clone();
+        c.pov = match (&c.pov, self.no_pov) {
+            (_, true) => PovMode::Off,
+            (PovMode::Tools(default), false) => {
+                PovMode::Tools(or_default(&self.pov_tools, default))
+            }
+            (PovMode::Off, false) => PovMode::Off,
+        };
+        c.width = self.width.unwrap_or(c.width);
+        c.height = self.height.unwrap_or(c.height);
+        c.reference_spp = self.reference_spp;
+        c.threads = threads;
+        c
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -169,6 +256,11 @@ fn whole_in(s: &str, range: std::ops::RangeInclusive<u32>) -> Result<u32, String
 
 fn parse_samples(s: &str) -> Result<u32, String> {
     whole_in(s, limits::SAMPLES)
+}
+
+/// A converged reference takes at least 1024 samples, and no more than any render may.
+fn parse_reference_samples(s: &str) -> Result<u32, String> {
+    whole_in(s, 1024..=*limits::SAMPLES.end())
 }
 
 fn parse_image_side(s: &str) -> Result<u32, String> {

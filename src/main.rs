@@ -15,6 +15,13 @@ fn main() -> ExitCode {
             },
             None,
         ),
-        Command::Bench(args) => anim::bench::run(&args),
+        Command::Bench(args) => app::run(
+            app::Command::Bench {
+                config: args.config(),
+                stress: args.stress,
+                out: args.out.clone(),
+            },
+            args.threads,
+        ),
     }
 }

@@ -2,16 +2,19 @@
 //! code. Each command gets a plain configuration (made from the command line by `cli`) and
 //! calls the library, which returns values and diagnostics.
 
+mod bench;
 mod check;
 mod generate;
 mod progress;
 mod render;
 
 pub use crate::anim::GenerateConfig;
+pub use crate::bench::BenchConfig;
 pub use check::CheckConfig;
 pub use render::RenderConfig;
 
 use crate::limits;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// A command with its configuration.
@@ -19,7 +22,17 @@ use std::process::ExitCode;
 pub enum Command {
     Render(RenderConfig),
     Check(CheckConfig),
-    Generate { config: GenerateConfig, quiet: bool },
+    Generate {
+        config: GenerateConfig,
+        quiet: bool,
+    },
+    /// The time-against-error benchmark, or with `stress` the numerical stress table; files
+    /// go to `out`.
+    Bench {
+        config: BenchConfig,
+        stress: bool,
+        out: Option<PathBuf>,
+    },
 }
 
 /// Runs `command` on a rayon pool of `threads` workers (default: one per core), the one pool
@@ -41,5 +54,10 @@ pub fn run(command: Command, threads: Option<u32>) -> ExitCode {
         Command::Render(config) => render::run(config),
         Command::Check(config) => check::run(config),
         Command::Generate { config, quiet } => generate::run(config, *quiet),
+        Command::Bench {
+            config,
+            stress,
+            out,
+        } => bench::run(config, *stress, out.as_deref()),
     })
 }

@@ -1,0 +1,121 @@
+//! Log-log time-against-error plots, drawn by `plotters` into a pixel buffer with the bundled
+//! DejaVu Sans (assets/fonts, Bitstream Vera licence), so no system font library is needed,
+//! and encoded with the `image` crate the renderer already uses.
+
+use super::report::series;
+use super::{Renderer, Row};
+use plotters::prelude::*;
+use std::path::Path;
+use std::sync::OnceLock;
+
+const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+const SIZE: (u32, u32) = (800, 560);
+
+/// plotters' `ab_glyph` text looks fonts up by family name; the default family of labels is
+/// "sans-serif".
+fn register_font() -> Result<(), String> {
+    static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
+    REGISTERED
+        .get_or_init(|| {
+            plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+                .map_err(|_| "the bundled font cannot be read".to_string())
+        })
+        .clone()
+}
+
+fn colour(renderer: Renderer, mode: &str) -> RGBColor {
+    match (renderer, mode) {
+        (Renderer::Anim, "uniform") => RGBColor(0x1f, 0x77, 0xb4),
+        (Renderer::Anim, _) => RGBColor(0x2c, 0xa0, 0x2c),
+        (Renderer::PovRay, "no AA") => RGBColor(0x7f, 0x7f, 0x7f),
+        (Renderer::PovRay, "AM1") => RGBColor(0xff, 0x7f, 0x0e),
+        (Renderer::PovRay, _) => RGBColor(0xd6, 0x27, 0x28),
+    }
+}
+
+/// Plots RMSE against CPU seconds, one line per renderer and mode. Values are clamped to
+/// small positive floors because a log axis cannot show 0 (an exact image, or a render
+/// shorter than the clock's tick).
+pub fn time_vs_error(path: &Path, scene: &str, rows: &[&Row]) -> Result<(), String> {
+    register_font()?;
+    const MIN_S: f64 = 1e-4;
+    const MIN_RMSE: f64 = 1e-3;
+    let pts = |r: &Row| (r.cpu_s.max(MIN_S), r.error.rmse.max(MIN_RMSE));
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &r in rows {
+        let (x, y) = pts(r);
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if rows.is_empty() {
+        (x0, x1, y0, y1) = (MIN_S, 1.0, MIN_RMSE, 1.0);
+    }
+    // Half a decade of room on each side keeps end points off the frame.
+    let (x0, x1, y0, y1) = (x0 / 1.6, x1 * 1.6, y0 / 1.6, y1 * 1.6);
+    let mut buf = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    {
+        let err = |e: DrawingAreaErrorKind<_>| format!("plot {}: {e:?}", path.display());
+        let root = BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!("{scene}: time against error"),
+                ("sans-serif", 22).into_font(),
+            )
+            .margin(14)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
+            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("CPU seconds")
+            .y_desc("RMSE (8-bit levels)")
+            .x_label_formatter(&|v| short(*v))
+            .y_label_formatter(&|v| short(*v))
+            .light_line_style(RGBColor(236, 236, 236))
+            .draw()
+            .map_err(err)?;
+        for ((renderer, mode), mut line) in series(rows) {
+            line.sort_by(|a, b| a.cpu_s.total_cmp(&b.cpu_s));
+            let c = colour(renderer, &mode);
+            let points: Vec<(f64, f64)> = line.iter().map(|r| pts(r)).collect();
+            chart
+                .draw_series(LineSeries::new(points.clone(), c.stroke_width(2)))
+                .map_err(err)?
+                .label(format!("{} {mode}", renderer.name()))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
+            chart
+                .draw_series(points.into_iter().map(|p| Circle::new(p, 4, c.filled())))
+                .map_err(err)?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(err)?;
+        root.present().map_err(err)?;
+    }
+    let rgb = image::RgbImage::from_raw(SIZE.0, SIZE.1, buf)
+        .ok_or_else(|| "plot buffer has the wrong size".to_string())?;
+    let mut png = std::io::Cursor::new(Vec::new());
+    rgb.write_to(&mut png, image::ImageFormat::Png)
+        .map_err(|e| format!("cannot encode {}: {e}", path.display()))?;
+    crate::util::write_atomically(path, |w| std::io::Write::write_all(w, png.get_ref()))
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+/// An axis number without trailing zeros: 0.01, 2, 150.
+fn short(v: f64) -> String {
+    let s = format!("{v:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s.is_empty() || s == "-" {
+        "0".into()
+    } else {
+        s.to_string()
+    }
+}

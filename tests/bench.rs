@@ -1,0 +1,112 @@
+//! `anim bench` end to end: the real binary at its hidden `--tiny` size on two of the bench
+//! scenes, checking the files it writes. POV-Ray rows are checked when POV-Ray and the shared
+//! converter scripts are there, and the skip note otherwise.
+
+use assert_cmd::Command;
+use std::path::Path;
+
+const HEADER: &str = "scene,renderer,mode,setting,width,height,cpu_s,wall_s,rays,mean_spp,rmse,pct_over_1lsb,max_error,psnr_db";
+
+fn pov_available() -> bool {
+    Path::new("../shared/tools/sdf2pov.py").is_file()
+        && std::process::Command::new("povray")
+            .arg("--version")
+            .output()
+            .is_ok()
+}
+
+/// The RMSE column of the anim row of `scene` at `setting`.
+fn rmse(csv: &str, scene: &str, setting: &str) -> f64 {
+    let line = csv
+        .lines()
+        .find(|l| l.starts_with(&format!("{scene},anim,uniform,{setting},")))
+        .unwrap_or_else(|| panic!("no row for {scene} {setting} in\n{csv}"));
+    line.split(',').nth(10).unwrap().parse().unwrap()
+}
+
+#[test]
+fn quick_bench_writes_csv_markdown_and_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let output = Command::cargo_bin("anim")
+        .unwrap()
+        .args(["bench", "--quick", "--tiny", "--scene", "assignment"])
+        .args(["--scene", "showcase", "--out"])
+        .arg(&out)
+        .arg("--cache")
+        .arg(dir.path().join("cache"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "bench failed:\n{stderr}");
+
+    let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some(HEADER));
+    for line in lines {
+        assert_eq!(line.split(',').count(), 14, "{line}");
+    }
+    for scene in ["assignment", "showcase"] {
+        let one = rmse(&csv, scene, "1 spp");
+        let many = rmse(&csv, scene, "64 spp");
+        assert!(many < one, "{scene}: 64 spp RMSE {many} ≥ 1 spp RMSE {one}");
+        let png = out.join(format!("time-vs-error-{scene}.png"));
+        let img = image::open(&png).unwrap();
+        assert!(img.width() > 100 && img.height() > 100);
+    }
+    let md = std::fs::read_to_string(out.join("bench.md")).unwrap();
+    assert!(md.contains("## assignment") && md.contains("## showcase"));
+    assert!(md.contains("adaptive sampling is not in this build"));
+    if pov_available() {
+        assert!(csv.contains("showcase,povray,AM2,+A0.1 +AM2 +R3,"), "{csv}");
+    } else {
+        assert!(md.contains("POV-Ray: skipped"), "{md}");
+    }
+    // The references were cached: a second run renders none.
+    let again = Command::cargo_bin("anim")
+        .unwrap()
+        .args(["bench", "--tiny", "--no-pov", "--scene", "assignment"])
+        .arg("--cache")
+        .arg(dir.path().join("cache"))
+        .output()
+        .unwrap();
+    assert!(again.status.success());
+    assert!(String::from_utf8_lossy(&again.stderr).contains("anim reference from cache"));
+}
+
+#[test]
+fn stress_writes_its_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let output = Command::cargo_bin("anim")
+        .unwrap()
+        .args([
+            "bench",
+            "--stress",
+            "--tiny",
+            "--scene",
+            "assignment",
+            "--out",
+        ])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.path().join("stress.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(
+        rows[0],
+        "scene,change,pct_within_1lsb,nonfinite_pixels,dropped_shapes,cpu_s"
+    );
+    // The unchanged render and eight changes.
+    assert_eq!(rows.len(), 1 + 9);
+    assert!(rows[1].starts_with("assignment,none,100.0000,0,"));
+    // A change to centimetres loses nothing in f32.
+    let cm = rows.iter().find(|r| r.contains("scale 1e-2")).unwrap();
+    let pct: f64 = cm.split(',').nth(2).unwrap().parse().unwrap();
+    assert!(pct > 99.0, "{cm}");
+    assert!(dir.path().join("stress.md").is_file());
+}

@@ -1,0 +1,281 @@
+//! The architecture, checked: imports run one way through the layers below, no two files
+//! import each other (directly or round a loop), only the command layer knows the command
+//! line, and no source file grows past what one reader can hold.
+//!
+//! The layers, top to bottom (a module may import only modules of lower layers):
+//!
+//! ```text
+//! cli → app → {pipeline, anim, bench} → render → scene → sdf → {accel, shape} → math
+//!     → limits → {diag, util}
+//! ```
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+const LAYERS: &[&[&str]] = &[
+    &["cli"],
+    &["app"],
+    &["pipeline", "anim", "bench"],
+    &["render"],
+    &["scene"],
+    &["sdf"],
+    &["accel", "shape"],
+    &["math"],
+    &["limits"],
+    &["diag", "util"],
+];
+
+/// About as much as one reader holds in mind; tests beside the code may run longer.
+const MAX_LINES: usize = 900;
+
+fn layer_of(module: &str) -> Option<usize> {
+    LAYERS.iter().position(|l| l.contains(&module))
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap().flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// The module path of a source file: `src/sdf/parse/mod.rs` → `["sdf", "parse"]`.
+fn module_path(src: &Path, file: &Path) -> Vec<String> {
+    let rel = file.strip_prefix(src).unwrap().with_extension("");
+    let mut parts: Vec<String> = rel
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    if parts
+        .last()
+        .is_some_and(|p| p == "mod" || p == "lib" || p == "main")
+    {
+        parts.pop();
+    }
+    parts
+}
+
+/// Code lines without comments (`//` to the end of the line; doc comments included).
+fn code_lines(text: &str) -> impl Iterator<Item = &str> {
+    text.lines().map(|l| match l.find("//") {
+        Some(i) => &l[..i],
+        None => l,
+    })
+}
+
+/// Paths written after `prefix` in `line`: `crate::a::b::{c, d}` gives `a::b`.
+fn paths_after<'a>(line: &'a str, prefix: &str) -> Vec<Vec<&'a str>> {
+    let mut found = Vec::new();
+    let mut rest = line;
+    while let Some(i) = rest.find(prefix) {
+        let before = &rest[..i];
+        rest = &rest[i + prefix.len()..];
+        if before.ends_with(|c: char| c.is_alphanumeric() || c == '_') {
+            continue;
+        }
+        let path: Vec<&str> = rest
+            .split("::")
+            .map(|seg| {
+                seg.split(|c: char| !(c.is_alphanumeric() || c == '_'))
+                    .next()
+                    .unwrap_or("")
+            })
+            .take_while(|seg| !seg.is_empty())
+            .collect();
+        found.push(path);
+    }
+    found
+}
+
+struct Crate {
+    /// Module path → file.
+    files: BTreeMap<Vec<String>, PathBuf>,
+}
+
+impl Crate {
+    fn load() -> Crate {
+        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+        let mut paths = Vec::new();
+        rust_files(&src, &mut paths);
+        let files = paths
+            .into_iter()
+            .map(|f| (module_path(&src, &f), f))
+            .collect();
+        Crate { files }
+    }
+
+    /// The longest module path of a file that prefixes `path`.
+    fn resolve(&self, path: &[String]) -> Option<Vec<String>> {
+        (1..=path.len())
+            .rev()
+            .map(|n| path[..n].to_vec())
+            .find(|p| self.files.contains_key(p))
+    }
+
+    /// Module files a file refers to through `crate::…` and `super::…` paths.
+    fn references(&self, module: &[String]) -> BTreeSet<Vec<String>> {
+        let text = std::fs::read_to_string(&self.files[module]).unwrap();
+        let mut refs = BTreeSet::new();
+        for line in code_lines(&text) {
+            for path in paths_after(line, "crate::") {
+                let path: Vec<String> = path.iter().map(|s| s.to_string()).collect();
+                refs.extend(self.resolve(&path));
+            }
+            for path in paths_after(line, "super::") {
+                let mut base = module.to_vec();
+                base.pop();
+                let mut full = base;
+                full.extend(
+                    path.iter()
+                        .filter(|s| **s != "super")
+                        .map(|s| s.to_string()),
+                );
+                refs.extend(self.resolve(&full));
+            }
+        }
+        refs.remove(module);
+        refs
+    }
+
+    fn is_test_file(&self, module: &[String]) -> bool {
+        module.last().is_some_and(|m| m == "tests")
+    }
+}
+
+#[test]
+fn imports_run_down_the_layers() {
+    let krate = Crate::load();
+    let mut problems = Vec::new();
+    // Tests beside the code may drive their module through higher layers (a parser test that
+    // builds the scene, say): they are not part of the layering.
+    for module in krate.files.keys().filter(|m| !krate.is_test_file(m)) {
+        let Some(top) = module.first() else { continue };
+        let Some(from) = layer_of(top) else {
+            if top != "main" {
+                problems.push(format!("src/{top}: not in any layer of this test"));
+            }
+            continue;
+        };
+        for target in krate.references(module) {
+            let to_top = &target[0];
+            if to_top == top {
+                continue;
+            }
+            match layer_of(to_top) {
+                Some(to) if to > from => {}
+                _ => problems.push(format!(
+                    "{} imports {} (layer {from} may import only lower layers)",
+                    module.join("::"),
+                    target.join("::")
+                )),
+            }
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// Within a module, no two files import each other, directly or round a loop. A folder's
+/// `mod.rs` is the folder's face (it declares and re-exports its files), so references
+/// between it and its own files are not counted.
+#[test]
+fn no_import_circles_between_files() {
+    let krate = Crate::load();
+    let mut edges: BTreeMap<Vec<String>, BTreeSet<Vec<String>>> = BTreeMap::new();
+    for module in krate.files.keys() {
+        if krate.is_test_file(module) {
+            continue;
+        }
+        let targets = krate
+            .references(module)
+            .into_iter()
+            .filter(|t| !krate.is_test_file(t))
+            .filter(|t| !(t.len() < module.len() && module.starts_with(t)))
+            .filter(|t| !(module.len() < t.len() && t.starts_with(module)))
+            .collect();
+        edges.insert(module.clone(), targets);
+    }
+    // Depth-first search for a back edge.
+    fn visit(
+        node: &Vec<String>,
+        edges: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>,
+        state: &mut BTreeMap<Vec<String>, u8>,
+        stack: &mut Vec<Vec<String>>,
+        circles: &mut Vec<String>,
+    ) {
+        state.insert(node.clone(), 1);
+        stack.push(node.clone());
+        for next in edges.get(node).into_iter().flatten() {
+            match state.get(next).copied().unwrap_or(0) {
+                0 => visit(next, edges, state, stack, circles),
+                1 => {
+                    let start = stack.iter().position(|n| n == next).unwrap();
+                    let names: Vec<String> = stack[start..].iter().map(|n| n.join("::")).collect();
+                    circles.push(format!("{} -> {}", names.join(" -> "), next.join("::")));
+                }
+                _ => {}
+            }
+        }
+        stack.pop();
+        state.insert(node.clone(), 2);
+    }
+    let mut state = BTreeMap::new();
+    let mut circles = Vec::new();
+    for node in edges.keys() {
+        if !state.contains_key(node) {
+            visit(node, &edges, &mut state, &mut Vec::new(), &mut circles);
+        }
+    }
+    assert!(
+        circles.is_empty(),
+        "import circles:\n{}",
+        circles.join("\n")
+    );
+}
+
+#[test]
+fn only_the_command_layer_knows_the_command_line() {
+    let krate = Crate::load();
+    let offenders: Vec<String> = krate
+        .files
+        .keys()
+        .filter(|m| m.first().is_some_and(|t| t != "cli" && t != "main"))
+        .filter(|m| krate.references(m).iter().any(|t| t[0] == "cli"))
+        .map(|m| m.join("::"))
+        .collect();
+    assert!(offenders.is_empty(), "import the CLI types: {offenders:?}");
+    // Printing and exit codes belong to the command layer too.
+    let mut printers = Vec::new();
+    for (module, file) in &krate.files {
+        if module.first().is_none_or(|t| t == "app" || t == "main") || krate.is_test_file(module) {
+            continue;
+        }
+        let text = std::fs::read_to_string(file).unwrap();
+        let body = text.split("#[cfg(test)]").next().unwrap_or("");
+        for word in ["println!", "eprintln!", "ExitCode"] {
+            if code_lines(body).any(|l| l.contains(word)) {
+                printers.push(format!("{} uses {word}", module.join("::")));
+            }
+        }
+    }
+    assert!(printers.is_empty(), "{}", printers.join("\n"));
+}
+
+#[test]
+fn no_source_file_is_longer_than_a_reader_can_hold() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    rust_files(&root.join("src"), &mut files);
+    rust_files(&root.join("tests"), &mut files);
+    let long: Vec<String> = files
+        .iter()
+        .filter_map(|f| {
+            let n = std::fs::read_to_string(f).unwrap().lines().count();
+            (n > MAX_LINES).then(|| format!("{} has {n} lines", f.display()))
+        })
+        .collect();
+    assert!(long.is_empty(), "{}", long.join("\n"));
+}
