@@ -55,10 +55,19 @@ pub struct RenderArgs {
     /// Write images into DIR instead of beside each scene file.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Samples per pixel (k² gives a k×k stratified grid; 1 = one ray through the pixel
-    /// centre). Overrides the render statement's own count. Default 4.
+    /// Uniform sampling, N samples per pixel (k² gives a k×k stratified grid; 1 = one ray
+    /// through the pixel centre). Overrides the render statement's own count. Without it,
+    /// sampling is adaptive unless the render statement gives a count.
     #[arg(long, value_name = "N", value_parser = parse_samples)]
     pub spp: Option<u32>,
+    /// Adaptive sampling: target error of each pixel that needs more than one sample, in
+    /// 8-bit levels (default 2). Given explicitly, it also overrides a render statement's
+    /// sample count.
+    #[arg(long, value_name = "E", value_parser = parse_error_target, conflicts_with = "spp")]
+    pub error: Option<f32>,
+    /// Adaptive sampling: most samples one pixel may take (default 32).
+    #[arg(long, value_name = "N", value_parser = parse_samples, conflicts_with = "spp")]
+    pub max_spp: Option<u32>,
     /// Worker threads (default: one per core). The output does not depend on it.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
@@ -224,6 +233,13 @@ pub enum TransformOrderArg {
     Local,
 }
 
+fn parse_error_target(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(e) if e.is_finite() && e > 0.0 => Ok(e),
+        _ => Err(format!("'{s}' is not a positive number of 8-bit levels")),
+    }
+}
+
 pub fn parse_material_fields(s: &str) -> Result<MaterialField, String> {
     match s.trim() {
         "reflectivity" => Ok(MaterialField::Reflectivity),
@@ -311,6 +327,8 @@ impl RenderArgs {
     pub fn settings(&self) -> RenderSettings {
         RenderSettings {
             spp: self.spp,
+            error: self.error,
+            max_spp: self.max_spp,
             width: self.width,
             height: self.height,
             max_depth: self.max_depth,

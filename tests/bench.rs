@@ -56,7 +56,8 @@ fn quick_bench_writes_csv_markdown_and_plots() {
     }
     let md = std::fs::read_to_string(out.join("bench.md")).unwrap();
     assert!(md.contains("## assignment") && md.contains("## showcase"));
-    assert!(md.contains("adaptive sampling is not in this build"));
+    // Adaptive rows are measured alongside the uniform ones.
+    assert!(csv.contains("assignment,anim,adaptive,error 2,"), "{csv}");
     if pov_available() {
         assert!(csv.contains("showcase,povray,AM2,+A0.1 +AM2 +R3,"), "{csv}");
     } else {

@@ -52,21 +52,13 @@ impl Setting {
     }
 }
 
-/// Whether this build's renderer can sample adaptively; adaptive rows are measured only then.
-/// Adaptive sampling is being written on another branch, and this switch and
-/// [`render_settings`] are where it plugs in.
-pub fn adaptive_supported() -> bool {
-    false
-}
-
-/// The one place a bench setting becomes renderer settings. `None` when the renderer cannot
-/// do the setting (adaptive sampling before it exists).
+/// The one place a bench setting becomes renderer settings.
 pub fn render_settings(
     setting: &Setting,
     width: u32,
     height: u32,
     max_depth: u32,
-) -> Option<RenderSettings> {
+) -> RenderSettings {
     let base = RenderSettings {
         width: Some(width),
         height: Some(height),
@@ -74,11 +66,14 @@ pub fn render_settings(
         ..RenderSettings::default()
     };
     match *setting {
-        Setting::Uniform(spp) => Some(RenderSettings {
+        Setting::Uniform(spp) => RenderSettings {
             spp: Some(spp),
             ..base
-        }),
-        Setting::Adaptive { .. } => None,
+        },
+        Setting::Adaptive { error } => RenderSettings {
+            error: Some(error as f32),
+            ..base
+        },
     }
 }
 
@@ -130,13 +125,19 @@ impl BenchConfig {
                     640,
                     360,
                     &[1, 4, 9, 16, 64],
-                    &[4.0, 2.0, 1.0, 0.5, 0.25],
+                    &[8.0, 4.0, 2.0, 1.0, 0.5],
                     pov::standard_settings(),
                 ),
                 // 96×54 keeps a cold run (no cached references) under two minutes on two
                 // cores: POV-Ray's converged +A0.0 +AM2 +R5 takes ~1 ms a pixel per pass.
-                Preset::Quick => (96, 54, &[1, 4, 16, 64], &[2.0, 0.5], pov::quick_settings()),
-                Preset::Tiny => (48, 27, &[1, 4, 64], &[1.0], pov::quick_settings()),
+                Preset::Quick => (
+                    96,
+                    54,
+                    &[1, 4, 16, 64],
+                    &[4.0, 2.0, 1.0],
+                    pov::quick_settings(),
+                ),
+                Preset::Tiny => (48, 27, &[1, 4, 64], &[2.0], pov::quick_settings()),
             };
         let mut settings: Vec<Setting> = uniform.iter().map(|&s| Setting::Uniform(s)).collect();
         settings.extend(errors.iter().map(|&error| Setting::Adaptive { error }));
@@ -391,8 +392,7 @@ fn anim_reference(
         config.width,
         config.height
     ));
-    let settings = render_settings(&setting, config.width, config.height, config.max_depth)
-        .ok_or("uniform sampling is always supported")?;
+    let settings = render_settings(&setting, config.width, config.height, config.max_depth);
     let t = render_measured(&scene.job, &settings)?;
     write_ppm(&path, &t.rgb, config.width, config.height)?;
     reference.wall_s = Some(t.wall_s);
@@ -403,14 +403,6 @@ fn anim_reference(
 pub fn run(config: &BenchConfig, progress: &mut dyn FnMut(&str)) -> Result<BenchReport, String> {
     let scenes = load_scenes(&config.scenes_dir, &config.only)?;
     let mut notes = Vec::new();
-    if config
-        .settings
-        .iter()
-        .any(|s| matches!(s, Setting::Adaptive { .. }))
-        && !adaptive_supported()
-    {
-        notes.push("anim: adaptive sampling is not in this build; only uniform rows.".into());
-    }
     let pov_tools = match &config.pov {
         PovMode::Off => {
             notes.push("POV-Ray: not run (--no-pov).".into());
@@ -442,14 +434,7 @@ pub fn run(config: &BenchConfig, progress: &mut dyn FnMut(&str)) -> Result<Bench
             references: vec![anim_ref],
         };
         for setting in &config.settings {
-            if matches!(setting, Setting::Adaptive { .. }) && !adaptive_supported() {
-                continue;
-            }
-            let Some(settings) =
-                render_settings(setting, config.width, config.height, config.max_depth)
-            else {
-                continue;
-            };
+            let settings = render_settings(setting, config.width, config.height, config.max_depth);
             let t = render_measured(&scene.job, &settings)?;
             let pixels = (config.width as f64) * (config.height as f64);
             let row = Row {
@@ -511,15 +496,15 @@ mod tests {
 
     #[test]
     fn uniform_settings_map_to_sample_counts() {
-        let s = render_settings(&Setting::Uniform(9), 64, 32, 5).unwrap();
+        let s = render_settings(&Setting::Uniform(9), 64, 32, 5);
         assert_eq!(s.spp, Some(9));
         assert_eq!((s.width, s.height, s.max_depth), (Some(64), Some(32), 5));
     }
 
     #[test]
-    fn adaptive_rows_only_when_supported() {
-        let mapped = render_settings(&Setting::Adaptive { error: 1.0 }, 8, 8, 8);
-        assert_eq!(mapped.is_some(), adaptive_supported());
+    fn adaptive_settings_map_to_an_error_target() {
+        let s = render_settings(&Setting::Adaptive { error: 1.0 }, 8, 8, 8);
+        assert_eq!((s.spp, s.error), (None, Some(1.0)));
     }
 
     #[test]

@@ -143,6 +143,8 @@ mod tests {
         let load = LoadOptions::default();
         let RenderSettings {
             spp,
+            error,
+            max_spp,
             width,
             height,
             max_depth,
@@ -160,6 +162,20 @@ mod tests {
             (
                 RenderSettings {
                     spp: Some(spp.unwrap_or(1) + 1),
+                    ..base.clone()
+                },
+                load.clone(),
+            ),
+            (
+                RenderSettings {
+                    error: Some(error.unwrap_or(1.0) * 2.0),
+                    ..base.clone()
+                },
+                load.clone(),
+            ),
+            (
+                RenderSettings {
+                    max_spp: Some(max_spp.unwrap_or(1) + 1),
                     ..base.clone()
                 },
                 load.clone(),

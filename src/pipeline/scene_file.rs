@@ -231,6 +231,7 @@ fn render_jobs(
             image,
             rays: counts,
             dropped,
+            ..
         } = match render_job(job, settings, &|n| progress.advance(n)) {
             Ok(r) => r,
             Err(e) => {

@@ -2,6 +2,7 @@
 //! reflection and Fresnel refraction.
 
 use super::compile::{RenderScene, ShadeMaterial};
+use super::primitive::SurfaceHit;
 use super::RayCounts;
 use crate::math::{reflect, spawn_ray, Ray};
 use glam::Vec3A;
@@ -12,6 +13,9 @@ use glam::Vec3A;
 const NEGLIGIBLE: f32 = 0.5 / 255.0;
 /// Bound on surfaces a shadow ray may pass through (glass behind glass behind glass ...).
 const MAX_SHADOW_CROSSINGS: usize = 64;
+
+/// The primitive index reported for a camera ray that hit nothing.
+pub const NO_HIT: u32 = u32::MAX;
 
 pub struct Integrator<'a> {
     pub scene: &'a RenderScene,
@@ -35,11 +39,36 @@ pub fn fresnel(cos_i: f32, eta: f32) -> (f32, f32) {
 impl Integrator<'_> {
     /// Radiance arriving along `ray` (unit direction). `weight` is the ray's share of the
     /// pixel, `depth` the number of bounces so far.
+    #[inline]
     pub fn trace(&self, ray: &Ray, depth: u32, weight: f32, counts: &mut RayCounts) -> Vec3A {
+        match self.scene.closest(ray, f32::INFINITY) {
+            Some((prim, hit)) => self.shade(ray, prim, &hit, depth, weight, counts),
+            None => self.scene.background,
+        }
+    }
+
+    /// Radiance along a camera ray and the primitive it hit ([`NO_HIT`] for the background),
+    /// which adaptive sampling compares between neighbouring pixels. The uniform path keeps
+    /// calling [`Integrator::trace`].
+    pub fn trace_primary(&self, ray: &Ray, counts: &mut RayCounts) -> (Vec3A, u32) {
+        match self.scene.closest(ray, f32::INFINITY) {
+            Some((prim, hit)) => (self.shade(ray, prim, &hit, 0, 1.0, counts), prim),
+            None => (self.scene.background, NO_HIT),
+        }
+    }
+
+    /// Radiance leaving the surface point `hit` of primitive `prim` back along `ray`.
+    #[inline]
+    fn shade(
+        &self,
+        ray: &Ray,
+        prim: u32,
+        hit: &SurfaceHit,
+        depth: u32,
+        weight: f32,
+        counts: &mut RayCounts,
+    ) -> Vec3A {
         let scene = self.scene;
-        let Some((prim, hit)) = scene.closest(ray, f32::INFINITY) else {
-            return scene.background;
-        };
         let mat = &scene.materials[scene.prims[prim as usize].material as usize];
         let entering = hit.normal.dot(ray.dir) < 0.0;
         // Shading normal faces the incoming ray; the geometric one decides inside/outside.

@@ -5,12 +5,13 @@ pub mod compile;
 pub mod film;
 pub mod integrator;
 pub mod primitive;
+pub mod sampling;
 
 use crate::scene::RenderJob;
 use camera::{sample_offsets, CameraError, CameraRays};
 use compile::RenderScene;
 use glam::{Vec3, Vec3A};
-use integrator::Integrator;
+use integrator::{Integrator, NO_HIT};
 use rayon::prelude::*;
 use std::path::PathBuf;
 
@@ -18,13 +19,14 @@ use std::path::PathBuf;
 /// per-tile overhead (one allocation, one progress update) vanishes.
 const TILE: u32 = 32;
 
-/// Samples per pixel when neither `--spp` nor the render statement says.
-pub const DEFAULT_SPP: u32 = 4;
-
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
-    /// Overrides the render statement's sample count.
+    /// Uniform sampling with this many samples per pixel; overrides everything else.
     pub spp: Option<u32>,
+    /// Adaptive sampling's target standard error per pixel, in 8-bit levels.
+    pub error: Option<f32>,
+    /// Adaptive sampling's most samples for one pixel.
+    pub max_spp: Option<u32>,
     pub width: Option<u32>,
     pub height: Option<u32>,
     pub max_depth: u32,
@@ -42,6 +44,8 @@ impl Default for RenderSettings {
     fn default() -> Self {
         RenderSettings {
             spp: None,
+            error: None,
+            max_spp: None,
             width: None,
             height: None,
             max_depth: crate::limits::DEFAULT_MAX_DEPTH,
@@ -85,15 +89,54 @@ impl std::ops::AddAssign for RayCounts {
     }
 }
 
+/// How the samples of a render are placed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Sampling {
+    /// The same count everywhere: the centre for 1, a k×k grid for k², Hammersley otherwise.
+    Uniform(u32),
+    /// A centre sample everywhere, then scrambled Sobol samples where a pixel needs them.
+    Adaptive { error: f32, max_spp: u32 },
+}
+
+impl Sampling {
+    /// The most samples any pixel may take.
+    pub fn max_spp(&self) -> u32 {
+        match *self {
+            Sampling::Uniform(n) => n,
+            Sampling::Adaptive { max_spp, .. } => max_spp,
+        }
+    }
+}
+
 impl RenderSettings {
-    /// The image size and samples per pixel for `job` under these settings.
+    /// The image size and the most samples per pixel for `job` under these settings.
     pub fn resolve(&self, job: &RenderJob) -> (u32, u32, u32) {
-        let spp = self.spp.or(job.samples).unwrap_or(DEFAULT_SPP).max(1);
         (
             self.width.unwrap_or(job.width),
             self.height.unwrap_or(job.height),
-            spp,
+            self.sampling(job).max_spp(),
         )
+    }
+
+    /// `--spp` asks for uniform sampling; otherwise `--error`/`--max-spp` ask for adaptive;
+    /// otherwise a render line's own sample count is the author's uniform request; with
+    /// none of these, adaptive sampling with the defaults.
+    pub fn sampling(&self, job: &RenderJob) -> Sampling {
+        if let Some(n) = self.spp {
+            return Sampling::Uniform(n.max(1));
+        }
+        if self.error.is_none() && self.max_spp.is_none() {
+            if let Some(n) = job.samples {
+                return Sampling::Uniform(n.max(1));
+            }
+        }
+        Sampling::Adaptive {
+            error: self.error.unwrap_or(crate::limits::DEFAULT_ERROR),
+            max_spp: self
+                .max_spp
+                .unwrap_or(crate::limits::DEFAULT_MAX_SPP)
+                .max(1),
+        }
     }
 }
 
@@ -102,6 +145,8 @@ impl RenderSettings {
 pub struct Rendered {
     pub image: HdrImage,
     pub rays: RayCounts,
+    /// Camera samples traced per pixel, on average.
+    pub mean_spp: f64,
     /// Shapes that became degenerate once transformed (in f32) and were left out.
     pub dropped: Vec<compile::Dropped>,
 }
@@ -112,13 +157,40 @@ pub fn render_job(
     settings: &RenderSettings,
     on_tile: &(dyn Fn(u64) + Sync),
 ) -> Result<Rendered, CameraError> {
-    let (width, height, spp) = settings.resolve(job);
+    let (width, height, _) = settings.resolve(job);
     let camera = CameraRays::new(&job.camera, width, height)?;
     let (scene, dropped) = RenderScene::compile(&job.scene);
     let integrator = Integrator {
         scene: &scene,
         max_depth: settings.max_depth,
     };
+    let (pixels, counts) = match settings.sampling(job) {
+        Sampling::Uniform(spp) => render_uniform(&camera, &integrator, width, height, spp, on_tile),
+        Sampling::Adaptive { error, max_spp } => {
+            render_adaptive(&camera, &integrator, width, height, error, max_spp, on_tile)
+        }
+    };
+    Ok(Rendered {
+        image: HdrImage {
+            width,
+            height,
+            pixels,
+        },
+        mean_spp: counts.primary as f64 / (width as f64 * height as f64),
+        rays: counts,
+        dropped,
+    })
+}
+
+/// Every pixel takes the same `spp` samples at the same sub-pixel offsets.
+fn render_uniform(
+    camera: &CameraRays,
+    integrator: &Integrator,
+    width: u32,
+    height: u32,
+    spp: u32,
+    on_tile: &(dyn Fn(u64) + Sync),
+) -> (Vec<Vec3>, RayCounts) {
     let offsets = sample_offsets(spp);
     let inv_spp = 1.0 / offsets.len() as f32;
     let tiles_x = width.div_ceil(TILE);
@@ -158,15 +230,105 @@ pub fn render_job(
             pixels[start..start + chunk.len()].copy_from_slice(chunk);
         }
     }
-    Ok(Rendered {
-        image: HdrImage {
-            width,
-            height,
-            pixels,
-        },
-        rays: counts,
-        dropped,
-    })
+    (pixels, counts)
+}
+
+fn add_counts(mut a: RayCounts, b: RayCounts) -> RayCounts {
+    a += b;
+    a
+}
+
+/// Adaptive sampling (see `sampling`), in two passes over the image.
+///
+/// 1. One ray through every pixel centre (exactly `--spp 1`), keeping the primitive it hit.
+/// 2. A pixel whose 3×3 neighbourhood of centres shows one surface and at most
+///    `FLAT_CONTRAST` levels of contrast keeps its centre value: on such a surface the
+///    shading is smooth and the centre is the pixel mean up to its curvature. This holds for
+///    a mirror showing a flat wall as much as for the wall, so secondary rays alone do not
+///    force more samples; an edge in the reflection shows as contrast. Every other pixel
+///    drops its centre sample and takes scrambled Sobol samples, at least as many as its
+///    neighbourhood contrast calls for (`sampling::min_samples`), then doubling until the
+///    estimated error of its tone-mapped mean is at most `error` levels, or `max_spp`.
+///
+/// The neighbourhood test is what catches features thinner than the base spacing: a sliver
+/// seen by one centre marks all eight pixels around it. Pass 2 reads only the finished pass 1
+/// and writes each pixel from its own position, so the image does not depend on the thread
+/// count, and each pixel's pattern depends on its position only, so it does not crawl from
+/// frame to frame of an animation.
+fn render_adaptive(
+    camera: &CameraRays,
+    integrator: &Integrator,
+    width: u32,
+    height: u32,
+    error: f32,
+    max_spp: u32,
+    on_tile: &(dyn Fn(u64) + Sync),
+) -> (Vec<Vec3>, RayCounts) {
+    let (w, h) = (width as usize, height as usize);
+    let mut base = vec![(Vec3A::ZERO, NO_HIT); w * h];
+    let base_counts = base
+        .par_chunks_mut(w)
+        .enumerate()
+        .map(|(y, row)| {
+            let mut counts = RayCounts::default();
+            for (x, px) in row.iter_mut().enumerate() {
+                let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
+                *px = integrator.trace_primary(&ray, &mut counts);
+            }
+            counts.primary += row.len() as u64;
+            counts
+        })
+        .reduce(RayCounts::default, add_counts);
+
+    let base = &base;
+    // The largest tone-mapped difference (8-bit levels) between the centre of (x, y) and the
+    // centres around it, or None if the pixel is flat and keeps its centre sample.
+    let edge_contrast = |x: usize, y: usize| -> Option<f32> {
+        let (colour, prim) = base[y * w + x];
+        let tone = sampling::tone3(colour);
+        let mut contrast = 0.0f32;
+        let mut other_surface = false;
+        for ny in y.saturating_sub(1)..(y + 2).min(h) {
+            for (c, p) in &base[ny * w + x.saturating_sub(1)..ny * w + (x + 2).min(w)] {
+                other_surface |= *p != prim;
+                contrast = contrast.max((sampling::tone3(*c) - tone).abs().max_element());
+            }
+        }
+        let contrast = 255.0 * contrast;
+        (other_surface || contrast > sampling::FLAT_CONTRAST).then_some(contrast)
+    };
+
+    let mut pixels = vec![Vec3::ZERO; w * h];
+    let refine_counts = pixels
+        .par_chunks_mut(w)
+        .enumerate()
+        .map(|(y, row)| {
+            let mut counts = RayCounts::default();
+            for (x, out) in row.iter_mut().enumerate() {
+                let Some(contrast) = edge_contrast(x, y).filter(|_| max_spp > 1) else {
+                    *out = Vec3::from(base[y * w + x].0);
+                    continue;
+                };
+                let at_least = sampling::min_samples(contrast, error, max_spp);
+                let pattern = sampling::PixelPattern::new(x as u32, y as u32);
+                let mut m = sampling::Moments::default();
+                while m.n < max_spp {
+                    let (dx, dy) = pattern.sample(m.n);
+                    let ray = camera.ray(x as f32 + dx, y as f32 + dy);
+                    m.add(integrator.trace(&ray, 0, 1.0, &mut counts));
+                    // Checked at powers of two only: there every prefix is a full net.
+                    if m.n >= at_least && m.n.is_power_of_two() && m.error() <= error {
+                        break;
+                    }
+                }
+                counts.primary += m.n as u64;
+                *out = Vec3::from(m.mean());
+            }
+            on_tile(row.len() as u64);
+            counts
+        })
+        .reduce(RayCounts::default, add_counts);
+    (pixels, add_counts(base_counts, refine_counts))
 }
 
 #[cfg(test)]

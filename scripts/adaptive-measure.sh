@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# Measures adaptive anti-aliasing against uniform sampling and POV-Ray's adaptive method 2:
+# CPU seconds (user + sys, whole process, /usr/bin/time) and RMSE in 8-bit levels against
+# each scene's own 256-spp uniform render, all in one run on the same machine.
+#
+#   scripts/adaptive-measure.sh [extra anim flags for the adaptive run, e.g. --error 0.4]
+#
+# Environment: ANIM (binary, default target/release/anim), TOOLS (the POV-Ray converters,
+# default /work/shared/tools), OUT (work directory, default /tmp/adaptive-measure),
+# REUSE_REF=1 to keep reference renders from an earlier run, SIZE (default "640 360"),
+# QUICK=1 for the adaptive run alone, SCENES (default: the mirror-glass bench and showcase).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ANIM=${ANIM:-target/release/anim}
+TOOLS=${TOOLS:-/work/shared/tools}
+OUT=${OUT:-/tmp/adaptive-measure}
+read -r W H <<<"${SIZE:-640 360}"
+read -r -a SCENES <<<"${SCENES:-scenes/bench/mirror-glass.sdf scenes/showcase.sdf}"
+mkdir -p "$OUT"
+
+# cpu_of LOG: user + sys seconds from a /usr/bin/time -f '%U %S' line (the last line).
+cpu_of() { tail -n 1 "$1" | awk '{printf "%.2f", $1 + $2}'; }
+
+# render NAME SCENE FLAGS...: renders into $OUT/NAME, prints CPU seconds.
+render() {
+  local name=$1 scene=$2
+  shift 2
+  mkdir -p "$OUT/$name"
+  /usr/bin/time -f '%U %S' -o "$OUT/$name/time" \
+    "$ANIM" render "$scene" --width "$W" --height "$H" --out "$OUT/$name" "$@" \
+    >"$OUT/$name/log" 2>&1
+  cpu_of "$OUT/$name/time"
+}
+
+rmse() {
+  python3 - "$1" "$2" "$TOOLS" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[3])
+import imgio
+def load(p):
+    w, h, n, rows = imgio.read_png(p)
+    return w, h, [v for r in rows for i, v in enumerate(r) if n < 4 or i % 4 != 3]
+wa, ha, a = load(sys.argv[1])
+wb, hb, b = load(sys.argv[2])
+assert (wa, ha) == (wb, hb), "sizes differ"
+print("%.3f" % ((sum((x - y) ** 2 for x, y in zip(a, b)) / len(a)) ** 0.5))
+PY
+}
+
+mean_spp() { grep -o 'primary [0-9]*' "$1" | awk -v px=$((W * H)) '{s += $2} END {printf "%.2f", s / px}'; }
+
+printf '%-14s %-28s %8s %8s %8s\n' scene method cpu_s rmse mean_spp
+for scene in "${SCENES[@]}"; do
+  base=$(basename "$scene" .sdf)
+  png=$(awk '$1 == "render" {print $3; exit}' "$scene")
+  if [[ ${REUSE_REF:-0} != 1 || ! -f $OUT/$base-ref/$png ]]; then
+    render "$base-ref" "$scene" --spp 256 >/dev/null
+  fi
+  ref=$OUT/$base-ref/$png
+  runs=("default:$*")
+  [[ ${QUICK:-0} == 1 ]] || runs+=("uniform 4:--spp 4" "uniform 16:--spp 16")
+  for run in "${runs[@]}"; do
+    label=${run%%:*}
+    flags=${run#*:}
+    dir="$base-${label// /-}"
+    # shellcheck disable=SC2086  # the flags are words on purpose
+    cpu=$(render "$dir" "$scene" $flags)
+    printf '%-14s %-28s %8s %8s %8s\n' "$base" "anim $label ${flags:+($flags)}" "$cpu" \
+      "$(rmse "$OUT/$dir/$png" "$ref")" "$(mean_spp "$OUT/$dir/log")"
+  done
+  if [[ ${QUICK:-0} != 1 ]] && command -v povray >/dev/null; then
+    pov=$OUT/$base-pov
+    mkdir -p "$pov"
+    python3 "$TOOLS/sdf2pov.py" "$scene" -o "$pov/scene.pov"
+    /usr/bin/time -f '%U %S' -o "$pov/time" povray -D +WT2 File_Gamma=1.0 +W"$W" +H"$H" \
+      +A0.1 +AM2 +R3 +FN +O"$pov/pov.png" "$pov/scene.pov" >"$pov/log" 2>&1
+    # No RMSE: POV-Ray reflects and refracts by its own model (no Fresnel), so its image
+    # is a different one, and only its time is comparable.
+    printf '%-14s %-28s %8s %8s %8s\n' "$base" "povray +A0.1 +AM2 +R3" "$(cpu_of "$pov/time")" "-" "-"
+  fi
+done
