@@ -227,3 +227,37 @@ fn a_second_run_on_the_same_directory_waits_for_the_first() {
     );
     assert!(dir.path().join("frame_0002.png").is_file());
 }
+
+/// A scene with its camera and lights, moved as a whole.
+fn far_scene(offset: f64) -> String {
+    format!(
+        "define material red 0.2 0 0 0.8 0.1 0.1 0.5 0.5 0.5 20\n\
+         define material blue 0 0 0.2 0.1 0.1 0.8 0.3 0.3 0.3 10\n\
+         define shape sphere ball 0 0.5 -5 1 red\n\
+         define shape box floor -4 -1 -9 4 -0.5 -1 blue\n\
+         define shape cylinder post 2 -0.5 -6 2 2 -6 0.3 red\n\
+         define shape composite root ball floor post\n\
+         define light sun 5 5 5 1 1 1 1\n\
+         define camera cam 60 0 1 2 0 -0.2 -1 0 1 0\n\
+         transform root translate {offset} {offset} {offset}\n\
+         transform sun translate {offset} {offset} {offset}\n\
+         transform cam translate {offset} {offset} {offset}\n\
+         render cam image.ppm 160 120\n"
+    )
+}
+
+/// Rendering is camera-relative: the scene is moved (in f64) so the eye sits at the origin
+/// before anything goes to f32, so a scene far from the world origin keeps its detail.
+#[test]
+fn a_scene_far_from_the_origin_renders_as_it_does_at_the_origin() {
+    let near = common::render_ppm(&far_scene(0.0), &["--spp", "1"]);
+    for offset in [1e3, 1e5, 1e6] {
+        let far = common::render_ppm(&far_scene(offset), &["--spp", "1"]);
+        let (max, differing) = common::compare(&near, &far);
+        let pixels = near.width * near.height;
+        assert!(
+            max <= 1 || differing * 1000 <= pixels,
+            "offset {offset}: {differing} of {pixels} pixels differ, by up to {max}"
+        );
+    }
+}

@@ -7,10 +7,11 @@ pub mod integrator;
 pub mod primitive;
 pub mod sampling;
 
-use crate::scene::RenderJob;
+use crate::math::Transform;
+use crate::scene::{Camera, RenderJob, Scene};
 use camera::{sample_offsets, CameraError, CameraRays};
 use compile::RenderScene;
-use glam::{Vec3, Vec3A};
+use glam::{DVec3, Vec3, Vec3A};
 use integrator::{Integrator, NO_HIT};
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -151,6 +152,30 @@ pub struct Rendered {
     pub dropped: Vec<compile::Dropped>,
 }
 
+/// The job's scene and camera moved (in f64) so that the eye sits at the origin, or `None`
+/// when it already does. Rendering works in f32, which keeps about 7 digits relative to a
+/// coordinate's magnitude: a scene far from the world origin would lose its detail near the
+/// camera, where the picture needs it most. Moved together, the picture is the same.
+fn camera_relative(job: &RenderJob) -> Option<(Scene, Camera)> {
+    let eye = job.camera.eye;
+    if eye == DVec3::ZERO {
+        return None;
+    }
+    let to_camera = Transform::translate(-eye);
+    let mut scene = job.scene.clone();
+    for instance in &mut scene.instances {
+        instance.transform = to_camera.then_after(&instance.transform);
+    }
+    for light in &mut scene.lights {
+        light.position -= eye;
+    }
+    let camera = Camera {
+        eye: DVec3::ZERO,
+        ..job.camera.clone()
+    };
+    Some((scene, camera))
+}
+
 /// Renders one job to an HDR image. `on_tile(pixels)` is called as tiles finish.
 pub fn render_job(
     job: &RenderJob,
@@ -158,8 +183,12 @@ pub fn render_job(
     on_tile: &(dyn Fn(u64) + Sync),
 ) -> Result<Rendered, CameraError> {
     let (width, height, _) = settings.resolve(job);
-    let camera = CameraRays::new(&job.camera, width, height)?;
-    let (scene, dropped) = RenderScene::compile(&job.scene);
+    let rebased = camera_relative(job);
+    let (scene, camera) = rebased
+        .as_ref()
+        .map_or((&job.scene, &job.camera), |(s, c)| (s, c));
+    let camera = CameraRays::new(camera, width, height)?;
+    let (scene, dropped) = RenderScene::compile(scene);
     let integrator = Integrator {
         scene: &scene,
         max_depth: settings.max_depth,
