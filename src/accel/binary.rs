@@ -1,0 +1,325 @@
+//! The binary tree the wide hierarchy is collapsed from: binned SAH build into flat nodes in
+//! depth-first order (the first child follows its parent, the second is linked). Large inputs
+//! build their two halves in parallel; the tree is the same whatever the thread count.
+
+use crate::math::Aabb;
+use glam::Vec3A;
+
+const BINS: usize = 16;
+const MAX_LEAF: usize = 4;
+/// Cost of one node visit relative to one primitive test, for the SAH.
+const TRAVERSAL_COST: f32 = 0.5;
+/// Deepest level of the binary tree (the root is level 0); deeper nodes become leaves. The
+/// wide tree's traversal stacks are sized from it.
+pub(super) const MAX_DEPTH: usize = 63;
+/// Below this many primitives a subtree is built on the calling thread: spawning costs more
+/// than it saves, and small scenes should not touch the pool at all.
+pub(super) const PARALLEL_MIN: usize = 100_000;
+
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct Node {
+    pub bounds: Aabb,
+    /// Leaf: index of the first primitive in `order`. Interior: index of the second child
+    /// (the first child follows the node directly).
+    pub offset: u32,
+    /// Number of primitives; 0 marks an interior node.
+    pub count: u16,
+    pub axis: u8,
+}
+
+impl Node {
+    pub fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(super) struct BinaryBvh {
+    pub nodes: Vec<Node>,
+    /// Primitive indices in leaf order.
+    pub order: Vec<u32>,
+}
+
+struct BuildItem {
+    bounds: Aabb,
+    centroid: Vec3A,
+    index: u32,
+}
+
+impl BinaryBvh {
+    /// Builds over `bounds[i]` for the primitive indices in `items`; subtrees of at least
+    /// `parallel_min` primitives build their halves with `rayon::join`.
+    pub fn build(
+        bounds: &[Aabb],
+        items: impl IntoIterator<Item = u32>,
+        parallel_min: usize,
+    ) -> BinaryBvh {
+        let mut work: Vec<BuildItem> = items
+            .into_iter()
+            .map(|i| {
+                let b = bounds[i as usize];
+                BuildItem {
+                    bounds: b,
+                    centroid: b.centroid(),
+                    index: i,
+                }
+            })
+            .collect();
+        if work.is_empty() {
+            return BinaryBvh::default();
+        }
+        build_subtree(&mut work, 0, parallel_min.max(2))
+    }
+
+    fn with_capacity(items: usize) -> BinaryBvh {
+        BinaryBvh {
+            nodes: Vec::with_capacity(items.max(1) * 2),
+            order: Vec::with_capacity(items),
+        }
+    }
+
+    fn build_node(&mut self, items: &mut [BuildItem], depth: usize) -> usize {
+        let node_index = self.nodes.len();
+        let bounds = bounds_of(items);
+        self.nodes.push(Node {
+            bounds,
+            offset: 0,
+            count: 0,
+            axis: 0,
+        });
+        match split_of(items, &bounds, depth) {
+            None => self.make_leaf(node_index, items),
+            Some((axis, mid)) => {
+                self.nodes[node_index].axis = axis as u8;
+                let (left, right) = items.split_at_mut(mid);
+                self.build_node(left, depth + 1);
+                let second = self.build_node(right, depth + 1);
+                self.nodes[node_index].offset = second as u32;
+            }
+        }
+        node_index
+    }
+
+    fn make_leaf(&mut self, node_index: usize, items: &[BuildItem]) {
+        // Leaves are capped at u16::MAX primitives; a pathological pile of identical boxes
+        // beyond that is split in halves instead.
+        let node = &mut self.nodes[node_index];
+        node.offset = self.order.len() as u32;
+        node.count = items.len() as u16;
+        self.order.extend(items.iter().map(|it| it.index));
+    }
+
+    /// Appends `sub` (built on its own, offsets relative to itself) after the current nodes.
+    fn append(&mut self, sub: BinaryBvh) {
+        let node_base = self.nodes.len() as u32;
+        let order_base = self.order.len() as u32;
+        self.nodes.extend(sub.nodes.into_iter().map(|mut n| {
+            n.offset += if n.is_leaf() { order_base } else { node_base };
+            n
+        }));
+        self.order.extend(sub.order);
+    }
+}
+
+fn bounds_of(items: &[BuildItem]) -> Aabb {
+    items.iter().fold(Aabb::EMPTY, |b, it| b.union(it.bounds))
+}
+
+/// The split of a node at `depth`, or `None` for a leaf. Partitions `items` in place.
+fn split_of(items: &mut [BuildItem], bounds: &Aabb, depth: usize) -> Option<(usize, usize)> {
+    if items.len() <= MAX_LEAF || depth >= MAX_DEPTH {
+        None
+    } else {
+        find_split(items, bounds)
+    }
+}
+
+/// The tree over `items`, exactly as `build_node` makes it; above `parallel_min` primitives
+/// the two halves are built concurrently and joined in a fixed order (left, then right), so
+/// the layout does not depend on which thread finished first.
+fn build_subtree(items: &mut [BuildItem], depth: usize, parallel_min: usize) -> BinaryBvh {
+    if items.len() < parallel_min {
+        let mut bvh = BinaryBvh::with_capacity(items.len());
+        bvh.build_node(items, depth);
+        return bvh;
+    }
+    let bounds = bounds_of(items);
+    let Some((axis, mid)) = split_of(items, &bounds, depth) else {
+        let mut bvh = BinaryBvh::with_capacity(items.len());
+        bvh.build_node(items, depth);
+        return bvh;
+    };
+    let (left, right) = items.split_at_mut(mid);
+    let (left, right) = rayon::join(
+        || build_subtree(left, depth + 1, parallel_min),
+        || build_subtree(right, depth + 1, parallel_min),
+    );
+    let mut bvh = BinaryBvh {
+        nodes: Vec::with_capacity(1 + left.nodes.len() + right.nodes.len()),
+        order: Vec::with_capacity(left.order.len() + right.order.len()),
+    };
+    bvh.nodes.push(Node {
+        bounds,
+        offset: (1 + left.nodes.len()) as u32,
+        count: 0,
+        axis: axis as u8,
+    });
+    bvh.append(left);
+    bvh.append(right);
+    bvh
+}
+
+/// Binned surface-area heuristic: the best (axis, split position) over `BINS` centroid bins,
+/// or `None` when a leaf is cheaper (or unavoidable). Partitions `items` in place.
+fn find_split(items: &mut [BuildItem], bounds: &Aabb) -> Option<(usize, usize)> {
+    let centroid_bounds = items
+        .iter()
+        .fold(Aabb::EMPTY, |b, it| b.union_point(it.centroid));
+    let extent = centroid_bounds.extent();
+    let leaf_cost = items.len() as f32;
+    let parent_area = bounds.surface_area().max(f32::MIN_POSITIVE);
+    let mut best: Option<(f32, usize, usize)> = None;
+    for axis in 0..3 {
+        // Skips flat axes, and NaN or infinite extents alike.
+        if !(extent[axis].is_finite() && extent[axis] > 0.0) {
+            continue;
+        }
+        let scale = BINS as f32 / extent[axis];
+        let bin_of =
+            |c: Vec3A| (((c[axis] - centroid_bounds.min[axis]) * scale) as usize).min(BINS - 1);
+        let mut bin_bounds = [Aabb::EMPTY; BINS];
+        let mut bin_counts = [0usize; BINS];
+        for it in items.iter() {
+            let b = bin_of(it.centroid);
+            bin_bounds[b] = bin_bounds[b].union(it.bounds);
+            bin_counts[b] += 1;
+        }
+        // Sweep from the right to get the area and count of everything right of each split.
+        let mut right_area = [0.0f32; BINS];
+        let mut right_count = [0usize; BINS];
+        let (mut acc_b, mut acc_n) = (Aabb::EMPTY, 0);
+        for b in (1..BINS).rev() {
+            acc_b = acc_b.union(bin_bounds[b]);
+            acc_n += bin_counts[b];
+            right_area[b] = acc_b.surface_area();
+            right_count[b] = acc_n;
+        }
+        let (mut left_b, mut left_n) = (Aabb::EMPTY, 0);
+        for split in 1..BINS {
+            left_b = left_b.union(bin_bounds[split - 1]);
+            left_n += bin_counts[split - 1];
+            if left_n == 0 || right_count[split] == 0 {
+                continue;
+            }
+            let cost = TRAVERSAL_COST
+                + (left_b.surface_area() * left_n as f32
+                    + right_area[split] * right_count[split] as f32)
+                    / parent_area;
+            if best.is_none_or(|(c, _, _)| cost < c) {
+                best = Some((cost, axis, split));
+            }
+        }
+    }
+    let (cost, axis, split) = match best {
+        Some(b) => b,
+        // All centroids coincide: split in halves if the leaf would be too big to store.
+        None if items.len() > u16::MAX as usize => {
+            let mid = items.len() / 2;
+            return Some((0, mid));
+        }
+        None => return None,
+    };
+    if cost >= leaf_cost && items.len() <= u16::MAX as usize {
+        return None;
+    }
+    let scale = BINS as f32 / extent[axis];
+    let min = centroid_bounds.min[axis];
+    let mut left = 0;
+    for i in 0..items.len() {
+        let b = (((items[i].centroid[axis] - min) * scale) as usize).min(BINS - 1);
+        if b < split {
+            items.swap(i, left);
+            left += 1;
+        }
+    }
+    Some((axis, left))
+}
+
+#[cfg(test)]
+impl BinaryBvh {
+    /// The binary tree's own traversals, kept as the reference the wide tree must reproduce:
+    /// the sequence of primitives they offer fixes which of two equally close hits wins and
+    /// the order in which transparent shadow crossings multiply.
+    pub fn closest(
+        &self,
+        ray: &crate::math::Ray,
+        mut t_max: f32,
+        mut hit: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> f32 {
+        if self.nodes.is_empty() {
+            return t_max;
+        }
+        let inv_dir = ray.dir.recip();
+        let negative = [ray.dir.x < 0.0, ray.dir.y < 0.0, ray.dir.z < 0.0];
+        let mut stack = Vec::new();
+        let mut current = 0usize;
+        loop {
+            let node = &self.nodes[current];
+            if node.bounds.hit_range(ray, inv_dir, 0.0, t_max).is_some() {
+                if node.is_leaf() {
+                    let start = node.offset as usize;
+                    for &prim in &self.order[start..start + node.count as usize] {
+                        if let Some(t) = hit(prim, t_max) {
+                            t_max = t;
+                        }
+                    }
+                } else {
+                    let (near, far) = if negative[node.axis as usize] {
+                        (node.offset as usize, current + 1)
+                    } else {
+                        (current + 1, node.offset as usize)
+                    };
+                    stack.push(far);
+                    current = near;
+                    continue;
+                }
+            }
+            match stack.pop() {
+                Some(next) => current = next,
+                None => return t_max,
+            }
+        }
+    }
+
+    pub fn any(
+        &self,
+        ray: &crate::math::Ray,
+        t_max: f32,
+        mut occludes: impl FnMut(u32) -> bool,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let inv_dir = ray.dir.recip();
+        let mut stack = vec![0usize];
+        while let Some(current) = stack.pop() {
+            let node = &self.nodes[current];
+            if node.bounds.hit_range(ray, inv_dir, 0.0, t_max).is_none() {
+                continue;
+            }
+            if node.is_leaf() {
+                let start = node.offset as usize;
+                if self.order[start..start + node.count as usize]
+                    .iter()
+                    .any(|&p| occludes(p))
+                {
+                    return true;
+                }
+            } else {
+                stack.push(node.offset as usize);
+                stack.push(current + 1);
+            }
+        }
+        false
+    }
+}

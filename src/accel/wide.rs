@@ -1,0 +1,527 @@
+//! The 4-wide hierarchy rays traverse: each node holds its children's boxes in SoA lanes so
+//! one SIMD slab test covers all four, and leaves keep their primitive indices contiguously.
+//!
+//! It is the binary SAH tree with levels collapsed, and it offers primitives in the order the
+//! binary traversal did (minus some it culled): the closest hit keeps the same winner among
+//! equally close hits, and transparent shadow crossings multiply in the same order, so images
+//! stay byte-identical to the binary tree's.
+
+use super::binary::{BinaryBvh, MAX_DEPTH, PARALLEL_MIN};
+use crate::math::{Aabb, Ray};
+use glam::Vec4;
+
+const WIDTH: usize = 4;
+/// Marks a child reference as a leaf; the other bits index the leaf's header in `prims`.
+const LEAF: u32 = 1 << 31;
+/// Widening of the slab exit so that round-off never rejects a box the ray grazes (Ize,
+/// "Robust BVH Ray Traversal", JCGT 2013: 1 + 2·gamma(3)); the same factor as
+/// `Aabb::hit_range`, so both make the same decision for every box.
+const SLAB_WIDEN: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+/// Every wide level consumes at least one binary level (at most `MAX_DEPTH + 1` of them), and
+/// visiting a node pops one entry and pushes at most `WIDTH`.
+const STACK_SIZE: usize = (WIDTH - 1) * (MAX_DEPTH + 1) + 1;
+
+/// One wide node: 128 bytes, two cache lines, aligned to them.
+#[derive(Clone, Debug)]
+#[repr(align(64))]
+struct Node {
+    /// Child boxes, lane `i` for child `i`: `min[axis]`, `max[axis]`.
+    min: [Vec4; 3],
+    max: [Vec4; 3],
+    /// A node index, or `LEAF | start` where `prims[start]` counts the leaf's primitives and
+    /// their indices follow it.
+    child: [u32; WIDTH],
+    /// For each ray octant (bit `a` set when the direction's component `a` is negative), the
+    /// child slots in the order the binary tree's front-to-back traversal reached them, two
+    /// bits per slot, first in the low bits.
+    order: [u8; 8],
+    /// Number of children (1 only for a root that is a single leaf).
+    len: u8,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Bvh {
+    /// Depth-first: a node's children follow it (the root is node 0).
+    nodes: Vec<Node>,
+    /// Leaves, each a count followed by that many primitive indices.
+    prims: Vec<u32>,
+}
+
+/// The ray splatted over the lanes, per axis.
+struct RayLanes {
+    origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
+}
+
+impl RayLanes {
+    #[inline(always)]
+    fn new(ray: &Ray) -> RayLanes {
+        // 1/0 = ±inf for zero components; `Node::hit` deals with the NaNs they can make.
+        let inv = ray.dir.recip();
+        RayLanes {
+            origin: [0, 1, 2].map(|a| Vec4::splat(ray.origin[a])),
+            inv_dir: [0, 1, 2].map(|a| Vec4::splat(inv[a])),
+        }
+    }
+}
+
+impl Node {
+    /// Bit `i` set when the ray meets child `i`'s box within `[0, t_max]`, and each lane's
+    /// entry distance. Lane by lane the same arithmetic as `Aabb::hit_range` (and so the same
+    /// answer): a ray parallel to a slab with its origin on one of the planes gives
+    /// `0 · inf = NaN` there, and is inside that slab, so NaN becomes the unbounded interval
+    /// before SSE min/max (which would not drop it) see it.
+    #[inline(always)]
+    fn hit(&self, ray: &RayLanes, t_max: f32) -> (u32, Vec4) {
+        let mut enter = Vec4::ZERO;
+        let mut exit = Vec4::INFINITY;
+        for axis in 0..3 {
+            let t0 = (self.min[axis] - ray.origin[axis]) * ray.inv_dir[axis];
+            let t1 = (self.max[axis] - ray.origin[axis]) * ray.inv_dir[axis];
+            let on_plane = t0.is_nan_mask() | t1.is_nan_mask();
+            enter = enter.max(Vec4::select(on_plane, Vec4::NEG_INFINITY, t0.min(t1)));
+            exit = exit.min(Vec4::select(on_plane, Vec4::INFINITY, t0.max(t1)));
+        }
+        let exit = (exit * SLAB_WIDEN).min(Vec4::splat(t_max));
+        let live = (1u32 << self.len) - 1;
+        (enter.cmple(exit).bitmask() & live, enter)
+    }
+}
+
+impl Bvh {
+    /// Builds over `bounds[i]` for the primitive indices in `items` (unbounded primitives must
+    /// be kept elsewhere by the caller).
+    pub fn build(bounds: &[Aabb], items: impl IntoIterator<Item = u32>) -> Bvh {
+        Bvh::from_binary(&BinaryBvh::build(bounds, items, PARALLEL_MIN))
+    }
+
+    fn from_binary(bin: &BinaryBvh) -> Bvh {
+        let mut bvh = Bvh {
+            nodes: Vec::with_capacity(bin.nodes.len() / 2 + 1),
+            prims: Vec::with_capacity(bin.order.len() + bin.nodes.len() / 2 + 1),
+        };
+        if !bin.nodes.is_empty() {
+            bvh.collapse(bin, 0);
+        }
+        bvh
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Makes the wide node for the binary subtree at `root` and, depth first, its children;
+    /// returns its index.
+    fn collapse(&mut self, bin: &BinaryBvh, root: usize) -> u32 {
+        // Open the child with the largest surface area until there are four: big boxes are
+        // the ones rays meet most often, so theirs are the splits worth testing at once.
+        // Slots stay in the binary tree's left-to-right order.
+        let mut slots = [root; WIDTH];
+        let mut len = 1;
+        while len < WIDTH {
+            let area = |i: usize| bin.nodes[slots[i]].bounds.surface_area();
+            let Some(open) = (0..len)
+                .filter(|&i| !bin.nodes[slots[i]].is_leaf())
+                .reduce(|a, b| if area(b) > area(a) { b } else { a })
+            else {
+                break;
+            };
+            let b = slots[open];
+            slots.copy_within(open + 1..len, open + 2);
+            slots[open] = b + 1;
+            slots[open + 1] = bin.nodes[b].offset as usize;
+            len += 1;
+        }
+        let slots = &slots[..len];
+
+        let mut order = [0u8; 8];
+        for (octant, o) in order.iter_mut().enumerate() {
+            let mut k = 0;
+            visit_order(bin, root, slots, octant, o, &mut k);
+        }
+        let index = self.nodes.len();
+        self.nodes.push(Node {
+            min: [Vec4::INFINITY; 3],
+            max: [Vec4::NEG_INFINITY; 3],
+            child: [0; WIDTH],
+            order,
+            len: len as u8,
+        });
+        let mut min = [[f32::INFINITY; WIDTH]; 3];
+        let mut max = [[f32::NEG_INFINITY; WIDTH]; 3];
+        let mut child = [0u32; WIDTH];
+        for (i, &b) in slots.iter().enumerate() {
+            let node = &bin.nodes[b];
+            for axis in 0..3 {
+                min[axis][i] = node.bounds.min[axis];
+                max[axis][i] = node.bounds.max[axis];
+            }
+            child[i] = if node.is_leaf() {
+                let start = node.offset as usize;
+                let leaf = self.prims.len() as u32;
+                self.prims.push(node.count as u32);
+                self.prims
+                    .extend_from_slice(&bin.order[start..start + node.count as usize]);
+                LEAF | leaf
+            } else {
+                self.collapse(bin, b)
+            };
+        }
+        let node = &mut self.nodes[index];
+        node.min = min.map(Vec4::from_array);
+        node.max = max.map(Vec4::from_array);
+        node.child = child;
+        index as u32
+    }
+
+    #[inline(always)]
+    fn leaf(&self, reference: u32) -> &[u32] {
+        let start = (reference & !LEAF) as usize;
+        let count = self.prims[start] as usize;
+        &self.prims[start + 1..start + 1 + count]
+    }
+
+    /// Closest hit: calls `hit(prim, t_max)` for candidate primitives in roughly front-to-back
+    /// order; it returns the new `t_max` when the primitive is hit closer.
+    #[inline]
+    pub fn closest(
+        &self,
+        ray: &Ray,
+        mut t_max: f32,
+        mut hit: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> f32 {
+        if self.nodes.is_empty() {
+            return t_max;
+        }
+        let lanes = RayLanes::new(ray);
+        let octant = usize::from(ray.dir.x < 0.0)
+            | usize::from(ray.dir.y < 0.0) << 1
+            | usize::from(ray.dir.z < 0.0) << 2;
+        // Entries carry their box's entry distance: one that lies beyond a hit found since it
+        // was pushed is dropped without touching its node.
+        let mut stack = [(0u32, 0.0f32); STACK_SIZE];
+        stack[0] = (0, f32::NEG_INFINITY);
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let (reference, enter) = stack[top];
+            if enter > t_max {
+                continue;
+            }
+            if reference & LEAF != 0 {
+                for &prim in self.leaf(reference) {
+                    if let Some(t) = hit(prim, t_max) {
+                        t_max = t;
+                    }
+                }
+                continue;
+            }
+            let node = &self.nodes[reference as usize];
+            let (mask, enter) = node.hit(&lanes, t_max);
+            if mask == 0 {
+                continue;
+            }
+            let enter = enter.to_array();
+            let order = node.order[octant];
+            // Farthest pushed first, so the nearest is visited next.
+            for k in (0..node.len).rev() {
+                let slot = usize::from((order >> (2 * k)) & 3);
+                if mask & (1 << slot) != 0 {
+                    stack[top] = (node.child[slot], enter[slot]);
+                    top += 1;
+                }
+            }
+        }
+        t_max
+    }
+
+    /// Any hit before `t_max`: stops as soon as `occludes(prim)` says yes. Children are
+    /// offered left to right, the binary tree's order.
+    #[inline]
+    pub fn any(&self, ray: &Ray, t_max: f32, mut occludes: impl FnMut(u32) -> bool) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let lanes = RayLanes::new(ray);
+        let mut stack = [0u32; STACK_SIZE];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let reference = stack[top];
+            if reference & LEAF != 0 {
+                if self.leaf(reference).iter().any(|&p| occludes(p)) {
+                    return true;
+                }
+                continue;
+            }
+            let node = &self.nodes[reference as usize];
+            let (mask, _) = node.hit(&lanes, t_max);
+            for slot in (0..usize::from(node.len)).rev() {
+                if mask & (1 << slot) != 0 {
+                    stack[top] = node.child[slot];
+                    top += 1;
+                }
+            }
+        }
+        false
+    }
+}
+
+/// Appends to `order` the slots of the binary subtree at `b` in the order the binary
+/// closest-hit traversal reaches them for rays of `octant`: at each split, the child on the
+/// ray's side first.
+fn visit_order(
+    bin: &BinaryBvh,
+    b: usize,
+    slots: &[usize],
+    octant: usize,
+    order: &mut u8,
+    k: &mut u32,
+) {
+    if let Some(slot) = slots.iter().position(|&s| s == b) {
+        *order |= (slot as u8) << (2 * *k);
+        *k += 1;
+        return;
+    }
+    let node = &bin.nodes[b];
+    let (first, second) = (b + 1, node.offset as usize);
+    let (near, far) = if (octant >> node.axis) & 1 == 1 {
+        (second, first)
+    } else {
+        (first, second)
+    };
+    visit_order(bin, near, slots, octant, order, k);
+    visit_order(bin, far, slots, octant, order, k);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3A;
+
+    struct Rng(u64);
+
+    impl Rng {
+        fn next(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 40) as f32 / (1u64 << 24) as f32
+        }
+
+        fn vec(&mut self, scale: f32) -> Vec3A {
+            Vec3A::new(self.next(), self.next(), self.next()) * scale
+        }
+    }
+
+    /// Unit cubes on a grid; each "primitive" is its own bounding box.
+    fn grid(n: usize) -> Vec<Aabb> {
+        let mut v = Vec::new();
+        for x in 0..n {
+            for y in 0..n {
+                for z in 0..n {
+                    let p = Vec3A::new(x as f32 * 2.0, y as f32 * 2.0, z as f32 * 2.0);
+                    v.push(Aabb::new(p, p + Vec3A::ONE));
+                }
+            }
+        }
+        v
+    }
+
+    /// Boxes of many sizes, overlapping, some flat (zero extent on an axis).
+    fn random_boxes(rng: &mut Rng, n: usize) -> Vec<Aabb> {
+        (0..n)
+            .map(|i| {
+                let p = rng.vec(40.0);
+                let mut e = rng.vec(3.0);
+                e[i % 3] *= f32::from(u8::from(!i.is_multiple_of(4)));
+                Aabb::new(p, p + e)
+            })
+            .collect()
+    }
+
+    fn box_t(b: &Aabb, ray: &Ray) -> Option<f32> {
+        b.hit_range(ray, ray.dir.recip(), 0.0, f32::INFINITY)
+            .map(|(t, _)| t)
+    }
+
+    /// Rays through the scene, a third of them axis-parallel (zero direction components),
+    /// some starting exactly on box faces.
+    fn random_ray(rng: &mut Rng, boxes: &[Aabb], i: usize) -> Ray {
+        let o = rng.vec(60.0) - Vec3A::splat(10.0);
+        let target = rng.vec(40.0);
+        let mut dir = (target - o).normalize();
+        if i.is_multiple_of(3) {
+            let keep = i / 3 % 3;
+            dir = Vec3A::ZERO;
+            dir[keep] = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+        }
+        let mut origin = o;
+        if i.is_multiple_of(5) {
+            // On the plane of a face, parallel to it when the direction is axis-aligned.
+            let b = &boxes[i % boxes.len()];
+            origin[(i / 5) % 3] = b.min[(i / 5) % 3];
+        }
+        Ray::new(origin, dir)
+    }
+
+    #[test]
+    fn closest_and_any_equal_brute_force() {
+        let mut rng = Rng(0x9E3779B97F4A7C15);
+        for boxes in [
+            grid(6),
+            random_boxes(&mut rng, 700),
+            random_boxes(&mut rng, 3),
+        ] {
+            let bvh = Bvh::build(&boxes, 0..boxes.len() as u32);
+            for i in 0..3000 {
+                let ray = random_ray(&mut rng, &boxes, i);
+                let brute = boxes
+                    .iter()
+                    .filter_map(|b| box_t(b, &ray))
+                    .fold(f32::INFINITY, f32::min);
+                let via_bvh = bvh.closest(&ray, f32::INFINITY, |i, t_max| {
+                    box_t(&boxes[i as usize], &ray).filter(|&t| t < t_max)
+                });
+                assert_eq!(brute, via_bvh);
+                let blocked = bvh.any(&ray, f32::INFINITY, |i| {
+                    box_t(&boxes[i as usize], &ray).is_some()
+                });
+                assert_eq!(blocked, brute.is_finite());
+            }
+        }
+    }
+
+    /// The wide tree offers hits in the binary tree's order: the sequence of accepted closest
+    /// hits, and the sequence of primitives an any-hit query meets, are the same.
+    #[test]
+    fn offers_hits_in_the_binary_order() {
+        let mut rng = Rng(0xD1B54A32D192ED03);
+        let boxes = random_boxes(&mut rng, 2000);
+        let bin = BinaryBvh::build(&boxes, 0..boxes.len() as u32, usize::MAX);
+        let wide = Bvh::from_binary(&bin);
+        for i in 0..3000 {
+            let ray = random_ray(&mut rng, &boxes, i);
+            let t_limit = if i.is_multiple_of(2) {
+                f32::INFINITY
+            } else {
+                30.0
+            };
+            let mut seen = [Vec::new(), Vec::new()];
+            let record = |seen: &mut Vec<(u32, f32)>, i: u32, t_max: f32| {
+                let t = box_t(&boxes[i as usize], &ray).filter(|&t| t < t_max)?;
+                seen.push((i, t));
+                Some(t)
+            };
+            bin.closest(&ray, t_limit, |i, t| record(&mut seen[0], i, t));
+            wide.closest(&ray, t_limit, |i, t| record(&mut seen[1], i, t));
+            assert_eq!(seen[0], seen[1]);
+            let mut met = [Vec::new(), Vec::new()];
+            let meet = |met: &mut Vec<u32>, i: u32| {
+                if box_t(&boxes[i as usize], &ray).is_some_and(|t| t < t_limit) {
+                    met.push(i);
+                }
+                false
+            };
+            assert!(!bin.any(&ray, t_limit, |i| meet(&mut met[0], i)));
+            assert!(!wide.any(&ray, t_limit, |i| meet(&mut met[1], i)));
+            assert_eq!(met[0], met[1]);
+        }
+    }
+
+    #[test]
+    fn grazing_and_axis_parallel_rays_are_not_rejected() {
+        let boxes = vec![Aabb::new(Vec3A::ZERO, Vec3A::ONE); 1];
+        let bvh = Bvh::build(&boxes, [0]);
+        // In the plane x = 0, parallel to the x slab; along an edge; from inside a face.
+        for ray in [
+            Ray::new(Vec3A::new(0.0, 0.5, -1.0), Vec3A::Z),
+            Ray::new(Vec3A::new(1.0, 1.0, -1.0), Vec3A::Z),
+            Ray::new(Vec3A::new(0.5, 0.0, 0.5), Vec3A::NEG_Y),
+            Ray::new(Vec3A::new(0.0, 0.0, 0.0), Vec3A::X),
+        ] {
+            assert!(bvh.any(&ray, f32::INFINITY, |_| true), "{ray:?}");
+        }
+        let beside = Ray::new(Vec3A::new(2.0, 0.5, -1.0), Vec3A::Z);
+        assert!(!bvh.any(&beside, f32::INFINITY, |_| true));
+        let short = Ray::new(Vec3A::new(0.5, 0.5, -1.0), Vec3A::Z);
+        assert!(!bvh.any(&short, 0.5, |_| true));
+    }
+
+    #[test]
+    fn parallel_build_makes_the_same_tree() {
+        let mut rng = Rng(0x2545F4914F6CDD1D);
+        let boxes = random_boxes(&mut rng, 5000);
+        let serial = BinaryBvh::build(&boxes, 0..boxes.len() as u32, usize::MAX);
+        for threads in [1, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let parallel = pool.install(|| BinaryBvh::build(&boxes, 0..boxes.len() as u32, 64));
+            assert_eq!(serial, parallel);
+        }
+    }
+
+    /// Exponentially spaced boxes make a deep, lopsided tree (binning peels a few boxes off
+    /// per level); traversal through every level stays within the fixed stack, whose size
+    /// follows from the depth cap (`STACK_SIZE`).
+    #[test]
+    fn deep_tree_traverses_every_level() {
+        let boxes: Vec<Aabb> = (0..90)
+            .map(|i| {
+                let x = 2f32.powi(i);
+                Aabb::new(Vec3A::new(x, 0.0, 0.0), Vec3A::new(x * 1.01, 1.0, 1.0))
+            })
+            .collect();
+        let bin = BinaryBvh::build(&boxes, 0..boxes.len() as u32, usize::MAX);
+        fn depth(bin: &BinaryBvh, n: usize) -> usize {
+            let node = &bin.nodes[n];
+            if node.is_leaf() {
+                0
+            } else {
+                1 + depth(bin, n + 1).max(depth(bin, node.offset as usize))
+            }
+        }
+        assert!(depth(&bin, 0) > 16, "depth {}", depth(&bin, 0));
+        let bvh = Bvh::from_binary(&bin);
+        let ray = Ray::new(Vec3A::new(0.0, 0.5, 0.5), Vec3A::X);
+        let mut offered = 0;
+        assert!(!bvh.any(&ray, f32::INFINITY, |_| {
+            offered += 1;
+            false
+        }));
+        assert_eq!(offered, boxes.len());
+        let t = bvh.closest(&ray, f32::INFINITY, |i, t_max| {
+            box_t(&boxes[i as usize], &ray).filter(|&t| t < t_max)
+        });
+        assert_eq!(t, 1.0);
+    }
+
+    #[test]
+    fn coincident_primitives_make_a_leaf() {
+        let boxes = vec![Aabb::new(Vec3A::ZERO, Vec3A::ONE); 10];
+        let bvh = Bvh::build(&boxes, 0..10);
+        assert_eq!(bvh.node_count(), 1);
+        let ray = Ray::new(Vec3A::new(0.5, 0.5, -1.0), Vec3A::Z);
+        let mut tested = 0;
+        bvh.closest(&ray, f32::INFINITY, |_, _| {
+            tested += 1;
+            None
+        });
+        assert_eq!(tested, 10);
+    }
+
+    #[test]
+    fn empty_bvh_hits_nothing() {
+        let bvh = Bvh::build(&[], std::iter::empty());
+        assert!(bvh.is_empty());
+        let ray = Ray::new(Vec3A::ZERO, Vec3A::Z);
+        assert!(!bvh.any(&ray, 1.0, |_| true));
+        assert_eq!(bvh.closest(&ray, 1.0, |_, _| Some(0.0)), 1.0);
+    }
+}

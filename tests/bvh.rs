@@ -1,0 +1,119 @@
+//! Differential test of the wide BVH against brute force over real primitives: random scenes
+//! of spheres, boxes and triangles (some transformed, so kept in object space); the closest
+//! hit's distance and primitive, and any-hit answers, must equal testing every primitive.
+
+use anim::accel::Bvh;
+use anim::math::{Ray, Transform};
+use anim::render::primitive::Primitive;
+use anim::shape::Geometry;
+use glam::{DVec3, Vec3A};
+
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn vec(&mut self, scale: f64) -> DVec3 {
+        DVec3::new(self.next(), self.next(), self.next()) * scale
+    }
+}
+
+fn random_scene(rng: &mut Rng, n: usize) -> Vec<Primitive> {
+    let mut prims = Vec::new();
+    while prims.len() < n {
+        let c = rng.vec(50.0);
+        let geometry = match prims.len() % 3 {
+            0 => Geometry::Sphere {
+                center: c,
+                radius: 0.2 + rng.next() * 2.0,
+            },
+            1 => Geometry::Box {
+                p1: c,
+                p2: c + rng.vec(3.0) + DVec3::splat(0.05),
+            },
+            _ => Geometry::Triangle {
+                vertices: [c, c + rng.vec(4.0), c + rng.vec(4.0)],
+            },
+        };
+        // Every seventh primitive rotated, so it keeps its matrix.
+        let transform = if prims.len() % 7 == 3 {
+            let turn = Transform::rotate(10.0 + rng.next() * 70.0, DVec3::Y).unwrap();
+            Transform::translate(c).then_after(&turn.then_after(&Transform::translate(-c)))
+        } else {
+            Transform::IDENTITY
+        };
+        if let Ok(p) = Primitive::new(&geometry, &transform, 0) {
+            prims.push(p);
+        }
+    }
+    prims
+}
+
+fn random_ray(rng: &mut Rng, i: usize) -> Ray {
+    let o = rng.vec(80.0) - DVec3::splat(15.0);
+    let mut dir = (rng.vec(50.0) - o).normalize();
+    if i.is_multiple_of(4) {
+        // Axis-parallel: direction components of exactly zero.
+        dir = DVec3::ZERO;
+        dir[i / 4 % 3] = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+    }
+    Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(dir.as_vec3()))
+}
+
+#[test]
+fn wide_bvh_equals_brute_force_on_random_scenes() {
+    let mut rng = Rng(0x853C49E6748FEA9B);
+    for n in [1, 5, 60, 1500] {
+        let prims = random_scene(&mut rng, n);
+        let bounds: Vec<_> = prims.iter().map(|p| p.bounds).collect();
+        let bvh = Bvh::build(&bounds, 0..prims.len() as u32);
+        let mut hits = 0;
+        for i in 0..4000 {
+            let ray = random_ray(&mut rng, i);
+            let t_limit = if i.is_multiple_of(3) {
+                40.0
+            } else {
+                f32::INFINITY
+            };
+            let mut brute: Option<(u32, f32)> = None;
+            for (k, p) in prims.iter().enumerate() {
+                let t_max = brute.map_or(t_limit, |(_, t)| t);
+                if let Some(h) = p.hit(&ray, t_max) {
+                    brute = Some((k as u32, h.t));
+                }
+            }
+            let mut found: Option<(u32, f32)> = None;
+            let t = bvh.closest(&ray, t_limit, |k, t_max| {
+                let h = prims[k as usize].hit(&ray, t_max)?;
+                found = Some((k, h.t));
+                Some(h.t)
+            });
+            assert_eq!(
+                brute.map(|(_, t)| t),
+                found.map(|(_, t)| t),
+                "n={n} ray {i}"
+            );
+            assert_eq!(t, found.map_or(t_limit, |(_, t)| t));
+            if let (Some((a, _)), Some((b, _))) = (brute, found) {
+                // The same primitive, unless two are hit at exactly the same distance.
+                assert!(
+                    a == b
+                        || prims[a as usize].hit(&ray, t_limit).map(|h| h.t)
+                            == prims[b as usize].hit(&ray, t_limit).map(|h| h.t)
+                );
+            }
+            let blocked = bvh.any(&ray, t_limit, |k| {
+                prims[k as usize].hit(&ray, t_limit).is_some()
+            });
+            assert_eq!(blocked, brute.is_some(), "n={n} ray {i}");
+            hits += usize::from(brute.is_some());
+        }
+        // Not vacuous: a fair share of the rays meet something.
+        assert!(n < 1500 || hits > 1000, "{hits} hits");
+    }
+}
