@@ -7,16 +7,12 @@
 //! stay byte-identical to the binary tree's.
 
 use super::binary::{BinaryBvh, MAX_DEPTH, PARALLEL_MIN};
-use crate::math::{Aabb, Ray};
+use crate::math::{Aabb, Ray, SLAB_WIDEN};
 use glam::Vec4;
 
 const WIDTH: usize = 4;
 /// Marks a child reference as a leaf; the other bits index the leaf's header in `prims`.
 const LEAF: u32 = 1 << 31;
-/// Widening of the slab exit so that round-off never rejects a box the ray grazes (Ize,
-/// "Robust BVH Ray Traversal", JCGT 2013: 1 + 2·gamma(3)); the same factor as
-/// `Aabb::hit_range`, so both make the same decision for every box.
-const SLAB_WIDEN: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 /// Every wide level consumes at least one binary level (at most `MAX_DEPTH + 1` of them), and
 /// visiting a node pops one entry and pushes at most `WIDTH`.
 const STACK_SIZE: usize = (WIDTH - 1) * (MAX_DEPTH + 1) + 1;

@@ -10,7 +10,8 @@ pub struct Aabb {
 
 /// Slab-test widening so that round-off never rejects a box the ray grazes
 /// (Ize, "Robust BVH Ray Traversal", JCGT 2013: 1 + 2·gamma(3)).
-const SLAB_WIDEN: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+pub const SLAB_WIDEN: f32 =
+    1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
 impl Aabb {
     pub const EMPTY: Aabb = Aabb {

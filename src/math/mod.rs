@@ -3,7 +3,7 @@
 pub(crate) mod aabb;
 mod transform;
 
-pub use aabb::Aabb;
+pub use aabb::{Aabb, SLAB_WIDEN};
 pub use transform::Transform;
 
 use glam::Vec3A;
