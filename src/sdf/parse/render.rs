@@ -39,6 +39,23 @@ impl Parser<'_> {
         variant: Option<&str>,
     ) {
         self.render_lines += 1;
+        let reported = self.diagnostics.len();
+        let statements = self.statements.len();
+        self.render_inner(line, from, camera_expected, variant);
+        if self.statements.len() == statements {
+            // Rejected: whether that stops the file depends on its other render lines.
+            let problems = self.diagnostics.split_off(reported);
+            self.render_errors.extend(problems);
+        }
+    }
+
+    fn render_inner(
+        &mut self,
+        line: &Line,
+        from: usize,
+        camera_expected: bool,
+        variant: Option<&str>,
+    ) {
         let toks = &line.tokens;
         let mut notes: Vec<String> = variant.map(str::to_string).into_iter().collect();
         let names_end = names_end(line, from);
