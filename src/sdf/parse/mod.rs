@@ -138,6 +138,7 @@ pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
         cameras_rejected: false,
         layout: material_layout(&lines, opts),
         render_errors: Vec::new(),
+        camera_sizes: HashMap::new(),
     };
     for line in &lines {
         p.line(line);
@@ -185,6 +186,9 @@ struct Parser<'a> {
     /// Problems of render lines, each of which rejects only its own line when another render
     /// line of the file stands (settled in `resolve_renders`).
     render_errors: Vec<Diagnostic>,
+    /// Image sizes written on camera lines (`camera eye 45 500 500`), for the render lines
+    /// of that camera that give none.
+    camera_sizes: HashMap<String, (u32, u32)>,
 }
 
 /// The layout of the numbers after the colours of the file's materials: the one named by

@@ -177,6 +177,20 @@ impl Parser<'_> {
                     }
                 }
             }
+            if !pending.size_given {
+                match self.camera_sizes.get(&def.camera.name) {
+                    Some(&(w, h)) => {
+                        (def.width, def.height) = (w, h);
+                        notes.push(format!(
+                            "no image size given: {w}×{h} from the camera's line is used"
+                        ));
+                    }
+                    None => notes.push(format!(
+                        "no image size given: {}×{}",
+                        def.width, def.height
+                    )),
+                }
+            }
             if def.output.is_empty() {
                 def.output = default_output.clone();
                 if !pending.output_given {
