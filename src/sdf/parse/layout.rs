@@ -59,6 +59,10 @@ const CANDIDATES: &[(&[Slot], bool)] = &[
     (&[F(R), F(O), F(I), M], true),
 ];
 
+/// Score subtracted from a reading as percentages: scaling every fraction by 1/100 makes
+/// most numbers look like fractions, so it must win clearly.
+const PERCENT_HANDICAP: f64 = 0.5;
+
 /// The reading of `--material-fields reflectivity,opacity,ior`.
 pub(super) fn default_layout() -> Layout {
     Layout::new(CANDIDATES[0].0, false, false)
@@ -200,15 +204,19 @@ fn score(layout: &Layout, materials: &[Vec<f64>]) -> Option<f64> {
 /// default then reports what is wrong).
 pub(super) fn infer(materials: &[Vec<f64>]) -> Option<Layout> {
     let mut best: Option<(f64, Layout)> = None;
-    for &(slots, m_last) in CANDIDATES {
-        for percent in [false, true] {
+    // Percentages only when plain fractions read worse: tried last, with a small handicap.
+    for percent in [false, true] {
+        for &(slots, m_last) in CANDIDATES {
             let layout = Layout::new(slots, m_last, percent);
             if percent && !uses_percentages(&layout, materials) {
                 continue;
             }
-            let Some(s) = score(&layout, materials) else {
+            let Some(mut s) = score(&layout, materials) else {
                 continue;
             };
+            if percent {
+                s -= PERCENT_HANDICAP;
+            }
             // Strictly better only: ties keep the earlier candidate (the default first).
             if best.as_ref().is_none_or(|(b, _)| s > *b + 1e-9) {
                 best = Some((s, layout));
