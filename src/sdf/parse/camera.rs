@@ -53,7 +53,7 @@ impl Parser<'_> {
             let size = (nums[1] as u32, nums[2] as u32);
             self.warn(
                 line,
-                At::Span(first + 1, first + 2),
+                At::Span(first, first + 2),
                 format!(
                     "image size {}×{} after the field of view: used by render lines of this camera that give none",
                     size.0, size.1
@@ -113,9 +113,9 @@ impl Parser<'_> {
             // can, so the order is clear.
             self.warn(
                 line,
-                At::Tok(first + 9),
+                At::Tok(first),
                 "camera written with the field of view last: read as [eye] [dir] [up] <fov-x>",
-                Some(format!("canonical form: `{FORM_CAMERA}`")),
+                Some(format!("the fov comes first: `{FORM_CAMERA}`")),
             );
             nums.rotate_right(1);
         }

@@ -122,10 +122,24 @@ impl Parser<'_> {
                 RenderCamera::Named => match self.camera_names.as_slice() {
                     // One camera: the line can only mean it (a renamed or misspelt camera).
                     [only] => {
-                        notes.push(format!(
-                            "no camera `{}`: the file's only camera `{only}` is used",
-                            def.camera.name
-                        ));
+                        let help = match crate::diag::suggest(&def.camera.name, [only.as_str()]) {
+                            Some(s) => format!("did you mean `{s}`?"),
+                            None => format!("write `render {only} ...`"),
+                        };
+                        let d = Diagnostic::new(
+                            Severity::Warning,
+                            def.camera.loc.clone(),
+                            format!(
+                                "unknown camera `{}`: the file's only camera `{only}` is used",
+                                def.camera.name
+                            ),
+                        )
+                        .with_source(
+                            pending.anchor.text.clone(),
+                            def.camera.name.chars().count() as u32,
+                        )
+                        .with_help(help);
+                        self.diagnostics.push(d);
                         def.camera.name = only.clone();
                     }
                     cameras => {
