@@ -63,6 +63,9 @@ const CANDIDATES: &[(&[Slot], bool)] = &[
 /// most numbers look like fractions, so it must win clearly.
 const PERCENT_HANDICAP: f64 = 0.5;
 
+/// Opacity and reflectivity below this leave a non-refracting material all but invisible.
+const NEARLY_INVISIBLE: f64 = 0.05;
+
 /// The reading of `--material-fields reflectivity,opacity,ior`.
 pub(super) fn default_layout() -> Layout {
     Layout::new(CANDIDATES[0].0, false, false)
@@ -170,10 +173,15 @@ fn score_material(layout: &Layout, extras: &[f64]) -> Option<f64> {
                     R => reflectivity = v,
                     O => opacity = v,
                     T => opacity = 1.0 - v,
-                    I => ior = v,
+                    // The reader repairs an unusable index to air's.
+                    I => ior = if v > 0.0 { v } else { 1.0 },
                     MaterialField::Roughness => {}
                 }
+                let raw_fraction = raw > 0.0 && raw <= 1.0;
                 match f {
+                    // "1 %" or "0.5 %" is not how percentages are written: these numbers are
+                    // fractions, and the file is not on a 0–100 scale.
+                    R | O | T if layout.percent && raw_fraction => -1.0,
                     R | O | T | MaterialField::Roughness if fraction => 1.0,
                     R | O | T | MaterialField::Roughness => -3.0,
                     // 0 is often written for "no refraction".
@@ -188,7 +196,7 @@ fn score_material(layout: &Layout, extras: &[f64]) -> Option<f64> {
         };
     }
     // A material nobody can see is almost never what the author meant.
-    if opacity <= 0.0 && reflectivity <= 0.0 && (ior - 1.0).abs() < 1e-9 {
+    if opacity < NEARLY_INVISIBLE && reflectivity < NEARLY_INVISIBLE && (ior - 1.0).abs() < 1e-9 {
         score -= 2.0;
     }
     Some(score)
