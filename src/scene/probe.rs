@@ -1,5 +1,5 @@
 //! Never a silent blank image: before rendering, a coarse look through each job's camera
-//! (32×18 primary rays, one shadow ray per light, a few mirror bounces) tells whether the
+//! (32×18 primary rays for a 16:9 image, one shadow ray per light, a few mirror bounces) tells whether the
 //! image would be all background or all black, and why.
 //!
 //! The probe lives in `scene` and uses only `shape` and `math` (the layering forbids
@@ -17,10 +17,10 @@ use glam::{DVec3, Vec3, Vec3A};
 use std::path::Path;
 use std::sync::Arc;
 
-/// The probe's image size: enough rays to see any object that covers a few percent of the
-/// image, at a cost far below one real sample per pixel.
+/// The probe's image width in rays (its height follows the image's aspect ratio: 18 for
+/// 16:9): enough to see any object that covers a few percent of the image, at a cost far
+/// below one real sample per pixel.
 pub const PROBE_WIDTH: u32 = 32;
-pub const PROBE_HEIGHT: u32 = 18;
 
 /// Mirror and see-through bounces the probe follows.
 const PROBE_DEPTH: u32 = 4;
@@ -85,14 +85,15 @@ fn shape_of(g: &Geometry) -> Option<Shape> {
     }
 }
 
-/// The material draws nothing: fully transparent and not refracting, not a mirror.
+/// The material draws nothing: fully transparent and not refracting. (Its reflectivity does
+/// not help: the shading model weighs the mirror term by the opacity, `docs/shading.md`.)
 fn invisible(m: &Material) -> bool {
-    m.opacity <= 0.0 && m.reflectivity <= 0.0 && (m.ior - 1.0).abs() < 1e-6
+    m.opacity <= 0.0 && (m.ior - 1.0).abs() < 1e-6
 }
 
 /// A mirror that shows only what it reflects.
 fn perfect_mirror(m: &Material) -> bool {
-    m.reflectivity >= 0.999
+    m.reflectivity * m.opacity >= 0.999
 }
 
 struct Probe<'s> {
@@ -199,7 +200,7 @@ impl<'s> Probe<'s> {
             return (Seen::Black, back);
         }
         let mut seen = Seen::Black;
-        if m.reflectivity > 0.0 {
+        if m.reflectivity * m.opacity > 0.0 {
             let dir = reflect(view, hit.normal);
             let (s, _) = self.trace(&spawn_ray(hit.point, hit.normal, dir), depth + 1);
             seen = combine(seen, s);
@@ -220,18 +221,23 @@ fn combine(a: Seen, b: Seen) -> Seen {
     }
 }
 
-/// The primary ray through the centre of probe pixel (`x`, `y`), as `render::camera` makes
-/// it; `None` for a camera the renderer would refuse (reported elsewhere).
-fn primary_rays(cam: &Camera) -> Option<Vec<Ray>> {
+/// The probe's primary rays, as `render::camera` makes them for an image of `width` ×
+/// `height`; `None` for a camera the renderer would refuse (reported elsewhere).
+fn primary_rays(cam: &Camera, width: u32, height: u32) -> Option<Vec<Ray>> {
     let d = cam.dir.try_normalize()?;
     let r = d.cross(cam.up).try_normalize()?;
     let u = r.cross(d);
-    let (w, h) = (f64::from(PROBE_WIDTH), f64::from(PROBE_HEIGHT));
+    // The image's own aspect ratio (the vertical field of view follows from it), on a grid
+    // of PROBE_WIDTH columns whose outer rays run along the image's edges.
+    let aspect = f64::from(height.max(1)) / f64::from(width.max(1));
+    let rows = ((f64::from(PROBE_WIDTH) * aspect).round() as u32).clamp(2, 2 * PROBE_WIDTH);
+    let (w, h) = (f64::from(PROBE_WIDTH), f64::from(PROBE_WIDTH) * aspect);
     let dist = (w / 2.0) / (cam.fov_x_deg.to_radians() / 2.0).tan();
     let mut rays = Vec::new();
-    for y in 0..PROBE_HEIGHT {
+    for y in 0..rows {
         for x in 0..PROBE_WIDTH {
-            let (px, py) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let px = f64::from(x) * w / f64::from(PROBE_WIDTH - 1);
+            let py = f64::from(y) * h / f64::from(rows - 1);
             let dir = d * dist + r * (px - w / 2.0) + u * (h / 2.0 - py);
             rays.push(Ray::new(v(cam.eye), v(dir.normalize())));
         }
@@ -247,7 +253,7 @@ pub fn blank_image(job: &RenderJob) -> Option<Blank> {
     if scene.instances.is_empty() {
         return blank("the scene has no shapes at all: the image is only the background".into());
     }
-    let rays = primary_rays(&job.camera)?;
+    let rays = primary_rays(&job.camera, job.width, job.height)?;
     let probe = Probe::new(scene);
     let mut seen = Vec::with_capacity(rays.len());
     for ray in &rays {
@@ -273,7 +279,7 @@ pub fn blank_image(job: &RenderJob) -> Option<Blank> {
     if hits_any_geometry && visible.is_empty() {
         let names = material_names(probe.placed.iter().map(|p| p.material));
         return blank(format!(
-            "every visible material is invisible (opacity 0, ior 1): {names}"
+            "every material the camera could see is invisible (opacity 0, ior 1): {names}"
         ));
     }
     if !hits_any_geometry {
@@ -453,6 +459,15 @@ mod tests {
             .to_string()
             + CAM;
         assert!(probe(&text).unwrap().contains("mirror"));
+    }
+
+    #[test]
+    fn a_cone_off_axis_is_seen() {
+        let text = "define material violet 0.3 0.0 0.6 0.5 0.0 0.8 0.1 0.0 0.3 1.0\n\
+                    define shape cone c 2.0 4.0 -10 4.0 7.0 -5 2 violet\n\
+                    define light spot 0 0 0 0.3 0.3 0.3 0.9 0.9 0.9\n\
+                    define camera eye 45.0\nrender eye out.ppm 1000 800\n";
+        assert_eq!(probe(text), None);
     }
 
     #[test]

@@ -63,7 +63,7 @@ const CANDIDATES: &[(&[Slot], bool)] = &[
 /// most numbers look like fractions, so it must win clearly.
 const PERCENT_HANDICAP: f64 = 0.5;
 
-/// Opacity and reflectivity below this leave a non-refracting material all but invisible.
+/// Opacity below this leaves a non-refracting material all but invisible.
 const NEARLY_INVISIBLE: f64 = 0.05;
 
 /// The reading of `--material-fields reflectivity,opacity,ior`.
@@ -158,7 +158,7 @@ pub(super) fn slot_name(s: Slot) -> &'static str {
 fn score_material(layout: &Layout, extras: &[f64]) -> Option<f64> {
     let slots = layout.read(extras.len())?;
     let mut score = 0.0;
-    let (mut opacity, mut reflectivity, mut ior) = (1.0, 0.0, 1.0);
+    let (mut opacity, mut ior) = (1.0, 1.0);
     for (&slot, &raw) in slots.iter().zip(extras) {
         let v = layout.value(slot, raw);
         score += match slot {
@@ -170,12 +170,11 @@ fn score_material(layout: &Layout, extras: &[f64]) -> Option<f64> {
             F(f) => {
                 let fraction = (0.0..=1.0).contains(&v);
                 match f {
-                    R => reflectivity = v,
                     O => opacity = v,
                     T => opacity = 1.0 - v,
                     // The reader repairs an unusable index to air's.
                     I => ior = if v > 0.0 { v } else { 1.0 },
-                    MaterialField::Roughness => {}
+                    R | MaterialField::Roughness => {}
                 }
                 let raw_fraction = raw > 0.0 && raw <= 1.0;
                 match f {
@@ -196,7 +195,9 @@ fn score_material(layout: &Layout, extras: &[f64]) -> Option<f64> {
         };
     }
     // A material nobody can see is almost never what the author meant.
-    if opacity < NEARLY_INVISIBLE && reflectivity < NEARLY_INVISIBLE && (ior - 1.0).abs() < 1e-9 {
+    // (The shading model weighs the mirror term by the opacity, so reflectivity does not
+    // make a transparent material visible.)
+    if opacity < NEARLY_INVISIBLE && (ior - 1.0).abs() < 1e-9 {
         score -= 2.0;
     }
     Some(score)
