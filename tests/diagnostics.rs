@@ -330,7 +330,10 @@ fn the_binary_refuses_broken_files_without_writing_images() {
         ("define shape sphere s 0 0 1O 1 red\n", "2:27"),
         ("transform ghost scale 2\n", "2:11"),
         ("define camera c 60 0 0 0 0 0 -1 0 0 2\n", "2:33"),
-        ("define material m 1 1 1 1 1 1 1 1 1 10 0 1 1 0.5 0.5\n", "2:46"),
+        (
+            "define material m 1 1 1 1 1 1 1 1 1 10 0 1 1 0.5 0.5\n",
+            "2:46",
+        ),
     ];
     for (bad_line, place) in cases {
         let dir = tempfile::tempdir().expect("temp dir");

@@ -21,7 +21,11 @@ fn corpus_files(test: &str) -> Option<Vec<PathBuf>> {
     let dir = shared_dir(test)?.join("corpus/wild");
     let mut files = Vec::new();
     for entry in std::fs::read_dir(&dir).ok()?.flatten() {
-        for file in std::fs::read_dir(entry.path()).into_iter().flatten().flatten() {
+        for file in std::fs::read_dir(entry.path())
+            .into_iter()
+            .flatten()
+            .flatten()
+        {
             files.push(file.path());
         }
     }
@@ -60,7 +64,11 @@ fn corpus_summary_has_no_silent_blank_images() {
     let mut table = String::new();
     for file in files.iter().filter(|f| !f.ends_with("MANIFEST.tsv")) {
         let name = file
-            .strip_prefix(file.parent().and_then(Path::parent).unwrap_or(Path::new("")))
+            .strip_prefix(
+                file.parent()
+                    .and_then(Path::parent)
+                    .unwrap_or(Path::new("")),
+            )
             .unwrap_or(file)
             .display()
             .to_string();
@@ -103,7 +111,10 @@ fn fourteen_number_materials_are_read_with_glossiness_ignored() {
     assert!(stderr.contains("--material-fields"), "{stderr}");
     let (code, stderr) = check(&file, &["--material-fields", "reflectivity,opacity,ior"]);
     assert_eq!(code, 1, "{stderr}");
-    assert!(stderr.contains("too many numbers for a material"), "{stderr}");
+    assert!(
+        stderr.contains("too many numbers for a material"),
+        "{stderr}"
+    );
 }
 
 /// Corpus files whose materials only make sense in another layout.
@@ -114,7 +125,10 @@ fn corpus_layouts_are_inferred() {
             "christiandunkel__raytracer/spheresInSkyScene.sdf",
             "transparency",
         ),
-        ("perlauy__programmiersprachen-raytracer/scene_composite.sdf", "m ior opacity"),
+        (
+            "perlauy__programmiersprachen-raytracer/scene_composite.sdf",
+            "m ior opacity",
+        ),
         ("tgrochow__scene/animation.sdf", "m opacity ior"),
         (
             "jacoblammert__programmiersprachen-raytracer/start.sdf",

@@ -70,12 +70,14 @@ fn v(x: DVec3) -> Vec3A {
 
 fn shape_of(g: &Geometry) -> Option<Shape> {
     match *g {
-        Geometry::Sphere { center, radius } => Sphere::new(v(center), radius as f32).map(Shape::Sphere),
+        Geometry::Sphere { center, radius } => {
+            Sphere::new(v(center), radius as f32).map(Shape::Sphere)
+        }
         Geometry::Box { p1, p2 } => AaBox::new(v(p1), v(p2)).map(Shape::Box),
         Geometry::Plane { point, normal } => Plane::new(v(point), v(normal)).map(Shape::Plane),
-        Geometry::Triangle { vertices: [a, b, c] } => {
-            Triangle::new(v(a), v(b), v(c)).map(Shape::Triangle)
-        }
+        Geometry::Triangle {
+            vertices: [a, b, c],
+        } => Triangle::new(v(a), v(b), v(c)).map(Shape::Triangle),
         Geometry::Cylinder { p1, p2, radius } => {
             Cylinder::new(v(p1), v(p2), radius as f32).map(Shape::Cylinder)
         }
@@ -273,7 +275,9 @@ pub fn blank_image(job: &RenderJob) -> Option<Blank> {
             let xf = &p.instance.transform;
             let o = xf.object_from_world.transform_point3(ray.origin.as_dvec3());
             let d = xf.object_from_world.transform_vector3(ray.dir.as_dvec3());
-            p.shape.intersect(&Ray::new(v(o), v(d)), f32::INFINITY).is_some()
+            p.shape
+                .intersect(&Ray::new(v(o), v(d)), f32::INFINITY)
+                .is_some()
         })
     });
     if hits_any_geometry && visible.is_empty() {
@@ -290,7 +294,10 @@ pub fn blank_image(job: &RenderJob) -> Option<Blank> {
             if !b.min.is_finite() || !b.max.is_finite() {
                 return false;
             }
-            let center = p.instance.transform.point(((b.min + b.max) * 0.5).as_dvec3());
+            let center = p
+                .instance
+                .transform
+                .point(((b.min + b.max) * 0.5).as_dvec3());
             (center - eye).dot(dir) < 0.0
         });
         return blank(if behind {
@@ -415,9 +422,8 @@ mod tests {
 
     #[test]
     fn a_lit_sphere_is_not_blank() {
-        let text = format!(
-            "{MAT}define shape sphere s 0 0 -5 1 red\ndefine light l 0 5 0 1 1 1 1\n{CAM}"
-        );
+        let text =
+            format!("{MAT}define shape sphere s 0 0 -5 1 red\ndefine light l 0 5 0 1 1 1 1\n{CAM}");
         assert_eq!(probe(&text), None);
     }
 
@@ -429,9 +435,8 @@ mod tests {
 
     #[test]
     fn every_shape_behind_the_camera() {
-        let text = format!(
-            "{MAT}define shape sphere s 0 0 5 1 red\ndefine light l 0 5 0 1 1 1 1\n{CAM}"
-        );
+        let text =
+            format!("{MAT}define shape sphere s 0 0 5 1 red\ndefine light l 0 5 0 1 1 1 1\n{CAM}");
         assert!(probe(&text).unwrap().contains("behind"));
     }
 

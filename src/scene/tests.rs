@@ -712,7 +712,10 @@ fn define_renderer_names_its_camera() {
     ));
     assert_eq!(l.jobs.len(), 1);
     let job = &l.jobs[0];
-    assert_eq!((job.camera.name.as_str(), job.width, job.height), ("eye", 32, 24));
+    assert_eq!(
+        (job.camera.name.as_str(), job.width, job.height),
+        ("eye", 32, 24)
+    );
     assert_eq!(job.output, Path::new("out.ppm"));
 }
 
@@ -722,9 +725,15 @@ fn a_bad_render_line_rejects_only_its_own_image() {
         "{MATERIAL}define camera a 60\ndefine camera b 60\nrender a one.png 0 8\nrender b two.png 8 8\n"
     ));
     assert_eq!(l.jobs.len(), 1);
-    assert!(warnings(&l).contains("this render line is skipped"), "{}", warnings(&l));
+    assert!(
+        warnings(&l).contains("this render line is skipped"),
+        "{}",
+        warnings(&l)
+    );
     // Alone, it is still an error.
-    let ds = errors(&format!("{MATERIAL}define camera a 60\nrender a one.png 0 8\n"));
+    let ds = errors(&format!(
+        "{MATERIAL}define camera a 60\nrender a one.png 0 8\n"
+    ));
     assert!(ds.iter().any(Diagnostic::is_error));
 }
 

@@ -4,8 +4,8 @@
 use super::definitions::{Definitions, ObjectKind};
 use super::{At, Builder};
 use crate::diag::Severity;
-use crate::sdf::ast::NameRef;
 use crate::scene::Material;
+use crate::sdf::ast::NameRef;
 use glam::Vec3;
 use std::collections::HashMap;
 
@@ -60,7 +60,10 @@ impl Builder<'_> {
             if self.skipped(&material.name) {
                 continue;
             }
-            match by_material.iter_mut().find(|(m, _)| m.name == material.name) {
+            match by_material
+                .iter_mut()
+                .find(|(m, _)| m.name == material.name)
+            {
                 Some((_, shapes)) => shapes.push(shape),
                 None => by_material.push((material, vec![shape])),
             }
@@ -87,7 +90,11 @@ impl Builder<'_> {
                 format!(
                     "unknown material `{}`: {} drawn in magenta ({} {})",
                     material.name,
-                    if shapes.len() == 1 { "the shape is" } else { "the shapes are" },
+                    if shapes.len() == 1 {
+                        "the shape is"
+                    } else {
+                        "the shapes are"
+                    },
                     if shapes.len() == 1 { "shape" } else { "shapes" },
                     list.join(", ")
                 ),

@@ -11,7 +11,9 @@ const FORM_CAMERA: &str = "define camera <name> <fov-x> [eye] [dir] [up]";
 
 /// Whether a camera line's number can be an image side (a whole number of pixels).
 fn is_image_side(v: f64) -> bool {
-    v.fract() == 0.0 && v >= f64::from(*limits::IMAGE_SIDE.start()) && v <= f64::from(*limits::IMAGE_SIDE.end())
+    v.fract() == 0.0
+        && v >= f64::from(*limits::IMAGE_SIDE.start())
+        && v <= f64::from(*limits::IMAGE_SIDE.end())
 }
 
 impl Parser<'_> {
@@ -157,7 +159,12 @@ impl Parser<'_> {
             if is_zero(def.dir) {
                 // Some renderers read these as rotation angles; 0 0 0 then means the default
                 // pose, which is written without them.
-                let eye = format!("{} {} {}", toks[first + 1].text, toks[first + 2].text, toks[first + 3].text);
+                let eye = format!(
+                    "{} {} {}",
+                    toks[first + 1].text,
+                    toks[first + 2].text,
+                    toks[first + 3].text
+                );
                 return Err(self.error(
                     line,
                     At::Span(first + 4, first + 6),

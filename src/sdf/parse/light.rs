@@ -73,7 +73,13 @@ impl Parser<'_> {
             color,
             brightness,
         };
-        if let Some(worst) = nums.iter().skip(3).copied().reduce(f64::min).filter(|&v| v < 0.0) {
+        if let Some(worst) = nums
+            .iter()
+            .skip(3)
+            .copied()
+            .reduce(f64::min)
+            .filter(|&v| v < 0.0)
+        {
             self.warn(
                 line,
                 At::Span(name_at + 4, toks.len() - 1),

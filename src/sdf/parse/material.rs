@@ -175,7 +175,12 @@ impl Parser<'_> {
             "{force}force another with --material-fields LIST, e.g. the default \
              `--material-fields reflectivity,opacity,ior`"
         );
-        self.warn(line, At::Span(12, line.tokens.len() - 1), message, Some(help));
+        self.warn(
+            line,
+            At::Span(12, line.tokens.len() - 1),
+            message,
+            Some(help),
+        );
     }
 
     fn too_many_numbers(&mut self, line: &Line, n: usize) -> Fail {

@@ -143,7 +143,10 @@ impl Parser<'_> {
                         def.camera.name = only.clone();
                     }
                     cameras => {
-                        let help = match crate::diag::suggest(&def.camera.name, cameras.iter().map(String::as_str)) {
+                        let help = match crate::diag::suggest(
+                            &def.camera.name,
+                            cameras.iter().map(String::as_str),
+                        ) {
                             Some(s) => format!("did you mean `{s}`?"),
                             None if cameras.is_empty() => {
                                 "the file defines no camera: add `define camera <name> <fov-x>`"
@@ -156,7 +159,10 @@ impl Parser<'_> {
                             def.camera.loc.clone(),
                             format!("unknown camera `{}`", def.camera.name),
                         )
-                        .with_source(pending.anchor.text.clone(), def.camera.name.chars().count() as u32)
+                        .with_source(
+                            pending.anchor.text.clone(),
+                            def.camera.name.chars().count() as u32,
+                        )
                         .with_help(help);
                         self.render_errors.push(d);
                         rejected.push(pending.index);
@@ -199,10 +205,9 @@ impl Parser<'_> {
                             "no image size given: {w}×{h} from the camera's line is used"
                         ));
                     }
-                    None => notes.push(format!(
-                        "no image size given: {}×{}",
-                        def.width, def.height
-                    )),
+                    None => {
+                        notes.push(format!("no image size given: {}×{}", def.width, def.height))
+                    }
                 }
             }
             if def.output.is_empty() {

@@ -159,7 +159,9 @@ impl Parser<'_> {
                     "translate with a fourth number 1 (a homogeneous coordinate) read as x y z"
                         .to_string(),
                 ));
-                Outcome::Op(TransformOp::Translate(DVec3::new(nums[0], nums[1], nums[2])))
+                Outcome::Op(TransformOp::Translate(DVec3::new(
+                    nums[0], nums[1], nums[2],
+                )))
             }
             "translate" => self.wrong_count(
                 line,
