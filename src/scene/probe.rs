@@ -230,16 +230,22 @@ fn primary_rays(cam: &Camera, width: u32, height: u32) -> Option<Vec<Ray>> {
     let r = d.cross(cam.up).try_normalize()?;
     let u = r.cross(d);
     // The image's own aspect ratio (the vertical field of view follows from it), on a grid
-    // of PROBE_WIDTH columns whose outer rays run along the image's edges.
+    // of PROBE_WIDTH columns.
     let aspect = f64::from(height.max(1)) / f64::from(width.max(1));
     let rows = ((f64::from(PROBE_WIDTH) * aspect).round() as u32).clamp(2, 2 * PROBE_WIDTH);
     let (w, h) = (f64::from(PROBE_WIDTH), f64::from(PROBE_WIDTH) * aspect);
     let dist = (w / 2.0) / (cam.fov_x_deg.to_radians() / 2.0).tan();
     let mut rays = Vec::new();
+    // The outer rays go through the centres of the image's outer pixels: what lies beyond
+    // them is never drawn.
+    let (ex, ey) = (
+        0.5 * w / f64::from(width.max(1)),
+        0.5 * h / f64::from(height.max(1)),
+    );
     for y in 0..rows {
         for x in 0..PROBE_WIDTH {
-            let px = f64::from(x) * w / f64::from(PROBE_WIDTH - 1);
-            let py = f64::from(y) * h / f64::from(rows - 1);
+            let px = ex + f64::from(x) * (w - 2.0 * ex) / f64::from(PROBE_WIDTH - 1);
+            let py = ey + f64::from(y) * (h - 2.0 * ey) / f64::from(rows - 1);
             let dir = d * dist + r * (px - w / 2.0) + u * (h / 2.0 - py);
             rays.push(Ray::new(v(cam.eye), v(dir.normalize())));
         }
