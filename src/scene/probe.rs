@@ -22,6 +22,10 @@ use std::sync::Arc;
 /// below one real sample per pixel.
 pub const PROBE_WIDTH: u32 = 32;
 
+/// Ray–shape tests the probe may spend on primary rays (each also costs shadow rays): it
+/// tests every shape for every ray, so a huge scene would cost more than its render.
+const PROBE_BUDGET: usize = 20_000_000;
+
 /// Mirror and see-through bounces the probe follows.
 const PROBE_DEPTH: u32 = 4;
 
@@ -263,6 +267,11 @@ pub fn blank_image(job: &RenderJob) -> Option<Blank> {
     }
     let rays = primary_rays(&job.camera, job.width, job.height)?;
     let probe = Probe::new(scene);
+    if probe.placed.len().saturating_mul(rays.len()) > PROBE_BUDGET {
+        // Scenes this big are generated, and their images are rarely empty: the probe
+        // stays cheap rather than exhaustive (the reasons above still apply).
+        return None;
+    }
     let mut seen = Vec::with_capacity(rays.len());
     for ray in &rays {
         seen.push(probe.trace(ray, 0));
