@@ -205,8 +205,34 @@ fn score_material(layout: &Layout, extras: &[f64]) -> Option<f64> {
 
 /// The total score of `layout` over every material, `None` if it cannot read one of them.
 fn score(layout: &Layout, materials: &[Vec<f64>]) -> Option<f64> {
-    materials.iter().map(|e| score_material(layout, e)).sum()
+    let total: f64 = materials
+        .iter()
+        .map(|e| score_material(layout, e))
+        .sum::<Option<f64>>()?;
+    // One perfect mirror is a common showpiece; a file of mostly perfect mirrors is a file
+    // read in the wrong layout.
+    let mirrors = materials
+        .iter()
+        .filter(|e| perfect_mirror(layout, e))
+        .count();
+    if materials.len() >= 2 && 2 * mirrors > materials.len() {
+        return Some(total - MIRROR_FILE_PENALTY * mirrors as f64);
+    }
+    Some(total)
 }
+
+/// Whether `layout` reads the material as a perfect mirror (reflectivity 1).
+fn perfect_mirror(layout: &Layout, extras: &[f64]) -> bool {
+    layout.read(extras.len()).is_some_and(|slots| {
+        slots
+            .iter()
+            .zip(extras)
+            .any(|(&slot, &v)| slot == F(R) && layout.value(slot, v) >= 1.0)
+    })
+}
+
+/// Score taken per perfect mirror from a reading that makes most of a file's materials ones.
+const MIRROR_FILE_PENALTY: f64 = 2.0;
 
 /// The best layout for the materials (each given by its numbers after the nine colours) and
 /// whether it differs from the default. `None` when no candidate reads every material (the
