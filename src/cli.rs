@@ -38,9 +38,10 @@ pub struct SceneArgs {
     #[arg(long)]
     pub strict: bool,
     /// Meaning of the numbers after `m` in material lines, in order
-    /// (reflectivity, opacity, transparency, ior, roughness).
-    #[arg(long, value_name = "LIST", default_value = "reflectivity,opacity,ior", value_parser = parse_material_fields, value_delimiter = ',')]
-    pub material_fields: Vec<MaterialField>,
+    /// (reflectivity, opacity, transparency, ior, roughness), or `auto`: the layout that
+    /// makes every material of the file plausible (one warning says which was taken).
+    #[arg(long, value_name = "LIST", default_value = "auto", value_parser = parse_material_fields, value_delimiter = ',')]
+    pub material_fields: Vec<Option<MaterialField>>,
     /// How a transform statement composes with earlier ones: `world` (M ← T·M, the
     /// default) or `local` (M ← M·T).
     #[arg(long, value_enum, default_value = "world")]
@@ -240,15 +241,18 @@ fn parse_error_target(s: &str) -> Result<f32, String> {
     }
 }
 
-pub fn parse_material_fields(s: &str) -> Result<MaterialField, String> {
+/// One entry of `--material-fields`; `None` is `auto`, which the loader reads as an empty
+/// list (infer the layout per file).
+pub fn parse_material_fields(s: &str) -> Result<Option<MaterialField>, String> {
     match s.trim() {
-        "reflectivity" => Ok(MaterialField::Reflectivity),
-        "opacity" => Ok(MaterialField::Opacity),
-        "transparency" => Ok(MaterialField::Transparency),
-        "ior" => Ok(MaterialField::Ior),
-        "roughness" => Ok(MaterialField::Roughness),
+        "auto" => Ok(None),
+        "reflectivity" => Ok(Some(MaterialField::Reflectivity)),
+        "opacity" => Ok(Some(MaterialField::Opacity)),
+        "transparency" => Ok(Some(MaterialField::Transparency)),
+        "ior" => Ok(Some(MaterialField::Ior)),
+        "roughness" => Ok(Some(MaterialField::Roughness)),
         other => Err(format!(
-            "unknown material field '{other}' (expected reflectivity, opacity, transparency, ior or roughness)"
+            "unknown material field '{other}' (expected auto, or a list from reflectivity, opacity, transparency, ior and roughness)"
         )),
     }
 }
@@ -367,7 +371,12 @@ impl SceneArgs {
     pub fn load_options(&self) -> LoadOptions {
         LoadOptions {
             strict: self.strict,
-            material_fields: self.material_fields.clone(),
+            // `auto` anywhere in the list means the whole list is inferred.
+            material_fields: if self.material_fields.contains(&None) {
+                Vec::new()
+            } else {
+                self.material_fields.iter().flatten().copied().collect()
+            },
             transform_order: match self.transform_order {
                 TransformOrderArg::World => TransformOrder::World,
                 TransformOrderArg::Local => TransformOrder::Local,

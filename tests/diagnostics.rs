@@ -85,7 +85,7 @@ const ROWS: &[Row] = &[
     row("hexadecimal", concat!(head!(), "define shape box b 0x10 0 0 1 1 1 red\n", tail!()),
         Diag(E, at(2, 20), "found '0x10'")),
     row("C float suffix", concat!(head!(), "define camera c2 1.5f\n", tail!()),
-        Diag(E, at(2, 18), "write `1.5`")),
+        Diag(W, at(2, 18), "read as `1.5`")),
     row("decimal comma", concat!(head!(), "define shape sphere s 0 0 0 1,5 red\n", tail!()),
         Diag(E, at(2, 29), "use a decimal point: `1.5`")),
     row("every documented number form", concat!(head!(),
@@ -94,13 +94,13 @@ const ROWS: &[Row] = &[
     row("CRLF line endings", "define material red 1 0 0 1 0 0 1 0 0 10\r\ndefine camera cam 60\r\nrender cam out.png 8 8\r\n",
         Clean),
     row("CRLF keeps columns right", "define material red 1 0 0 1 0 0 1 0 0 10\r\ndefine shape sphere s 0 0 0 1 rde\r\ndefine camera cam 60\r\nrender cam out.png 8 8\r\n",
-        Diag(E, at(2, 31), "unknown material `rde`")),
+        Diag(W, at(2, 31), "unknown material `rde`")),
     row("no final newline", "define material red 1 0 0 1 0 0 1 0 0 10\ndefine camera cam 60\nrender cam out.png 8 8",
         Clean),
     row("error on a last line without newline", concat!(base!(), "transform cam scale 0"),
         Diag(E, at(4, 21), "scale by 0")),
     row("tabs separate tokens and count as one column", concat!(head!(), "define\tshape\tsphere\ts\t0 0 0 1\trde\n", tail!()),
-        Diag(E, at(2, 31), "did you mean `red`?")),
+        Diag(W, at(2, 31), "did you mean `red`?")),
     row("double-slash comment line", concat!(head!(), "// define shape sphere s 0 0 0 1 nothing\n", tail!()),
         Clean),
     row("trailing hash comment", concat!(head!(), "define shape sphere s 0 0 0 1 red # a ball\n", tail!()),
@@ -108,7 +108,7 @@ const ROWS: &[Row] = &[
     row("hash comment glued to a token", concat!(head!(), "define shape sphere s 0 0 0 1 red#ball\n", tail!()),
         Clean),
     row("columns count characters, not bytes", concat!(head!(), "define shape sphere jklö 0 0 0 1 rde\n", tail!()),
-        Diag(E, at(2, 34), "unknown material `rde`")),
+        Diag(W, at(2, 34), "unknown material `rde`")),
     // ----- unknown statements ----------------------------------------------------------
     row("typo in define", concat!(head!(), "efine shape sphere s 0 0 0 1 red\n", tail!()),
         Diag(W, at(2, 1), "did you mean `define`?")),
@@ -145,7 +145,7 @@ const ROWS: &[Row] = &[
         Clean),
     // ----- shapes ----------------------------------------------------------------------
     row("unknown material with suggestion", concat!(head!(), "define shape sphere s 0 0 0 1 rde\n", tail!()),
-        Diag(E, at(2, 31), "did you mean `red`?")),
+        Diag(W, at(2, 31), "did you mean `red`?")),
     row("sphere with too few numbers", concat!(head!(), "define shape sphere s 0 0 1 red\n", tail!()),
         Diag(E, at(2, 29), "a sphere takes 4 numbers")),
     row("shape without material", concat!(head!(), "define shape sphere s 0 0 0 1\n", tail!()),
@@ -214,9 +214,9 @@ const ROWS: &[Row] = &[
     row("camera with zero direction", concat!(head!(), "define camera c 60 0 0 0 0 0 0 0 1 0\n", tail!()),
         Diag(E, at(2, 26), "viewing direction is zero")),
     row("camera with fov last", concat!(head!(), "define camera c 0 0 0 0 0 -1 0 1 0 90\n", tail!()),
-        Diag(E, at(2, 17), "the fov comes first")),
+        Diag(W, at(2, 17), "the fov comes first")),
     row("camera with a resolution after the fov", concat!(head!(), "camera c 45 500 500\n", tail!()),
-        Diag(E, at(2, 10), "belongs on the render line")),
+        Diag(W, at(2, 10), "belongs on the render line")),
     row("camera with only an eye", concat!(head!(), "define camera c 60 10 0 0\n", tail!()),
         Diag(W, at(2, 20), "looking along -z with y up")),
     row("camera with a stray number after up", concat!(head!(), "define camera c 60 0 0 0 0 0 -1 0 1 0 0\n", tail!()),
@@ -225,7 +225,7 @@ const ROWS: &[Row] = &[
         Diag(W, at(4, 15), "camera `cam` is already defined")),
     // ----- render ----------------------------------------------------------------------
     row("render with an unknown camera", "define camera eye 60\nrender eey out.png 8 8\n",
-        Diag(E, at(2, 8), "did you mean `eye`?")),
+        Diag(W, at(2, 8), "did you mean `eye`?")),
     row("render size not whole", "define camera eye 60\nrender eye out.png 8.5 8\n",
         Diag(E, at(2, 20), "whole number")),
     row("render without height", "define camera eye 60\nrender eye out.png 8\n",
@@ -328,10 +328,12 @@ fn diagnostics_quote_the_line_with_a_caret_under_the_token() {
 fn the_binary_refuses_broken_files_without_writing_images() {
     let cases = [
         ("define shape sphere s 0 0 1O 1 red\n", "2:27"),
-        ("define shape sphere s 0 0 0 1 rde\n", "2:31"),
         ("transform ghost scale 2\n", "2:11"),
         ("define camera c 60 0 0 0 0 0 -1 0 0 2\n", "2:33"),
-        ("define material m 1 1 1 1 1 1 1 1 1 10 0 1 1 0.5\n", "2:46"),
+        (
+            "define material m 1 1 1 1 1 1 1 1 1 10 0 1 1 0.5 0.5\n",
+            "2:46",
+        ),
     ];
     for (bad_line, place) in cases {
         let dir = tempfile::tempdir().expect("temp dir");
@@ -369,7 +371,16 @@ fn the_binary_refuses_broken_files_without_writing_images() {
 #[test]
 fn check_command_summarises() {
     let dir = tempfile::tempdir().expect("temp dir");
-    std::fs::write(dir.path().join("good.sdf"), base!()).expect("write");
+    // A file with nothing to see is itself worth a warning (the image would be blank).
+    std::fs::write(
+        dir.path().join("good.sdf"),
+        concat!(
+            head!(),
+            "define shape sphere s 0 0 -5 1 red\ndefine light l 0 5 0 1 1 1 1\n",
+            tail!()
+        ),
+    )
+    .expect("write");
     std::fs::write(
         dir.path().join("warned.txt"),
         concat!(head!(), "efine x\n", tail!()),
@@ -377,7 +388,7 @@ fn check_command_summarises() {
     .expect("write");
     std::fs::write(
         dir.path().join("bad"),
-        concat!(head!(), "define shape sphere s 0 0 0 1 rde\n", tail!()),
+        concat!(head!(), "define shape sphere s 0 0 1O 1 red\n", tail!()),
     )
     .expect("write");
     std::fs::write(dir.path().join("notes.md"), "not a scene").expect("write");
@@ -395,7 +406,7 @@ fn check_command_summarises() {
         "{stdout}"
     );
     assert!(
-        stderr.contains("bad:2:31: error: unknown material `rde`"),
+        stderr.contains("bad:2:27: error: expected a number"),
         "{stderr}"
     );
     assert!(stderr.contains("warned.txt:2:1: warning"), "{stderr}");

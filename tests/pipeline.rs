@@ -185,7 +185,7 @@ fn a_failing_frame_does_not_stop_the_others() {
     let dir = frames(4);
     std::fs::write(
         dir.path().join("frame_0002.sdf"),
-        "define material red 0.2 0 0 0.8 0.1 0.1 0.5 0.5 0.5 20\ndefine shape sphere ball 0 0 -5 1 rde\ndefine camera cam 60\nrender cam frame_0002.png 16 12\n",
+        "define material red 0.2 0 0 0.8 0.1 0.1 0.5 0.5 0.5 20\ndefine shape sphere ball 0 0 -5 1O red\ndefine camera cam 60\nrender cam frame_0002.png 16 12\n",
     )
     .expect("write");
     let s = render(dir.path(), &[]);
@@ -282,7 +282,7 @@ fn generate_errors_in_an_inline_scene_point_into_the_spec() {
     let spec = dir.path().join("inline.ron");
     std::fs::write(
         &spec,
-        "(\n  scene: Inline(r#\"\ndefine camera cam 60\ndefine shape sphere s 0 0 -5 1 nomat\n\"#),\n  length: Frames(2),\n  resolution: (8, 8),\n)\n",
+        "(\n  scene: Inline(r#\"\ndefine camera cam 60\ndefine shape sphere s 0 0 -5 1O nomat\n\"#),\n  length: Frames(2),\n  resolution: (8, 8),\n)\n",
     )
     .expect("write");
     let out = Command::cargo_bin("anim")

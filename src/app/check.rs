@@ -42,7 +42,14 @@ pub fn run(config: &CheckConfig) -> ExitCode {
     let (mut ok, mut warned, mut rejected) = (0usize, 0usize, 0usize);
     for file in &files {
         match load_file(file, opts) {
-            Ok(loaded) => {
+            Ok(mut loaded) => {
+                // What the camera would see, as `anim render` checks it.
+                loaded
+                    .diagnostics
+                    .extend(crate::scene::probe::blank_image_warnings(
+                        &loaded.jobs,
+                        file,
+                    ));
                 if loaded.diagnostics.is_empty() {
                     ok += 1;
                 } else {

@@ -126,6 +126,12 @@ pub fn render_scene_file(
 ) -> Result<FileOutcome, Vec<Diagnostic>> {
     let loaded = crate::scene::load_file(path, load)?;
     let mut warnings = loaded.diagnostics;
+    // A file that loads but would render one flat colour says why, instead of handing back a
+    // blank image in silence.
+    warnings.extend(crate::scene::probe::blank_image_warnings(
+        &loaded.jobs,
+        path,
+    ));
     // Resolve every output before rendering anything, so a bad name fails fast.
     let mut targets = Vec::with_capacity(loaded.jobs.len());
     let mut errors = Vec::new();

@@ -5,6 +5,7 @@
 
 mod build;
 mod load;
+pub mod probe;
 #[cfg(test)]
 mod tests;
 

@@ -686,3 +686,195 @@ fn camera_with_only_an_eye_and_light_without_position() {
     );
     assert!(job.scene.lights.is_empty());
 }
+
+// ----- forms other renderers accepted (the author-intent issue) ---------------------------
+
+fn warnings(loaded: &Loaded) -> String {
+    loaded
+        .diagnostics
+        .iter()
+        .map(|d| d.to_string())
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+fn auto() -> LoadOptions {
+    LoadOptions {
+        material_fields: Vec::new(),
+        ..LoadOptions::default()
+    }
+}
+
+#[test]
+fn define_renderer_names_its_camera() {
+    let l = load(&format!(
+        "{MATERIAL}define camera eye 60\ndefine renderer eye out.ppm 32 24\n"
+    ));
+    assert_eq!(l.jobs.len(), 1);
+    let job = &l.jobs[0];
+    assert_eq!(
+        (job.camera.name.as_str(), job.width, job.height),
+        ("eye", 32, 24)
+    );
+    assert_eq!(job.output, Path::new("out.ppm"));
+}
+
+#[test]
+fn a_bad_render_line_rejects_only_its_own_image() {
+    let l = load(&format!(
+        "{MATERIAL}define camera a 60\ndefine camera b 60\nrender a one.png 0 8\nrender b two.png 8 8\n"
+    ));
+    assert_eq!(l.jobs.len(), 1);
+    assert!(
+        warnings(&l).contains("this render line is skipped"),
+        "{}",
+        warnings(&l)
+    );
+    // Alone, it is still an error.
+    let ds = errors(&format!(
+        "{MATERIAL}define camera a 60\nrender a one.png 0 8\n"
+    ));
+    assert!(ds.iter().any(Diagnostic::is_error));
+}
+
+#[test]
+fn an_unknown_render_camera_means_the_only_one() {
+    let l = load(&format!(
+        "{MATERIAL}define camera eye 60\nrender bob out.png 8 8\n"
+    ));
+    assert_eq!(l.jobs[0].camera.name, "eye");
+}
+
+#[test]
+fn transform_camera_moves_the_only_camera() {
+    let l = load(&format!(
+        "{MATERIAL}define camera eye 60\ntransform camera translate 0 0 5\nrender eye out.png 8 8\n"
+    ));
+    assert!(close(l.jobs[0].camera.eye, DVec3::new(0.0, 0.0, 5.0)));
+}
+
+#[test]
+fn ten_number_lights_carry_ambient_diffuse_and_brightness() {
+    let l = load(&format!(
+        "{MATERIAL}define light l 0 5 0 0.1 0.2 0.3 1 1 1 2\ndefine camera eye 60\nrender eye out.png 8 8\n"
+    ));
+    let scene = &l.jobs[0].scene;
+    assert_eq!(scene.lights[0].intensity, Vec3::splat(2.0));
+    assert_eq!(scene.ambient, Vec3::new(0.1, 0.2, 0.3));
+}
+
+#[test]
+fn a_camera_without_up_looks_with_y_up() {
+    let l = load(&format!(
+        "{MATERIAL}define camera eye 60 0 0 0 1 0 0\nrender eye out.png 8 8\n"
+    ));
+    assert!(close(l.jobs[0].camera.up, DVec3::Y));
+    assert!(close(l.jobs[0].camera.dir, DVec3::X));
+}
+
+#[test]
+fn a_name_after_the_material_is_the_shapes_name() {
+    let l = load(&format!(
+        "{MATERIAL}define shape sphere 0 0 -5 1 m ball\ndefine camera eye 60\nrender eye out.png 8 8\n"
+    ));
+    assert_eq!(l.jobs[0].scene.instances[0].name, "ball");
+}
+
+#[test]
+fn undefined_materials_are_magenta_and_name_every_shape() {
+    let l = load(
+        "define shape sphere a 0 0 -5 1 red\ndefine shape sphere b 0 0 -9 1 red\n\
+         define camera eye 60\nrender eye out.png 8 8\n",
+    );
+    let scene = &l.jobs[0].scene;
+    assert_eq!(scene.instances.len(), 2);
+    let m = &scene.materials[scene.instances[0].material];
+    assert_eq!(m.kd, Vec3::new(1.0, 0.0, 1.0));
+    let w = warnings(&l);
+    assert_eq!(w.matches("unknown material").count(), 1, "{w}");
+    assert!(w.contains("`a`, `b`"), "{w}");
+}
+
+#[test]
+fn f_suffixed_numbers_are_read() {
+    let l = load(&format!(
+        "{MATERIAL}define shape sphere s 0 0 -5 1.5f m\ndefine camera eye 60\nrender eye out.png 8 8\n"
+    ));
+    assert_eq!(
+        l.jobs[0].scene.instances[0].geometry,
+        Geometry::Sphere {
+            center: DVec3::new(0.0, 0.0, -5.0),
+            radius: 1.5
+        }
+    );
+}
+
+#[test]
+fn implausible_values_are_warned() {
+    let l = load(
+        "define material m -1 0 0 1 1 1 1 1 1 10\ndefine light l 0 5 0 1 1 1 -2\n\
+         define shape box b 0 0 0 0 0 1 m\ndefine shape box flat 0 0 0 1 1 0 m\n\
+         define camera eye 60\nrender eye out.png 8 8\n",
+    );
+    let w = warnings(&l);
+    assert!(w.contains("negative Ka"), "{w}");
+    assert!(w.contains("negative colour or brightness"), "{w}");
+    assert!(w.contains("box `b` has zero size on 2 axes"), "{w}");
+    assert!(!w.contains("box `flat`"), "{w}");
+}
+
+#[test]
+fn every_invisible_material_is_reported_and_same_outputs_warned() {
+    let l = load(
+        "define material a 1 1 1 1 1 1 1 1 1 10 0 0 1\ndefine material b 1 1 1 1 1 1 1 1 1 10 0 0 1\n\
+         define camera eye 60\nrender eye out.png 8 8\nrender eye out.png 8 8\n",
+    );
+    let w = warnings(&l);
+    assert!(w.contains("material `a` is invisible"), "{w}");
+    assert!(w.contains("material `b` is invisible"), "{w}");
+    assert!(w.contains("also writes `out.png`"), "{w}");
+}
+
+#[test]
+fn inferred_layouts_read_the_materials_as_meant() {
+    // Transparency written where the default expects opacity: 0 means opaque.
+    let text = "define material a 1 1 1 1 1 1 1 1 1 10 0 0 1\n\
+                define material b 1 1 1 1 1 1 1 1 1 10 0.2 0 1\n\
+                define camera eye 60\nrender eye out.png 8 8\n";
+    let l = load_with(text, &auto());
+    let parsed = parse(text, Path::new("scene.sdf"), &auto()).0;
+    let opacities: Vec<f32> = parsed
+        .iter()
+        .filter_map(|s| match &s.kind {
+            ast::StatementKind::Material(m) => Some(m.opacity),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(opacities, [1.0, 1.0]);
+    let w = warnings(&l);
+    assert_eq!(w.matches("are read as").count(), 1, "{w}");
+    assert!(w.contains("transparency"), "{w}");
+    // An explicit list wins.
+    let explicit = LoadOptions {
+        material_fields: vec![
+            MaterialField::Reflectivity,
+            MaterialField::Opacity,
+            MaterialField::Ior,
+        ],
+        ..LoadOptions::default()
+    };
+    assert!(!warnings(&load_with(text, &explicit)).contains("are read as"));
+    // ior then opacity after m (12 numbers), m last (13 numbers), percentages.
+    for (line, want) in [
+        ("10 1.5 0.5", "m ior opacity"),
+        ("0.3 1 0 60", "reflectivity ior transparency m`"),
+        ("20 50 100 1.5", "percentages"),
+        ("30 0.1 1 1.2 0.5", "glossiness"),
+    ] {
+        let text = format!(
+            "define material a 1 1 1 1 1 1 1 1 1 {line}\ndefine camera eye 60\nrender eye out.png 8 8\n"
+        );
+        let w = warnings(&load_with(&text, &auto()));
+        assert!(w.contains(want), "{line}: {w}");
+    }
+}

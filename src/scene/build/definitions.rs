@@ -4,7 +4,9 @@
 use super::{At, Builder};
 use crate::limits::{clamp_fraction, fov_is_valid, FOV_RULE};
 use crate::scene::{Geometry, Material};
-use crate::sdf::ast::{CameraDef, LightDef, MaterialDef, Statement, StatementKind, TransformOp};
+use crate::sdf::ast::{
+    CameraDef, LightDef, MaterialDef, NameRef, Statement, StatementKind, TransformOp,
+};
 use crate::sdf::repair;
 use crate::shape::degeneracy;
 use crate::shape::geometry::{is_zero, parallel};
@@ -146,6 +148,20 @@ impl Builder<'_> {
         }
         d.ambient = ambient_set.unwrap_or(Vec3::ZERO) + ambient_added;
 
+        // Shapes whose material is undefined, for one report per material.
+        let undefined: Vec<(&NameRef, &str)> = statements
+            .iter()
+            .filter_map(|stmt| match &stmt.kind {
+                StatementKind::Shape { name, material, .. }
+                    if !d.material_index.contains_key(material.name.as_str()) =>
+                {
+                    Some((material, name.as_str()))
+                }
+                _ => None,
+            })
+            .collect();
+        let fallback_of = self.undefined_materials(&mut d, &undefined);
+
         // Shapes' materials and composites' children, now that every name is known.
         for (index, stmt) in statements.iter().enumerate() {
             match &stmt.kind {
@@ -154,7 +170,9 @@ impl Builder<'_> {
                     geometry,
                     material,
                 } => {
-                    let resolved = self.resolve_material(&d, &material_first_def, index, material);
+                    let resolved = self
+                        .resolve_material(&d, &material_first_def, index, material)
+                        .or_else(|| fallback_of.get(material.name.as_str()).copied());
                     let Some(&i) = d.object_index.get(name.as_str()) else {
                         continue;
                     };

@@ -4,8 +4,17 @@
 use super::definitions::{Definitions, ObjectKind};
 use super::{At, Builder};
 use crate::diag::Severity;
+use crate::scene::Material;
 use crate::sdf::ast::NameRef;
+use glam::Vec3;
 use std::collections::HashMap;
+
+/// The loud stand-in for an undefined material: pure magenta, lit or not, never a colour a
+/// scene means.
+fn fallback_material() -> Material {
+    let magenta = Vec3::new(1.0, 0.0, 1.0);
+    Material::phong("(undefined material)", magenta, magenta, Vec3::ZERO, 1.0)
+}
 
 impl Builder<'_> {
     pub(super) fn resolve_material(
@@ -32,19 +41,68 @@ impl Builder<'_> {
                 }
                 Some(i)
             }
-            None => {
-                if !self.skipped(name) {
-                    let help = self.name_help(name, d.material_index.keys().copied());
-                    self.at_ref(
-                        Severity::Error,
-                        material,
-                        format!("unknown material `{name}`"),
-                        help,
-                    );
-                }
-                None
+            // Reported together with every shape that uses it, in `undefined_materials`.
+            None => None,
+        }
+    }
+
+    /// Shapes whose material is not defined are drawn in a loud magenta fallback, so the
+    /// image shows which ones they are; one warning per material name lists every shape that
+    /// uses it. `uses` holds (material, shape name) in file order. A material whose line was
+    /// rejected (already an error) gets no fallback and no second report.
+    pub(super) fn undefined_materials<'s>(
+        &mut self,
+        d: &mut Definitions<'s>,
+        uses: &[(&'s NameRef, &'s str)],
+    ) -> HashMap<&'s str, usize> {
+        let mut by_material: Vec<(&NameRef, Vec<&str>)> = Vec::new();
+        for &(material, shape) in uses {
+            if self.skipped(&material.name) {
+                continue;
+            }
+            match by_material
+                .iter_mut()
+                .find(|(m, _)| m.name == material.name)
+            {
+                Some((_, shapes)) => shapes.push(shape),
+                None => by_material.push((material, vec![shape])),
             }
         }
+        let mut fallback_of = HashMap::new();
+        if by_material.is_empty() {
+            return fallback_of;
+        }
+        let fallback = d.materials.len();
+        d.materials.push(fallback_material());
+        let none_defined = d.material_index.is_empty();
+        for (material, shapes) in by_material {
+            let mut help = self.name_help(&material.name, d.material_index.keys().copied());
+            if none_defined {
+                help = Some(format!(
+                    "the file defines no material: add `define material {} 0.1 0.1 0.1 0.8 0.8 0.8 0.2 0.2 0.2 20`",
+                    material.name
+                ));
+            }
+            let list: Vec<String> = shapes.iter().map(|s| format!("`{s}`")).collect();
+            self.at_ref(
+                Severity::Warning,
+                material,
+                format!(
+                    "unknown material `{}`: {} drawn in magenta ({} {})",
+                    material.name,
+                    if shapes.len() == 1 {
+                        "the shape is"
+                    } else {
+                        "the shapes are"
+                    },
+                    if shapes.len() == 1 { "shape" } else { "shapes" },
+                    list.join(", ")
+                ),
+                help,
+            );
+            fallback_of.insert(material.name.as_str(), fallback);
+        }
+        fallback_of
     }
 
     pub(super) fn resolve_children<'s>(

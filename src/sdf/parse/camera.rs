@@ -9,6 +9,13 @@ use glam::DVec3;
 
 const FORM_CAMERA: &str = "define camera <name> <fov-x> [eye] [dir] [up]";
 
+/// Whether a camera line's number can be an image side (a whole number of pixels).
+fn is_image_side(v: f64) -> bool {
+    v.fract() == 0.0
+        && v >= f64::from(*limits::IMAGE_SIDE.start())
+        && v <= f64::from(*limits::IMAGE_SIDE.end())
+}
+
 impl Parser<'_> {
     pub(super) fn camera(&mut self, line: &Line, name_at: usize) {
         if let Some(t) = line.tokens.get(name_at) {
@@ -43,6 +50,31 @@ impl Parser<'_> {
                 "camera with an eye position but no direction or up vector: looking along -z with y up",
                 Some(format!("canonical form: `{FORM_CAMERA}`")),
             );
+        } else if nums.len() == 3 && is_image_side(nums[1]) && is_image_side(nums[2]) {
+            // `camera eye 45 500 500`: renderers that size the image by the camera.
+            let size = (nums[1] as u32, nums[2] as u32);
+            self.warn(
+                line,
+                At::Span(first, first + 2),
+                format!(
+                    "image size {}×{} after the field of view: used by render lines of this camera that give none",
+                    size.0, size.1
+                ),
+                Some(format!(
+                    "the image size belongs on the render line: `render {name} <file> {} {}`",
+                    size.0, size.1
+                )),
+            );
+            self.camera_sizes.insert(name.clone(), size);
+            nums.truncate(1);
+        } else if nums.len() == 7 {
+            self.warn(
+                line,
+                At::End,
+                "camera with an eye position and a direction but no up vector: +y is up",
+                Some(format!("canonical form: `{FORM_CAMERA}`")),
+            );
+            nums.extend([0.0, 1.0, 0.0]);
         } else if nums.len() == 11 {
             self.warn(
                 line,
@@ -57,7 +89,18 @@ impl Parser<'_> {
         } else if nums.len() != 1 && nums.len() != 10 {
             let n = nums.len();
             let mut help = format!("canonical form: `{FORM_CAMERA}` (1 or 10 numbers)");
-            if n == 3 || n == 9 {
+            if n == 9 && is_image_side(nums[1]) && is_image_side(nums[2]) {
+                // Without the size the line is `<fov> [eye] [dir]`, which is read.
+                let rest: Vec<&str> = toks[first + 3..].iter().map(|t| t.text).collect();
+                help = format!(
+                    "the image size belongs on the render line: write `define camera {name} {} {}` \
+                     and `render {name} <file> {} {}`",
+                    toks[first].text,
+                    rest.join(" "),
+                    toks[first + 1].text,
+                    toks[first + 2].text
+                );
+            } else if n == 3 || n == 9 {
                 help.push_str("; the image size belongs on the render line, not after the fov");
             }
             return Err(self.error(
@@ -66,6 +109,17 @@ impl Parser<'_> {
                 format!("a camera takes <fov-x> or <fov-x> [eye] [dir] [up] (1 or 10 numbers), found {n}"),
                 Some(help),
             ));
+        }
+        if nums.len() == 10 && !limits::fov_is_valid(nums[0]) && limits::fov_is_valid(nums[9]) {
+            // `[eye] [dir] [up] <fov>`: the first number cannot be a field of view, the last
+            // can, so the order is clear.
+            self.warn(
+                line,
+                At::Tok(first),
+                "camera written with the field of view last: read as [eye] [dir] [up] <fov-x>",
+                Some(format!("the fov comes first: `{FORM_CAMERA}`")),
+            );
+            nums.rotate_right(1);
         }
         let fov = nums[0];
         if !limits::fov_is_valid(fov) {
@@ -103,17 +157,44 @@ impl Parser<'_> {
             def.dir = v(4);
             def.up = v(7);
             if is_zero(def.dir) {
+                // Some renderers read these as rotation angles; 0 0 0 then means the default
+                // pose, which is written without them.
+                let eye = format!(
+                    "{} {} {}",
+                    toks[first + 1].text,
+                    toks[first + 2].text,
+                    toks[first + 3].text
+                );
                 return Err(self.error(
                     line,
                     At::Span(first + 4, first + 6),
                     "the camera's viewing direction is zero",
-                    form,
+                    Some(format!(
+                        "to look along -z with +y up, write `define camera {name} {} {eye}`; otherwise `{FORM_CAMERA}`",
+                        toks[first].text
+                    )),
                 ));
             }
-            if parallel(def.dir, def.up) {
-                return Err(self.error(
+            if is_zero(def.up) && !parallel(def.dir, DVec3::Y) {
+                // A zero up vector is no up vector: the default one is meant.
+                self.warn(
                     line,
                     At::Span(first + 7, first + 9),
+                    "the camera's up vector is zero: +y is up",
+                    Some(format!("canonical form: `{FORM_CAMERA}`")),
+                );
+                def.up = DVec3::Y;
+            }
+            if parallel(def.dir, def.up) {
+                // Without an up vector in the file, point at the direction that needs one.
+                let at = if toks.len() > first + 9 {
+                    At::Span(first + 7, first + 9)
+                } else {
+                    At::Span(first + 4, first + 6)
+                };
+                return Err(self.error(
+                    line,
+                    at,
                     "the camera's up vector is zero or parallel to its viewing direction",
                     Some("up must point away from the viewing direction, e.g. 0 1 0 when looking along -z".to_string()),
                 ));

@@ -73,7 +73,39 @@ impl Parser<'_> {
             color,
             brightness,
         };
+        if let Some(worst) = nums
+            .iter()
+            .skip(3)
+            .copied()
+            .reduce(f64::min)
+            .filter(|&v| v < 0.0)
+        {
+            self.warn(
+                line,
+                At::Span(name_at + 4, toks.len() - 1),
+                format!("light `{name}` has a negative colour or brightness ({worst}): it takes light away"),
+                Some("colours lie between 0 and 1, brightness is at least 0".to_string()),
+            );
+        }
         match nums.len() {
+            10 => {
+                // `[pos] [La] [Ld] <brightness>`: the lecture's form with a brightness.
+                let ambient = c(3);
+                let l = light(c(6), nums[9] as f32);
+                self.variant(
+                    line,
+                    At::Span(name_at + 4, toks.len() - 1),
+                    "ten-number-light",
+                    "10-number light read as [pos] [La] [Ld] <brightness>: La is added to the \
+                     ambient light, the intensity is Ld × brightness"
+                        .to_string(),
+                    format!("read as `{}`", StatementKind::Light(l.clone())),
+                );
+                if ambient != Vec3::ZERO {
+                    self.emit(line, StatementKind::AmbientAdd(ambient));
+                }
+                self.emit_named(line, name_at, StatementKind::Light(l));
+            }
             7 => {
                 let l = light(c(3), nums[6] as f32);
                 self.emit_named(line, name_at, StatementKind::Light(l));
@@ -149,7 +181,7 @@ impl Parser<'_> {
                     At::End
                 };
                 let mut help = format!(
-                    "canonical form: `{FORM_LIGHT}`; 6 numbers (no brightness) and 9 are also read"
+                    "canonical form: `{FORM_LIGHT}`; 6 numbers (no brightness), 9 and 10 are also read"
                 );
                 if matches!(n, 1 | 3) {
                     help.push_str(&format!(

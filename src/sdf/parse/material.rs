@@ -1,7 +1,8 @@
 //! `define material`: colours, the Phong exponent, and the extras named by
 //! `--material-fields`.
 
-use super::{At, PResult, Parser};
+use super::layout::{default_layout, Slot};
+use super::{At, Fail, PResult, Parser};
 use crate::limits;
 use crate::sdf::ast::{MaterialDef, StatementKind};
 use crate::sdf::lexer::Line;
@@ -29,9 +30,6 @@ impl Parser<'_> {
         }
         let name = toks[2].text.to_string();
         let nums = self.numbers(line, 3, toks.len())?;
-        let opts = self.opts;
-        let fields = &opts.material_fields;
-        let field_list = field_names(fields);
         if nums.len() < 10 {
             return Err(self.error(
                 line,
@@ -43,76 +41,54 @@ impl Parser<'_> {
                 Some(format!("canonical form: `{FORM_MATERIAL}`")),
             ));
         }
-        let extras = nums.len() - 10;
-        if extras > fields.len() {
-            let first_surplus = 3 + 10 + fields.len();
-            // The current list, padded with the ignored field to the count on this line.
-            let mut padded: Vec<&str> = fields.iter().map(field_name).collect();
-            padded.resize(extras, "roughness");
-            let padded = padded.join(",");
-            let help = format!(
-                "the numbers after m are read as --material-fields {field_list}; this line has {extras}. \
-                 Name them all with --material-fields (from reflectivity, opacity, transparency, ior, \
-                 roughness), e.g. `--material-fields {padded}` (roughness is read and ignored)"
-            );
-            return Err(self.error(
-                line,
-                At::Span(first_surplus, toks.len() - 1),
-                format!(
-                    "too many numbers for a material: {} (at most {} with --material-fields {field_list})",
-                    nums.len(),
-                    10 + fields.len()
-                ),
-                Some(help),
-            ));
+        let count = nums.len() - 9;
+        let layout = self.layout.clone();
+        let Some(slots) = layout.read(count) else {
+            return Err(self.too_many_numbers(line, nums.len()));
+        };
+        if count > 1 {
+            self.explain_layout(line);
         }
         let c3 = |i: usize| Vec3::new(nums[i] as f32, nums[i + 1] as f32, nums[i + 2] as f32);
+        for (what, at) in [("Ka", 3), ("Kd", 6), ("Ks", 9)] {
+            if c3(at - 3).min_element() < 0.0 {
+                self.warn(
+                    line,
+                    At::Span(at, at + 2),
+                    format!("negative {what} in material `{name}`: it takes light away"),
+                    Some("reflection coefficients lie between 0 and 1".to_string()),
+                );
+            }
+        }
         let mut def = MaterialDef {
             name,
             ka: c3(0),
             kd: c3(3),
             ks: c3(6),
-            m: nums[9] as f32,
+            m: 1.0,
             reflectivity: 0.0,
             opacity: 1.0,
             ior: repair::AIR_IOR,
         };
-        if def.m < 0.0 {
-            self.warn(
-                line,
-                At::Tok(12),
-                format!(
-                    "the Phong exponent m must not be negative, found {}; its absolute value is used",
-                    nums[9]
-                ),
-                None,
-            );
-            def.m = repair::phong_exponent(def.m);
-        } else if def.m == 0.0 {
-            // Kept: pow(x, 0) = 1 is well defined, and it is what the file's own renderer drew.
-            self.warn(
-                line,
-                At::Tok(12),
-                "the Phong exponent m is 0: the highlight covers the whole lit side",
-                Some("m is usually between 1 (dull) and a few hundred (sharp)".to_string()),
-            );
-        }
         let mut opacity_at = None;
-        for (k, field) in fields.iter().enumerate().take(extras) {
-            let value = nums[10 + k];
-            let at = At::Tok(13 + k);
-            match field {
-                MaterialField::Reflectivity => {
+        for (k, &slot) in slots.iter().enumerate() {
+            let value = layout.value(slot, nums[9 + k]);
+            let at = At::Tok(12 + k);
+            match slot {
+                Slot::M => self.phong(line, at, value, &mut def),
+                Slot::Gloss | Slot::Field(MaterialField::Roughness) => {}
+                Slot::Field(MaterialField::Reflectivity) => {
                     def.reflectivity = self.unit_interval(line, at, "reflectivity", value);
                 }
-                MaterialField::Opacity => {
+                Slot::Field(MaterialField::Opacity) => {
                     def.opacity = self.unit_interval(line, at, "opacity", value);
                     opacity_at = Some(at);
                 }
-                MaterialField::Transparency => {
+                Slot::Field(MaterialField::Transparency) => {
                     def.opacity = 1.0 - self.unit_interval(line, at, "transparency", value);
+                    opacity_at = Some(at);
                 }
-                MaterialField::Ior => match repair::usable_ior(value) {
+                Slot::Field(MaterialField::Ior) => match repair::usable_ior(value) {
                     Some(ior) => def.ior = ior as f32,
                     None => self.warn(
                         line,
@@ -124,27 +100,113 @@ impl Parser<'_> {
                         None,
                     ),
                 },
-                MaterialField::Roughness => {}
             }
         }
         if let Some(at) = opacity_at.filter(|_| def.opacity == 0.0 && def.ior == 1.0) {
-            // Fully transparent without refraction: invisible. Many files mean transparency
-            // by this number (0 = opaque), and this is the symptom. Said once per file.
-            self.warn_once(
+            // Fully transparent without refraction: invisible. Every such material is named
+            // (a file often has several); the hint about the field list is given once.
+            let hint = if self.variants_noted.insert("invisible-material") {
+                "if this file means transparency by this number, load it with \
+                 --material-fields reflectivity,transparency,ior"
+                    .to_string()
+            } else {
+                "see the first invisible material for the field list to try".to_string()
+            };
+            self.warn(
                 line,
                 at,
-                "invisible-material",
                 format!(
                     "material `{}` is invisible: fully transparent (opacity 0) and not refracting (ior 1)",
                     def.name
                 ),
-                "if this file means transparency by this number, load it with \
-                 --material-fields reflectivity,transparency,ior"
-                    .to_string(),
+                Some(hint),
             );
         }
         self.emit_named(line, 2, StatementKind::Material(def));
         Ok(())
+    }
+
+    /// The Phong exponent `m` at `at`, repaired with a warning where it means nothing.
+    fn phong(&mut self, line: &Line, at: At, value: f64, def: &mut MaterialDef) {
+        def.m = value as f32;
+        if def.m < 0.0 {
+            self.warn(
+                line,
+                at,
+                format!(
+                    "the Phong exponent m must not be negative, found {value}; its absolute value is used"
+                ),
+                None,
+            );
+            def.m = repair::phong_exponent(def.m);
+        } else if def.m == 0.0 {
+            // Kept: pow(x, 0) = 1 is well defined, and it is what the file's own renderer drew.
+            self.warn(
+                line,
+                at,
+                "the Phong exponent m is 0: the highlight covers the whole lit side",
+                Some("m is usually between 1 (dull) and a few hundred (sharp)".to_string()),
+            );
+        }
+    }
+
+    /// Says once, at the first material with extras, how they were read when the layout was
+    /// inferred and is not the default (`--material-fields auto`).
+    fn explain_layout(&mut self, line: &Line) {
+        if !self.opts.material_fields.is_empty() || self.layout == default_layout() {
+            return;
+        }
+        if !self.variants_noted.insert("material-layout") {
+            return;
+        }
+        let layout = &self.layout;
+        let mut message = format!(
+            "the numbers after the colours of this file's materials are read as `{}`, the layout that makes them plausible",
+            layout.describe()
+        );
+        if layout.has_gloss() {
+            message.push_str("; glossiness is ignored");
+        }
+        let force = match layout.flag() {
+            Some(list) => format!("this reading is `--material-fields {list}`; "),
+            None => String::new(),
+        };
+        let help = format!(
+            "{force}force another with --material-fields LIST, e.g. the default \
+             `--material-fields reflectivity,opacity,ior`"
+        );
+        self.warn(
+            line,
+            At::Span(12, line.tokens.len() - 1),
+            message,
+            Some(help),
+        );
+    }
+
+    fn too_many_numbers(&mut self, line: &Line, n: usize) -> Fail {
+        let fields = &self.opts.material_fields;
+        let field_list = field_names(fields);
+        let extras = n - 10;
+        let most = self.layout.slots.len() + 9;
+        let mut padded: Vec<&str> = fields.iter().map(field_name).collect();
+        padded.resize(extras, "roughness");
+        let padded = padded.join(",");
+        let reading = if fields.is_empty() {
+            "no known layout reads them all (--material-fields auto)".to_string()
+        } else {
+            format!("the numbers after m are read as --material-fields {field_list}")
+        };
+        let help = format!(
+            "{reading}; this line has {extras}. Name them all with --material-fields (from \
+             reflectivity, opacity, transparency, ior, roughness), e.g. \
+             `--material-fields {padded}` (roughness is read and ignored)"
+        );
+        self.error(
+            line,
+            At::Span((3 + most).min(line.tokens.len() - 1), line.tokens.len() - 1),
+            format!("too many numbers for a material: {n} (at most {most} with this layout)"),
+            Some(help),
+        )
     }
 
     /// A value that must lie in [0, 1]: clamped with a warning.

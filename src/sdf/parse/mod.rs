@@ -8,6 +8,7 @@
 //! follow-on errors.
 
 mod camera;
+mod layout;
 mod light;
 mod material;
 mod render;
@@ -135,11 +136,15 @@ pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
         variants_noted: HashSet::new(),
         render_lines: 0,
         cameras_rejected: false,
+        layout: material_layout(&lines, opts),
+        render_errors: Vec::new(),
+        camera_sizes: HashMap::new(),
     };
     for line in &lines {
         p.line(line);
     }
     p.resolve_renders();
+    p.resolve_camera_role(&lines);
     p.prune_skipped_references();
     p.drop_transforms_of_commented_definitions(&lines);
     Parsed {
@@ -175,6 +180,51 @@ struct Parser<'a> {
     variants_noted: HashSet<&'static str>,
     render_lines: usize,
     cameras_rejected: bool,
+    /// How the numbers after a material's colours are read: `--material-fields`, or the
+    /// layout inferred from the file's materials when it is `auto` (an empty list).
+    layout: layout::Layout,
+    /// Problems of render lines, each of which rejects only its own line when another render
+    /// line of the file stands (settled in `resolve_renders`).
+    render_errors: Vec<Diagnostic>,
+    /// Image sizes written on camera lines (`camera eye 45 500 500`), for the render lines
+    /// of that camera that give none.
+    camera_sizes: HashMap<String, (u32, u32)>,
+}
+
+/// The layout of the numbers after the colours of the file's materials: the one named by
+/// `--material-fields`, or with `auto` (an empty list) the most plausible one for every
+/// material line of the file (`docs/scene-language.md §3.1`).
+fn material_layout(lines: &[Line], opts: &LoadOptions) -> layout::Layout {
+    if !opts.material_fields.is_empty() {
+        return layout::Layout::explicit(&opts.material_fields);
+    }
+    let extras: Vec<Vec<f64>> = lines
+        .iter()
+        .filter(|l| {
+            l.tokens.first().is_some_and(|t| t.text == "define")
+                && l.tokens.get(1).is_some_and(|t| t.text == "material")
+        })
+        .filter_map(|l| {
+            // Lines with a malformed number are reported when read; they do not vote.
+            let nums: Option<Vec<f64>> = l
+                .tokens
+                .iter()
+                .skip(3)
+                .map(|t| lenient_number(t.text))
+                .collect();
+            nums.filter(|n| n.len() >= 10).map(|n| n[9..].to_vec())
+        })
+        .collect();
+    layout::infer(&extras).unwrap_or_else(layout::default_layout)
+}
+
+/// A number as the reader takes it, a C-style suffix (`1.0f`) included.
+fn lenient_number(text: &str) -> Option<f64> {
+    match lexer::parse_number(text) {
+        Ok(v) => Some(v),
+        Err(NumberError::Suffix(plain)) => lexer::parse_number(&plain).ok(),
+        Err(_) => None,
+    }
 }
 
 impl Parser<'_> {
@@ -366,6 +416,18 @@ impl Parser<'_> {
         for i in from..to.min(line.tokens.len()) {
             match lexer::parse_number(line.tokens[i].text) {
                 Ok(v) => out.push(v),
+                Err(NumberError::Suffix(plain)) if lexer::parse_number(&plain).is_ok() => {
+                    // `1.0f`: C and Java source pasted into scene files; the meaning is clear.
+                    let text = line.tokens[i].text.to_string();
+                    self.variant(
+                        line,
+                        At::Tok(i),
+                        "number-suffix",
+                        format!("number `{text}` written with a type suffix"),
+                        format!("read as `{plain}`; SDF numbers take no suffix"),
+                    );
+                    out.extend(lexer::parse_number(&plain).ok());
+                }
                 Err(e) => {
                     self.bad_number(line, i, e);
                     failed = true;
@@ -442,8 +504,10 @@ impl Parser<'_> {
             "backgroundcolor" => self.background(line, 2),
             "transform" => self.transform(line, 2, Some("`define transform` read as `transform`")),
             "render" | "renderer" => {
+                // `define renderer <camera> <file> <w> <h>`: a camera is named like on a
+                // render line (a lone name is settled once every camera is known).
                 let note = format!("`define {}` read as `render`", kind.text);
-                self.render(line, 2, false, Some(&note))
+                self.render(line, 2, true, Some(&note))
             }
             k if SHAPE_KINDS.contains(&k) => self.shape(line, 1),
             other => {

@@ -2,6 +2,7 @@
 
 use super::{Anchor, At, PResult, Parser};
 use crate::limits::{self, DEFAULT_IMAGE_SIZE};
+
 use crate::sdf::ast::{NameRef, RenderDef, StatementKind};
 use crate::sdf::lexer::{self, looks_numeric, Line};
 
@@ -26,6 +27,8 @@ pub(super) struct PendingRender {
     pub(super) output_anchor: Anchor,
     /// Descriptions of the variants read on this line, for one warning.
     pub(super) notes: Vec<String>,
+    /// Whether the line gives the image size.
+    pub(super) size_given: bool,
 }
 
 impl Parser<'_> {
@@ -39,6 +42,23 @@ impl Parser<'_> {
         variant: Option<&str>,
     ) {
         self.render_lines += 1;
+        let reported = self.diagnostics.len();
+        let statements = self.statements.len();
+        self.render_inner(line, from, camera_expected, variant);
+        if self.statements.len() == statements {
+            // Rejected: whether that stops the file depends on its other render lines.
+            let problems = self.diagnostics.split_off(reported);
+            self.render_errors.extend(problems);
+        }
+    }
+
+    fn render_inner(
+        &mut self,
+        line: &Line,
+        from: usize,
+        camera_expected: bool,
+        variant: Option<&str>,
+    ) {
         let toks = &line.tokens;
         let mut notes: Vec<String> = variant.map(str::to_string).into_iter().collect();
         let names_end = names_end(line, from);
@@ -139,6 +159,7 @@ impl Parser<'_> {
             output_given,
             output_anchor,
             notes,
+            size_given: !nums.is_empty(),
         });
         self.emit(line, StatementKind::Render(def));
     }
@@ -150,16 +171,11 @@ impl Parser<'_> {
         line: &Line,
         at: usize,
         nums: &[f64],
-        notes: &mut Vec<String>,
+        _notes: &mut Vec<String>,
     ) -> PResult<(u32, u32)> {
         match nums.len() {
-            0 => {
-                notes.push(format!(
-                    "no image size given: {}×{}",
-                    DEFAULT_IMAGE_SIZE.0, DEFAULT_IMAGE_SIZE.1
-                ));
-                Ok(DEFAULT_IMAGE_SIZE)
-            }
+            // Settled in `resolve_renders` (the camera line may give one).
+            0 => Ok(DEFAULT_IMAGE_SIZE),
             1 => Err(self.error(
                 line,
                 At::End,

@@ -106,6 +106,7 @@ impl Parser<'_> {
         let first_camera = self.camera_names.first().cloned();
         let mut need_default_camera = false;
         let mut rejected = Vec::new();
+        let mut outputs: HashMap<String, u32> = HashMap::new();
         for pending in std::mem::take(&mut self.pending) {
             let mut notes = pending.notes;
             let Some(Statement {
@@ -117,7 +118,57 @@ impl Parser<'_> {
             };
             let mut camera_missing = false;
             match pending.camera {
-                RenderCamera::Named => {}
+                RenderCamera::Named if self.camera_names.contains(&def.camera.name) => {}
+                RenderCamera::Named => match self.camera_names.as_slice() {
+                    // One camera: the line can only mean it (a renamed or misspelt camera).
+                    [only] => {
+                        let help = match crate::diag::suggest(&def.camera.name, [only.as_str()]) {
+                            Some(s) => format!("did you mean `{s}`?"),
+                            None => format!("write `render {only} ...`"),
+                        };
+                        let d = Diagnostic::new(
+                            Severity::Warning,
+                            def.camera.loc.clone(),
+                            format!(
+                                "unknown camera `{}`: the file's only camera `{only}` is used",
+                                def.camera.name
+                            ),
+                        )
+                        .with_source(
+                            pending.anchor.text.clone(),
+                            def.camera.name.chars().count() as u32,
+                        )
+                        .with_help(help);
+                        self.diagnostics.push(d);
+                        def.camera.name = only.clone();
+                    }
+                    cameras => {
+                        let help = match crate::diag::suggest(
+                            &def.camera.name,
+                            cameras.iter().map(String::as_str),
+                        ) {
+                            Some(s) => format!("did you mean `{s}`?"),
+                            None if cameras.is_empty() => {
+                                "the file defines no camera: add `define camera <name> <fov-x>`"
+                                    .to_string()
+                            }
+                            None => format!("cameras of this file: {}", cameras.join(", ")),
+                        };
+                        let d = Diagnostic::new(
+                            Severity::Error,
+                            def.camera.loc.clone(),
+                            format!("unknown camera `{}`", def.camera.name),
+                        )
+                        .with_source(
+                            pending.anchor.text.clone(),
+                            def.camera.name.chars().count() as u32,
+                        )
+                        .with_help(help);
+                        self.render_errors.push(d);
+                        rejected.push(pending.index);
+                        continue;
+                    }
+                },
                 RenderCamera::Ambiguous(word) => {
                     if self.camera_names.contains(&word) {
                         def.camera.name = word;
@@ -146,6 +197,19 @@ impl Parser<'_> {
                     }
                 }
             }
+            if !pending.size_given {
+                match self.camera_sizes.get(&def.camera.name) {
+                    Some(&(w, h)) => {
+                        (def.width, def.height) = (w, h);
+                        notes.push(format!(
+                            "no image size given: {w}×{h} from the camera's line is used"
+                        ));
+                    }
+                    None => {
+                        notes.push(format!("no image size given: {}×{}", def.width, def.height))
+                    }
+                }
+            }
             if def.output.is_empty() {
                 def.output = default_output.clone();
                 if !pending.output_given {
@@ -158,13 +222,32 @@ impl Parser<'_> {
             let canonical = StatementKind::Render(def.clone()).to_string();
             if is_scene_file(self.path, &output) {
                 rejected.push(pending.index);
-                self.report(
+                let anchor = pending.output_anchor;
+                let d = Diagnostic::new(
                     Severity::Error,
-                    pending.output_anchor,
+                    anchor.loc,
                     format!("the render output `{output}` is this scene file itself"),
-                    Some("name an image file such as image.png".to_string()),
-                );
-            } else if !notes.is_empty() {
+                )
+                .with_source(anchor.text, anchor.width)
+                .with_help("name an image file such as image.png");
+                self.render_errors.push(d);
+                continue;
+            }
+            match outputs.get(&output) {
+                Some(&first) => {
+                    let anchor = pending.output_anchor.clone();
+                    self.report(
+                        Severity::Warning,
+                        anchor,
+                        format!("render line {first} also writes `{output}`: this image replaces it"),
+                        Some("give each render line its own file name, e.g. frame001.png, frame002.png".to_string()),
+                    );
+                }
+                None => {
+                    outputs.insert(output.clone(), pending.anchor.loc.line);
+                }
+            }
+            if !notes.is_empty() {
                 self.report(
                     Severity::Warning,
                     pending.anchor,
@@ -177,6 +260,7 @@ impl Parser<'_> {
         for index in rejected.into_iter().rev() {
             self.statements.remove(index);
         }
+        self.settle_render_errors();
         if need_default_camera {
             let loc = Loc {
                 file: self.file.clone(),
@@ -190,6 +274,71 @@ impl Parser<'_> {
                     loc,
                 ),
             );
+        }
+    }
+}
+
+impl Parser<'_> {
+    /// A rejected render line stops the file only when no other render line stands: each
+    /// render line is its own image, and the others can still be made (warnings then).
+    fn settle_render_errors(&mut self) {
+        let standing = self
+            .statements
+            .iter()
+            .any(|s| matches!(s.kind, StatementKind::Render(_)));
+        for mut d in std::mem::take(&mut self.render_errors) {
+            if standing && d.severity == Severity::Error {
+                d.severity = Severity::Warning;
+                d.message
+                    .push_str("; this render line is skipped, the other render lines are rendered");
+            }
+            self.diagnostics.push(d);
+        }
+    }
+
+    /// `transform camera ...` in a file with exactly one camera, none of whose objects is
+    /// named `camera`: the word names the camera's role, and there is only one to mean.
+    pub(super) fn resolve_camera_role(&mut self, lines: &[Line]) {
+        let [only] = self.camera_names.as_slice() else {
+            return;
+        };
+        if only == "camera" {
+            return;
+        }
+        let only = only.clone();
+        let named_camera = self.statements.iter().any(|s| match &s.kind {
+            StatementKind::Shape { name, .. } | StatementKind::Composite { name, .. } => {
+                name == "camera"
+            }
+            StatementKind::Light(l) => l.name == "camera",
+            _ => false,
+        });
+        if named_camera {
+            return;
+        }
+        let mut first = None;
+        for s in &mut self.statements {
+            if let StatementKind::Transform { target, .. } = &mut s.kind {
+                if target.name == "camera" {
+                    first.get_or_insert_with(|| target.loc.clone());
+                    target.name = only.clone();
+                }
+            }
+        }
+        if let Some(loc) = first {
+            let text = lines
+                .get((loc.line as usize).saturating_sub(1))
+                .map_or(String::new(), |l| l.text.to_string());
+            let d = Diagnostic::new(
+                Severity::Warning,
+                loc,
+                format!("`transform camera` read as a transform of the file's only camera `{only}`"),
+            )
+            .with_source(text, 6)
+            .with_help(format!(
+                "write `transform {only} ...` (later lines written this way are read the same, without a warning)"
+            ));
+            self.diagnostics.push(d);
         }
     }
 }

@@ -47,7 +47,26 @@ impl Parser<'_> {
                 self.skip_name(line, name_at);
             }
             k if SHAPE_KINDS.contains(&k) => {
-                if self.geometric_shape(line, kind_at).is_err() {
+                if let Some(reordered) = name_after_material(line, kind_at) {
+                    let last = line.tokens.len() - 1;
+                    self.variant(
+                        line,
+                        At::Tok(last),
+                        "name-after-material",
+                        format!(
+                            "the {k}'s name `{}` written after its material",
+                            line.tokens[last].text
+                        ),
+                        format!(
+                            "write `define shape {k} {} <numbers> {}`",
+                            line.tokens[last].text,
+                            line.tokens[last - 1].text
+                        ),
+                    );
+                    if self.geometric_shape(&reordered, kind_at).is_err() {
+                        self.skip_name(&reordered, name_at);
+                    }
+                } else if self.geometric_shape(line, kind_at).is_err() {
                     self.skip_name(line, name_at);
                 }
             }
@@ -207,6 +226,23 @@ impl Parser<'_> {
                 *radius = limits::fixed_radius(*radius);
             }
         }
+        if let Geometry::Box { p1, p2 } = geometry {
+            // One flat axis is a rectangle (floors, walls); two or three leave a line or a
+            // point, which no ray hits: almost always a typo in the corners.
+            let flat = (*p2 - *p1).to_array().iter().filter(|d| **d == 0.0).count();
+            if flat >= 2 {
+                self.warn(
+                    line,
+                    At::Span(args.nums_from, args.nums_to - 1),
+                    format!(
+                        "box `{}` has zero size on {flat} axes: it is a {} and cannot be seen",
+                        args.name,
+                        if flat == 3 { "point" } else { "line" }
+                    ),
+                    Some("a box is given by two opposite corners: [p1] [p2]".to_string()),
+                );
+            }
+        }
         if let Some(reason) = degeneracy(geometry) {
             let at = match geometry {
                 Geometry::Sphere { .. } | Geometry::Cylinder { .. } | Geometry::Cone { .. }
@@ -260,6 +296,32 @@ impl Parser<'_> {
         self.emit_named(line, name_at, StatementKind::Composite { name, children });
         Ok(())
     }
+}
+
+/// `define shape sphere 0 0 0 1 red ball`: the name slot holds a number and the line ends
+/// with two words, a material and then the name. The line with its tokens put in canonical
+/// order (each keeps its column, so diagnostics still point where it is written).
+fn name_after_material<'t>(line: &Line<'t>, kind_at: usize) -> Option<Line<'t>> {
+    let toks = &line.tokens;
+    let name_at = kind_at + 1;
+    let n = toks.len();
+    let numeric_name = toks.get(name_at).is_some_and(|t| looks_numeric(t.text));
+    if !numeric_name || n < name_at + 3 {
+        return None;
+    }
+    let (material, name) = (toks[n - 2], toks[n - 1]);
+    if looks_numeric(material.text) || looks_numeric(name.text) {
+        return None;
+    }
+    let mut tokens = toks[..name_at].to_vec();
+    tokens.push(name);
+    tokens.extend_from_slice(&toks[name_at..n - 2]);
+    tokens.push(material);
+    Some(Line {
+        number: line.number,
+        text: line.text,
+        tokens,
+    })
 }
 
 /// How a primitive is written: how many numbers it takes and what they mean.

@@ -151,6 +151,18 @@ impl Parser<'_> {
             "translate" if nums.len() == 3 => Outcome::Op(TransformOp::Translate(DVec3::new(
                 nums[0], nums[1], nums[2],
             ))),
+            // A homogeneous point `x y z 1`: the 1 is the w of 4×4 matrix code.
+            "translate" if nums.len() == 4 && nums[3] == 1.0 => {
+                notes.push((
+                    At::Tok(op.nums_to - 1),
+                    "translate-homogeneous",
+                    "translate with a fourth number 1 (a homogeneous coordinate) read as x y z"
+                        .to_string(),
+                ));
+                Outcome::Op(TransformOp::Translate(DVec3::new(
+                    nums[0], nums[1], nums[2],
+                )))
+            }
             "translate" => self.wrong_count(
                 line,
                 op,

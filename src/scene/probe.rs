@@ -1,0 +1,498 @@
+//! Never a silent blank image: before rendering, a coarse look through each job's camera
+//! (32×18 primary rays for a 16:9 image, one shadow ray per light, a few mirror bounces) tells whether the
+//! image would be all background or all black, and why.
+//!
+//! The probe lives in `scene` and uses only `shape` and `math` (the layering forbids
+//! `render` here), so it rebuilds the pinhole camera of `render::camera` (the same formula:
+//! horizontal field of view, image plane at `(w/2)/tan(fov/2)` pixels) and intersects the
+//! instances one by one. It only has to be right about "nothing at all would show", so it
+//! shades with Phong terms but without refraction.
+
+use super::{load_file, Camera, Instance, Material, RenderJob, Scene};
+use crate::diag::{Diagnostic, Loc, Severity};
+use crate::math::{reflect, spawn_ray, Ray};
+use crate::sdf::LoadOptions;
+use crate::shape::{AaBox, Cone, Cylinder, Geometry, Plane, Shape, Sphere, Triangle};
+use glam::{DVec3, Vec3, Vec3A};
+use std::path::Path;
+use std::sync::Arc;
+
+/// The probe's image width in rays (its height follows the image's aspect ratio: 18 for
+/// 16:9): enough to see any object that covers a few percent of the image, at a cost far
+/// below one real sample per pixel.
+pub const PROBE_WIDTH: u32 = 32;
+
+/// Ray–shape tests the probe may spend on primary rays (each also costs shadow rays): it
+/// tests every shape for every ray, so a huge scene would cost more than its render.
+const PROBE_BUDGET: usize = 20_000_000;
+
+/// Mirror and see-through bounces the probe follows.
+const PROBE_DEPTH: u32 = 4;
+
+/// Below this a colour is black (8-bit output rounds it to 0).
+const BLACK: f32 = 1.0 / 512.0;
+
+/// What one probe ray sees.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Seen {
+    /// Nothing: the background colour.
+    Background,
+    /// A surface that would be drawn black.
+    Black,
+    /// Something lit.
+    Content,
+}
+
+/// Why an image would show nothing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Blank {
+    pub reason: String,
+}
+
+/// A shape placed in the world, ready to intersect.
+struct Placed<'s> {
+    instance: &'s Instance,
+    shape: Shape,
+    material: &'s Material,
+    /// Closed shapes have an inside a camera can be in.
+    closed: bool,
+}
+
+/// A world-space hit.
+struct Hit<'p, 's> {
+    placed: &'p Placed<'s>,
+    t: f32,
+    point: Vec3A,
+    /// Unit, facing the ray.
+    normal: Vec3A,
+    back_face: bool,
+}
+
+fn v(x: DVec3) -> Vec3A {
+    Vec3A::from(x.as_vec3())
+}
+
+fn shape_of(g: &Geometry) -> Option<Shape> {
+    match *g {
+        Geometry::Sphere { center, radius } => {
+            Sphere::new(v(center), radius as f32).map(Shape::Sphere)
+        }
+        Geometry::Box { p1, p2 } => AaBox::new(v(p1), v(p2)).map(Shape::Box),
+        Geometry::Plane { point, normal } => Plane::new(v(point), v(normal)).map(Shape::Plane),
+        Geometry::Triangle {
+            vertices: [a, b, c],
+        } => Triangle::new(v(a), v(b), v(c)).map(Shape::Triangle),
+        Geometry::Cylinder { p1, p2, radius } => {
+            Cylinder::new(v(p1), v(p2), radius as f32).map(Shape::Cylinder)
+        }
+        Geometry::Cone { base, tip, radius } => {
+            Cone::new(v(base), v(tip), radius as f32).map(Shape::Cone)
+        }
+    }
+}
+
+/// The material draws nothing: fully transparent and not refracting. (Its reflectivity does
+/// not help: the shading model weighs the mirror term by the opacity, `docs/shading.md`.)
+fn invisible(m: &Material) -> bool {
+    m.opacity <= 0.0 && (m.ior - 1.0).abs() < 1e-6
+}
+
+/// A mirror that shows only what it reflects.
+fn perfect_mirror(m: &Material) -> bool {
+    m.reflectivity * m.opacity >= 0.999
+}
+
+struct Probe<'s> {
+    scene: &'s Scene,
+    placed: Vec<Placed<'s>>,
+}
+
+impl<'s> Probe<'s> {
+    fn new(scene: &'s Scene) -> Self {
+        let placed = scene
+            .instances
+            .iter()
+            .filter_map(|instance| {
+                let material = scene.materials.get(instance.material)?;
+                let shape = shape_of(&instance.geometry)?;
+                let closed = !matches!(
+                    instance.geometry,
+                    Geometry::Plane { .. } | Geometry::Triangle { .. }
+                );
+                Some(Placed {
+                    instance,
+                    shape,
+                    material,
+                    closed,
+                })
+            })
+            .collect();
+        Probe { scene, placed }
+    }
+
+    /// The nearest hit with a shape that draws something.
+    fn nearest(&self, ray: &Ray, t_max: f32) -> Option<Hit<'_, 's>> {
+        let mut best: Option<Hit> = None;
+        for p in &self.placed {
+            if invisible(p.material) {
+                continue;
+            }
+            let xf = &p.instance.transform;
+            let origin = xf.object_from_world.transform_point3(ray.origin.as_dvec3());
+            let dir = xf.object_from_world.transform_vector3(ray.dir.as_dvec3());
+            let local = Ray::new(v(origin), v(dir));
+            let limit = best.as_ref().map_or(t_max, |b| b.t);
+            let Some(h) = p.shape.intersect(&local, limit) else {
+                continue;
+            };
+            let n = (xf.normal_matrix() * h.normal.as_dvec3()).normalize_or_zero();
+            let mut normal = v(n);
+            let back_face = normal.dot(ray.dir) > 0.0;
+            if back_face {
+                normal = -normal;
+            }
+            best = Some(Hit {
+                placed: p,
+                t: h.t,
+                point: ray.at(h.t),
+                normal,
+                back_face,
+            });
+        }
+        best
+    }
+
+    /// Ambient and direct light at a hit (shadows from opaque shapes included).
+    fn direct(&self, hit: &Hit, view: Vec3A) -> Vec3 {
+        let m = hit.placed.material;
+        let mut c = self.scene.ambient * m.ka;
+        for light in &self.scene.lights {
+            let to_light = v(light.position) - hit.point;
+            let dist = to_light.length();
+            if dist <= 0.0 || light.intensity.max_element() <= 0.0 {
+                continue;
+            }
+            let l = to_light / dist;
+            let cos = hit.normal.dot(l);
+            if cos <= 0.0 {
+                continue;
+            }
+            let shadow = spawn_ray(hit.point, hit.normal, l);
+            let blocked = self
+                .nearest(&shadow, dist)
+                .is_some_and(|b| b.placed.material.opacity >= 1.0);
+            if blocked {
+                continue;
+            }
+            let r = reflect(-l, hit.normal);
+            let spec = r.dot(-view).max(0.0).powf(m.m.max(1.0));
+            c += light.intensity * (m.kd * cos + m.ks * spec);
+        }
+        c
+    }
+
+    fn trace(&self, ray: &Ray, depth: u32) -> (Seen, Option<bool>) {
+        let Some(hit) = self.nearest(ray, f32::INFINITY) else {
+            return (Seen::Background, None);
+        };
+        let m = hit.placed.material;
+        let back = Some(hit.back_face && hit.placed.closed);
+        let view = ray.dir.normalize_or_zero();
+        let local = self.direct(&hit, view) * (1.0 - m.reflectivity) * m.opacity;
+        if local.max_element() > BLACK {
+            return (Seen::Content, back);
+        }
+        if depth >= PROBE_DEPTH {
+            return (Seen::Black, back);
+        }
+        let mut seen = Seen::Black;
+        if m.reflectivity * m.opacity > 0.0 {
+            let dir = reflect(view, hit.normal);
+            let (s, _) = self.trace(&spawn_ray(hit.point, hit.normal, dir), depth + 1);
+            seen = combine(seen, s);
+        }
+        if m.opacity < 1.0 {
+            let (s, _) = self.trace(&spawn_ray(hit.point, hit.normal, view), depth + 1);
+            seen = combine(seen, s);
+        }
+        (seen, back)
+    }
+}
+
+fn combine(a: Seen, b: Seen) -> Seen {
+    match (a, b) {
+        (Seen::Content, _) | (_, Seen::Content) => Seen::Content,
+        (Seen::Background, _) | (_, Seen::Background) => Seen::Background,
+        _ => Seen::Black,
+    }
+}
+
+/// The probe's primary rays, as `render::camera` makes them for an image of `width` ×
+/// `height`; `None` for a camera the renderer would refuse (reported elsewhere).
+fn primary_rays(cam: &Camera, width: u32, height: u32) -> Option<Vec<Ray>> {
+    let d = cam.dir.try_normalize()?;
+    let r = d.cross(cam.up).try_normalize()?;
+    let u = r.cross(d);
+    // The image's own aspect ratio (the vertical field of view follows from it), on a grid
+    // of PROBE_WIDTH columns.
+    let aspect = f64::from(height.max(1)) / f64::from(width.max(1));
+    let rows = ((f64::from(PROBE_WIDTH) * aspect).round() as u32).clamp(2, 2 * PROBE_WIDTH);
+    let (w, h) = (f64::from(PROBE_WIDTH), f64::from(PROBE_WIDTH) * aspect);
+    let dist = (w / 2.0) / (cam.fov_x_deg.to_radians() / 2.0).tan();
+    let mut rays = Vec::new();
+    // The outer rays go through the centres of the image's outer pixels: what lies beyond
+    // them is never drawn.
+    let (ex, ey) = (
+        0.5 * w / f64::from(width.max(1)),
+        0.5 * h / f64::from(height.max(1)),
+    );
+    for y in 0..rows {
+        for x in 0..PROBE_WIDTH {
+            let px = ex + f64::from(x) * (w - 2.0 * ex) / f64::from(PROBE_WIDTH - 1);
+            let py = ey + f64::from(y) * (h - 2.0 * ey) / f64::from(rows - 1);
+            let dir = d * dist + r * (px - w / 2.0) + u * (h / 2.0 - py);
+            rays.push(Ray::new(v(cam.eye), v(dir.normalize())));
+        }
+    }
+    Some(rays)
+}
+
+/// Whether the image of `job` would be blank, and why. `None` when something would show (or
+/// the camera is one the renderer refuses, which it reports itself).
+pub fn blank_image(job: &RenderJob) -> Option<Blank> {
+    let scene = &job.scene;
+    let blank = |reason: String| Some(Blank { reason });
+    if scene.instances.is_empty() {
+        return blank("the scene has no shapes at all: the image is only the background".into());
+    }
+    let rays = primary_rays(&job.camera, job.width, job.height)?;
+    let probe = Probe::new(scene);
+    if probe.placed.len().saturating_mul(rays.len()) > PROBE_BUDGET {
+        // Scenes this big are generated, and their images are rarely empty: the probe
+        // stays cheap rather than exhaustive (the reasons above still apply).
+        return None;
+    }
+    let mut seen = Vec::with_capacity(rays.len());
+    for ray in &rays {
+        seen.push(probe.trace(ray, 0));
+    }
+    if seen.iter().any(|(s, _)| *s == Seen::Content) {
+        return None;
+    }
+    // Why: the reasons an author can act on, the most basic first.
+    let visible: Vec<&Placed> = probe
+        .placed
+        .iter()
+        .filter(|p| !invisible(p.material))
+        .collect();
+    let hits_any_geometry = rays.iter().any(|ray| {
+        probe.placed.iter().any(|p| {
+            let xf = &p.instance.transform;
+            let o = xf.object_from_world.transform_point3(ray.origin.as_dvec3());
+            let d = xf.object_from_world.transform_vector3(ray.dir.as_dvec3());
+            p.shape
+                .intersect(&Ray::new(v(o), v(d)), f32::INFINITY)
+                .is_some()
+        })
+    });
+    if hits_any_geometry && visible.is_empty() {
+        let names = material_names(probe.placed.iter().map(|p| p.material));
+        return blank(format!(
+            "every material the camera could see is invisible (opacity 0, ior 1): {names}"
+        ));
+    }
+    if !hits_any_geometry {
+        let eye = job.camera.eye;
+        let dir = job.camera.dir;
+        let behind = probe.placed.iter().all(|p| {
+            let b = p.shape.bounds();
+            if !b.min.is_finite() || !b.max.is_finite() {
+                return false;
+            }
+            let center = p
+                .instance
+                .transform
+                .point(((b.min + b.max) * 0.5).as_dvec3());
+            (center - eye).dot(dir) < 0.0
+        });
+        return blank(if behind {
+            format!(
+                "every shape is behind camera `{}`: it looks along {} {} {}",
+                job.camera.name, dir.x, dir.y, dir.z
+            )
+        } else {
+            format!(
+                "no shape is in the view of camera `{}` (all lie outside its field of view)",
+                job.camera.name
+            )
+        });
+    }
+    if seen.iter().all(|(_, back)| *back == Some(true)) {
+        let name = probe
+            .nearest(&rays[rays.len() / 2], f32::INFINITY)
+            .map_or(String::new(), |h| format!(" `{}`", h.placed.instance.name));
+        return blank(format!(
+            "the camera is inside an object{name}: every ray meets its inside, which no light reaches"
+        ));
+    }
+    if visible.iter().all(|p| perfect_mirror(p.material)) {
+        return blank(
+            "every visible material is a perfect mirror (reflectivity 1) of an empty world: \
+             the mirrors show only each other and the background"
+                .into(),
+        );
+    }
+    let lit = scene.lights.iter().any(|l| l.intensity.max_element() > 0.0);
+    if !lit && scene.ambient.max_element() <= 0.0 {
+        return blank(
+            "the scene has no lights and no ambient light: every surface is black".into(),
+        );
+    }
+    if !lit && visible.iter().all(|p| p.material.ka.max_element() <= 0.0) {
+        return blank(
+            "the scene has no lights, and the ambient light meets materials with Ka 0: every surface is black"
+                .into(),
+        );
+    }
+    blank("no light reaches the surfaces the camera sees: every one is in shadow or faces away from the lights".into())
+}
+
+fn material_names<'m>(materials: impl Iterator<Item = &'m Material>) -> String {
+    let mut names: Vec<&str> = Vec::new();
+    for m in materials {
+        if !names.contains(&m.name.as_str()) {
+            names.push(&m.name);
+        }
+    }
+    names
+        .iter()
+        .map(|n| format!("`{n}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// One warning per job whose image would be blank, at its render line (or the file's first
+/// line for the image of a file without one). Meant to be added to a loaded file's
+/// diagnostics (`scene::load`).
+pub fn blank_image_warnings(jobs: &[RenderJob], path: &Path) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    for job in jobs {
+        let Some(b) = blank_image(job) else { continue };
+        let loc = job.loc.clone().unwrap_or_else(|| Loc {
+            file: Arc::from(path),
+            line: 1,
+            col: 1,
+        });
+        let message = format!(
+            "the image `{}` would be blank: {}",
+            job.output.display(),
+            b.reason
+        );
+        out.push(Diagnostic::new(Severity::Warning, loc, message));
+    }
+    out
+}
+
+/// How a file fares, for `anim check --summary`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Classification {
+    /// Every image shows something.
+    Renders,
+    /// Some image would be blank; the reason is given (as a warning when loading).
+    BlankExplained(String),
+    /// The file is not rendered; the first error.
+    Rejected(String),
+}
+
+/// Loads `path` and probes each of its images.
+pub fn classify(path: &Path, opts: &LoadOptions) -> Classification {
+    match load_file(path, opts) {
+        Err(diagnostics) => {
+            let first = diagnostics
+                .iter()
+                .find(|d| d.is_error())
+                .map_or_else(|| "rejected".to_string(), |d| d.to_string());
+            Classification::Rejected(first.lines().next().unwrap_or_default().to_string())
+        }
+        Ok(loaded) => match loaded.jobs.iter().find_map(blank_image) {
+            Some(b) => Classification::BlankExplained(b.reason),
+            None => Classification::Renders,
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::load_str;
+
+    fn probe(text: &str) -> Option<String> {
+        let loaded = load_str(text, Path::new("probe.sdf"), &LoadOptions::default())
+            .unwrap_or_else(|d| panic!("{d:?}"));
+        loaded.jobs.iter().find_map(blank_image).map(|b| b.reason)
+    }
+
+    const MAT: &str = "define material red 0.2 0 0 1 0 0 0.5 0.5 0.5 20\n";
+    const CAM: &str = "define camera eye 60 0 0 0 0 0 -1 0 1 0\nrender eye out.png 64 36\n";
+
+    #[test]
+    fn a_lit_sphere_is_not_blank() {
+        let text =
+            format!("{MAT}define shape sphere s 0 0 -5 1 red\ndefine light l 0 5 0 1 1 1 1\n{CAM}");
+        assert_eq!(probe(&text), None);
+    }
+
+    #[test]
+    fn no_lights_and_no_ambient() {
+        let text = format!("{MAT}define shape sphere s 0 0 -5 1 red\n{CAM}");
+        assert!(probe(&text).unwrap().contains("no lights and no ambient"));
+    }
+
+    #[test]
+    fn every_shape_behind_the_camera() {
+        let text =
+            format!("{MAT}define shape sphere s 0 0 5 1 red\ndefine light l 0 5 0 1 1 1 1\n{CAM}");
+        assert!(probe(&text).unwrap().contains("behind"));
+    }
+
+    #[test]
+    fn camera_inside_a_sphere() {
+        let text = format!(
+            "{MAT}define shape sphere s 0 0 0 10 red\ndefine light l 0 50 0 1 1 1 1\n{CAM}"
+        );
+        assert!(probe(&text).unwrap().contains("inside"));
+    }
+
+    #[test]
+    fn invisible_materials() {
+        let text = "define material glass 0 0 0 0 0 0 0 0 0 10 0 0 1\n\
+                    define shape sphere s 0 0 -5 1 glass\ndefine light l 0 5 0 1 1 1 1\n"
+            .to_string()
+            + CAM;
+        assert!(probe(&text).unwrap().contains("invisible"));
+    }
+
+    #[test]
+    fn a_lone_perfect_mirror() {
+        let text = "define material m 0 0 0 0 0 0 0 0 0 10 1 1 1\n\
+                    define shape sphere s 0 0 -5 1 m\ndefine light l 0 5 0 1 1 1 1\n"
+            .to_string()
+            + CAM;
+        assert!(probe(&text).unwrap().contains("mirror"));
+    }
+
+    #[test]
+    fn a_cone_off_axis_is_seen() {
+        let text = "define material violet 0.3 0.0 0.6 0.5 0.0 0.8 0.1 0.0 0.3 1.0\n\
+                    define shape cone c 2.0 4.0 -10 4.0 7.0 -5 2 violet\n\
+                    define light spot 0 0 0 0.3 0.3 0.3 0.9 0.9 0.9\n\
+                    define camera eye 45.0\nrender eye out.ppm 1000 800\n";
+        assert_eq!(probe(text), None);
+    }
+
+    #[test]
+    fn no_shapes() {
+        let text = format!("{MAT}define light l 0 5 0 1 1 1 1\n{CAM}");
+        assert!(probe(&text).unwrap().contains("no shapes"));
+    }
+}
