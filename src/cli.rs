@@ -113,6 +113,10 @@ pub struct CheckArgs {
     /// Print only errors and the summary.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Print a table: for each file, whether it renders, renders blank (and why) or is
+    /// rejected (and why).
+    #[arg(long)]
+    pub summary: bool,
     #[command(flatten)]
     pub scene: SceneArgs,
 }
@@ -363,6 +367,7 @@ impl CheckArgs {
             inputs: self.inputs.clone(),
             load: self.scene.load_options(),
             quiet: self.quiet,
+            summary: self.summary,
         }
     }
 }

@@ -206,3 +206,42 @@ fn accepted_forms_are_errors_when_strict() {
         assert_eq!(code, 1, "{form}: {stderr}");
     }
 }
+
+/// `anim check --summary` prints what each file would show, and why not when it shows nothing.
+#[test]
+fn check_summary_classifies_each_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let material = "define material red 0.2 0 0 0.8 0.1 0.1 0.5 0.5 0.5 20\n";
+    let visible = "define shape sphere ball 0 0 -5 1 red\n";
+    let camera = "define camera cam 60\nrender cam out.png 8 6\n";
+    let lit = format!("{material}{visible}define light sun 5 5 5 1 1 1 1\n{camera}");
+    let dark = format!("{material}{visible}{camera}");
+    std::fs::write(dir.path().join("lit.sdf"), lit).unwrap();
+    std::fs::write(dir.path().join("dark.sdf"), dark).unwrap();
+    std::fs::write(dir.path().join("broken.sdf"), "define shape sphere\n").unwrap();
+    let out = assert_cmd::Command::cargo_bin("anim")
+        .unwrap()
+        .args(["check", "--summary", "--quiet"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let row = |name: &str| {
+        stdout
+            .lines()
+            .find(|l| l.contains(name))
+            .unwrap_or_else(|| panic!("no row for {name}:\n{stdout}"))
+            .to_string()
+    };
+    assert!(row("lit.sdf").contains("| renders |"), "{stdout}");
+    let dark = row("dark.sdf");
+    assert!(
+        dark.contains("| blank |") && dark.contains("light"),
+        "{dark}"
+    );
+    assert!(row("broken.sdf").contains("| rejected |"), "{stdout}");
+    assert!(
+        stdout.contains("renders: 1, blank with a reason: 1, rejected with a reason: 1"),
+        "{stdout}"
+    );
+}

@@ -1,7 +1,7 @@
 //! `anim check FILE|DIR...`: load scene files without rendering and report every problem.
 
 use crate::diag::Diagnostic;
-use crate::scene::load_file;
+use crate::scene::{load_file, probe};
 use crate::sdf::LoadOptions;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -12,6 +12,9 @@ pub struct CheckConfig {
     pub inputs: Vec<PathBuf>,
     pub load: LoadOptions,
     pub quiet: bool,
+    /// Also print a table saying of each file whether it renders, renders blank (and why) or
+    /// is rejected (and why).
+    pub summary: bool,
 }
 
 /// Checks every input (directories recursively: files ending in `.sdf` or `.txt`, or
@@ -40,16 +43,18 @@ pub fn run(config: &CheckConfig) -> ExitCode {
         }
     }
     let (mut ok, mut warned, mut rejected) = (0usize, 0usize, 0usize);
+    let mut table = Vec::new();
     for file in &files {
         match load_file(file, opts) {
             Ok(mut loaded) => {
+                table.push(match loaded.jobs.iter().find_map(probe::blank_image) {
+                    Some(blank) => (file, "blank", blank.reason),
+                    None => (file, "renders", String::new()),
+                });
                 // What the camera would see, as `anim render` checks it.
                 loaded
                     .diagnostics
-                    .extend(crate::scene::probe::blank_image_warnings(
-                        &loaded.jobs,
-                        file,
-                    ));
+                    .extend(probe::blank_image_warnings(&loaded.jobs, file));
                 if loaded.diagnostics.is_empty() {
                     ok += 1;
                 } else {
@@ -62,12 +67,22 @@ pub fn run(config: &CheckConfig) -> ExitCode {
                 }
             }
             Err(diagnostics) => {
+                let first = diagnostics.iter().find(|d| d.is_error());
+                let why = first.map(|d| d.to_string()).unwrap_or_default();
+                table.push((
+                    file,
+                    "rejected",
+                    why.lines().next().unwrap_or("").to_string(),
+                ));
                 rejected += 1;
                 for d in diagnostics.iter().filter(|d| !quiet || d.is_error()) {
                     eprintln!("{d}");
                 }
             }
         }
+    }
+    if config.summary {
+        print_summary_table(&table);
     }
     println!(
         "{} files: {ok} ok, {warned} with warnings, {rejected} rejected",
@@ -104,4 +119,25 @@ fn collect(dir: &Path, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
         }
     }
     Ok(())
+}
+
+/// What the camera would show of each file: `renders`, `blank` (with the reason the warning
+/// gives) or `rejected` (with the first error), then the counts of each.
+fn print_summary_table(table: &[(&PathBuf, &str, String)]) {
+    println!("| file | result | why |");
+    println!("|---|---|---|");
+    for (file, result, why) in table {
+        println!(
+            "| {} | {result} | {} |",
+            file.display(),
+            why.replace('|', "\\|")
+        );
+    }
+    let count = |what: &str| table.iter().filter(|(_, r, _)| *r == what).count();
+    println!(
+        "renders: {}, blank with a reason: {}, rejected with a reason: {}",
+        count("renders"),
+        count("blank"),
+        count("rejected")
+    );
 }
