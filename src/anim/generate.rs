@@ -53,7 +53,7 @@ impl BaseScene {
                 }
                 _ => None,
             };
-            // A later definition of a name replaces the earlier one (DIALECT.md).
+            // A later definition of a name replaces the earlier one (docs/scene-language.md §2).
             if let Some((name, kind)) = entry {
                 kinds.insert(name.clone(), kind);
             }

@@ -101,7 +101,7 @@ impl RenderScene {
             .enumerate()
             .any(|(i, m)| m.is_transparent() && used(i));
         // Every shaded colour is a convex combination of local colours and the background
-        // (the weights in SPEC.md §4 sum to 1), so the largest local colour bounds them all.
+        // (the weights in docs/shading.md §3 sum to 1), so the largest local colour bounds them all.
         let total_light: Vec3A = lights.iter().map(|l| l.intensity.max(Vec3A::ZERO)).sum();
         let max_local = materials
             .iter()

@@ -1,4 +1,4 @@
-//! Whitted-style shading: SPEC.md §4's local Phong model with hard shadows, mirror
+//! Whitted-style shading: the local Phong model of docs/shading.md §2 with hard shadows, mirror
 //! reflection and Fresnel refraction.
 
 use super::compile::{RenderScene, ShadeMaterial};
