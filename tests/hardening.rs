@@ -261,3 +261,70 @@ fn a_scene_far_from_the_origin_renders_as_it_does_at_the_origin() {
         );
     }
 }
+
+fn generate(spec: &Path) -> String {
+    let out = anim().arg("generate").arg(spec).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{stderr}");
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// `anim generate` pointed at a folder of the user's own files with frame-like names removes
+/// only what it wrote itself, and `anim render DIR` only the images it rendered.
+#[test]
+fn generate_and_render_remove_only_the_files_they_wrote() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "base.sdf",
+        &format!("{SPHERE}render cam x.png 8 6\n"),
+    );
+    let spec_text = |frames: u32| {
+        format!(
+            "(scene: File(\"base.sdf\"), fps: 1, length: Frames({frames}), resolution: (8, 6),\n\
+             output: \"IMG_{{frame}}.jpg\", frames_dir: \"photos\")\n"
+        )
+    };
+    let photos = dir.path().join("photos");
+    std::fs::create_dir_all(&photos).unwrap();
+    // The user's photos, named as frames of the spec would be.
+    let theirs = [
+        "IMG_0002.jpg",
+        "IMG_0007.jpg",
+        "IMG_0042.jpg",
+        "IMG_0007.sdf",
+    ];
+    for name in theirs {
+        write(&photos, name, "a holiday");
+    }
+    let untouched = || {
+        for name in theirs {
+            assert_eq!(
+                std::fs::read_to_string(photos.join(name)).unwrap(),
+                "a holiday",
+                "{name}"
+            );
+        }
+    };
+    let spec = write(dir.path(), "spec.ron", &spec_text(4));
+    generate(&spec);
+    assert!(photos.join("IMG_0003.sdf").is_file());
+    untouched();
+
+    // Shorter: the frames it wrote past the new end go, the photos stay.
+    write(dir.path(), "spec.ron", &spec_text(2));
+    let said = generate(&spec);
+    assert!(said.contains("removed 2 files"), "{said}");
+    assert!(!photos.join("IMG_0002.sdf").exists() && !photos.join("IMG_0003.sdf").exists());
+    untouched();
+
+    // Rendered, then shorter again: the renderer removes its own image of the dropped frame.
+    render_dir(&photos);
+    assert!(photos.join("IMG_0001.jpg").is_file());
+    write(dir.path(), "spec.ron", &spec_text(1));
+    generate(&spec);
+    render_dir(&photos);
+    assert!(!photos.join("IMG_0001.jpg").exists());
+    assert!(photos.join("IMG_0000.jpg").is_file());
+    untouched();
+}

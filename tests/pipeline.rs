@@ -349,14 +349,16 @@ fn generate_is_deterministic_atomic_and_trims_old_frames() {
         .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
         .collect();
     assert!(names.iter().all(|n| !n.contains(".tmp")), "{names:?}");
-    // A shorter animation removes the frames past its end (and their images), so they are
-    // neither rendered nor encoded by mistake.
-    std::fs::write(frames_dir.join("frame_0011.png"), b"old").expect("write");
+    // A shorter animation removes the frames it wrote past its end, so they are not rendered
+    // by mistake; an image anim did not write is left alone (the renderer removes its own, see
+    // tests/hardening.rs).
+    std::fs::write(frames_dir.join("frame_0011.png"), b"not anim's").expect("write");
     write_spec(8);
     let said = run();
     assert!(said.contains("wrote 8 frames"), "{said}");
     assert!(!frames_dir.join("frame_0008.sdf").exists());
-    assert!(!frames_dir.join("frame_0011.png").exists());
+    assert!(!frames_dir.join("frame_0011.sdf").exists());
+    assert!(frames_dir.join("frame_0011.png").exists());
     assert!(frames_dir.join("frame_0007.sdf").exists());
 }
 

@@ -41,8 +41,9 @@ pub struct GenerateReport {
     pub frames: usize,
     /// How many frame files were written because they were new or differed.
     pub written: usize,
-    /// Files an earlier run of `anim generate` wrote here (frames and their images) that the
-    /// animation no longer has, removed so they cannot be rendered or encoded by mistake.
+    /// Frame files an earlier run of `anim generate` wrote here that the animation no longer
+    /// has, removed so they cannot be rendered by mistake (`anim render DIR` then removes
+    /// their images).
     pub removed: usize,
     pub fps: u32,
     /// Warnings about the base scene.
@@ -116,10 +117,8 @@ pub fn run_generate(config: &GenerateConfig) -> Result<GenerateReport, Vec<Diagn
         let text = checked_frame_text(&generator, &anim, &src, &dir, i)?;
         let name = anim.output.sdf(i, anim.digits());
         let path = dir.join(&name);
-        manifest.push_str(&format!(
-            "{name}\t{}\n",
-            anim.output.image(i, anim.digits())
-        ));
+        manifest.push_str(&name);
+        manifest.push('\n');
         // Unchanged frames are left alone, so their files keep their identity for tools
         // that look at modification times.
         if std::fs::read(&path).ok().as_deref() == Some(text.as_bytes()) {
@@ -129,7 +128,7 @@ pub fn run_generate(config: &GenerateConfig) -> Result<GenerateReport, Vec<Diagn
             .map_err(|e| fail(&path, "cannot write the frame", e))?;
         written += 1;
     }
-    let current: HashSet<&str> = manifest.lines().flat_map(|l| l.split('\t')).collect();
+    let current: HashSet<&str> = manifest.lines().collect();
     let mut removed = 0;
     for stale in previous.iter().filter(|f| !current.contains(f.as_str())) {
         let path = dir.join(stale);
@@ -248,9 +247,10 @@ fn checked_frame_text(
     Ok(text)
 }
 
-/// The files `anim generate` wrote into a frame directory, one frame a line (its `.sdf` file
-/// and the image its render line names). Only files listed here are ever removed: a frame
-/// directory may hold the user's own files with names like frames.
+/// The frame files `anim generate` wrote into a frame directory, one a line. Only files listed
+/// here are ever removed: a frame directory may hold the user's own files with names like
+/// frames. The images of removed frames are the renderer's: `anim render DIR` removes those
+/// whose bytes are still exactly the ones it wrote.
 const MANIFEST: &str = ".anim-generated";
 
 /// The files listed by an earlier run's manifest (none without one).
@@ -258,7 +258,6 @@ fn read_manifest(path: &Path) -> std::io::Result<Vec<String>> {
     match std::fs::read_to_string(path) {
         Ok(text) => Ok(text
             .lines()
-            .flat_map(|l| l.split('\t'))
             // Only plain names in the directory itself, whatever the file says.
             .filter(|f| !f.is_empty() && Path::new(f).file_name() == Some(f.as_ref()))
             .map(str::to_string)

@@ -49,7 +49,8 @@ pub(super) fn frame_hash(sdf: &[u8], fingerprint: &str) -> u64 {
 }
 
 /// Removes the records of frames whose `.sdf` file is gone from `frames_dir` (an animation
-/// made shorter), so they cannot vouch for anything later.
+/// made shorter), with the images they vouch for: an image goes only when its bytes are still
+/// exactly the ones this renderer wrote, so a file of the user's with the same name stays.
 pub(super) fn prune_orphan_records(frames_dir: &Path, out_dir: &Path) -> std::io::Result<()> {
     let Ok(entries) = std::fs::read_dir(out_dir.join(CACHE_DIR)) else {
         return Ok(());
@@ -57,13 +58,52 @@ pub(super) fn prune_orphan_records(frames_dir: &Path, out_dir: &Path) -> std::io
     for entry in entries {
         let entry = entry?;
         let name = entry.file_name().to_string_lossy().into_owned();
-        if let Some(sdf) = name.strip_suffix(".hash") {
-            if !frames_dir.join(sdf).exists() {
-                std::fs::remove_file(entry.path())?;
+        let Some(sdf) = name.strip_suffix(".hash") else {
+            continue;
+        };
+        if frames_dir.join(sdf).exists() {
+            continue;
+        }
+        let text = std::fs::read_to_string(entry.path()).unwrap_or_default();
+        for image in text.lines().skip(2).filter_map(RecordedImage::parse) {
+            let path = out_dir.join(image.rel);
+            if image.still_holds_what_was_written(&path) {
+                std::fs::remove_file(&path)?;
             }
         }
+        std::fs::remove_file(entry.path())?;
     }
     Ok(())
+}
+
+/// An image line of a record: `image <len> <hash> <path relative to the images>`.
+struct RecordedImage<'a> {
+    len: u64,
+    hash: u64,
+    rel: &'a str,
+}
+
+impl RecordedImage<'_> {
+    fn parse(line: &str) -> Option<RecordedImage<'_>> {
+        let mut fields = line.splitn(4, ' ');
+        let (Some("image"), Some(len), Some(hash), Some(rel)) =
+            (fields.next(), fields.next(), fields.next(), fields.next())
+        else {
+            return None;
+        };
+        Some(RecordedImage {
+            len: len.parse().ok()?,
+            hash: u64::from_str_radix(hash, 16).ok()?,
+            rel,
+        })
+    }
+
+    /// Whether `path` holds exactly the bytes recorded (the length first: a changed size is
+    /// caught without reading the file).
+    fn still_holds_what_was_written(&self, path: &Path) -> bool {
+        let same_length = std::fs::metadata(path).is_ok_and(|m| m.is_file() && m.len() == self.len);
+        same_length && std::fs::read(path).map(|b| Fnv64::of(&b)).ok() == Some(self.hash)
+    }
 }
 
 /// The record's text: a header, the hash, and each image with its length and byte hash.
@@ -109,20 +149,10 @@ pub(super) fn is_up_to_date(out_dir: &Path, name: &str, hash: u64) -> bool {
     }
     let mut images = 0;
     for line in lines {
-        let mut fields = line.splitn(4, ' ');
-        let (Some("image"), Some(len), Some(bytes_hash), Some(rel)) =
-            (fields.next(), fields.next(), fields.next(), fields.next())
-        else {
+        let Some(image) = RecordedImage::parse(line) else {
             return false;
         };
-        let (Ok(len), Ok(bytes_hash)) = (len.parse::<u64>(), u64::from_str_radix(bytes_hash, 16))
-        else {
-            return false;
-        };
-        let path = out_dir.join(rel);
-        let same_length = std::fs::metadata(&path).is_ok_and(|m| m.is_file() && m.len() == len);
-        // The length first: a changed size is caught without reading the image.
-        if !same_length || std::fs::read(&path).map(|b| Fnv64::of(&b)).ok() != Some(bytes_hash) {
+        if !image.still_holds_what_was_written(&out_dir.join(image.rel)) {
             return false;
         }
         images += 1;
