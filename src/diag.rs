@@ -77,8 +77,19 @@ impl Diagnostic {
         let col = self.loc.as_ref().map_or(1, |l| l.col);
         let (start, end) = quote_range(line, col);
         let skipped = line[..start].chars().count();
-        self.source_start = u32::try_from(skipped).map_or(u32::MAX, |n| n.saturating_add(1));
-        self.source_line = Some(line[start..end].to_string());
+        // The `…` marks are kept in the quote; the opening one stands in the column of the
+        // last character left out, so columns still line up.
+        let mut quoted = String::with_capacity(end - start + 6);
+        if start > 0 {
+            quoted.push('…');
+        }
+        quoted.push_str(&line[start..end]);
+        if end < line.len() {
+            quoted.push('…');
+        }
+        let first = if start > 0 { skipped } else { 1 };
+        self.source_start = u32::try_from(first).unwrap_or(u32::MAX);
+        self.source_line = Some(quoted);
     }
 
     pub fn with_help(mut self, help: impl Into<String>) -> Self {
@@ -171,7 +182,8 @@ const MAX_MESSAGE_CHARS: usize = 1000;
 /// The byte range of `line` quoted for a diagnostic at 1-based character column `col`:
 /// the whole line when short, else about [`QUOTE_SIDE`] characters on each side of `col`.
 fn quote_range(line: &str, col: u32) -> (usize, usize) {
-    if line.len() <= 2 * QUOTE_SIDE {
+    // Two more for the `…` marks of a line quoted already.
+    if line.len() <= 2 * QUOTE_SIDE || line.chars().nth(2 * QUOTE_SIDE + 2).is_none() {
         return (0, line.len());
     }
     let col = col.saturating_sub(1) as usize;
@@ -324,7 +336,8 @@ mod tests {
         assert!(!text.chars().any(|c| c.is_control() && c != '\n'), "{text}");
         assert!(text.contains("unknown '\\u{1b}[31m'"), "{text}");
         assert!(
-            text.contains("ab \\u{1b}[31m\\u{0} \\u{85}x\n  |    ^^^^^^^^^^^^^^^^^"),
+            // `\u{1b}[31m\u{0}` takes 15 columns once escaped; the caret spans them all.
+            text.contains("ab \\u{1b}[31m\\u{0} \\u{85}x\n  |    ^^^^^^^^^^^^^^^\n"),
             "{text}"
         );
     }

@@ -79,7 +79,7 @@ pub fn build(
     opts: &LoadOptions,
 ) -> Result<Loaded, Vec<Diagnostic>> {
     let (jobs, diagnostics) = build_jobs(statements, path, opts, None);
-    conclude(jobs, finish_diagnostics(diagnostics, opts), path)
+    conclude(jobs, finish_diagnostics(diagnostics, opts), path, &[])
 }
 
 /// Parses and builds a file's text. `Err` holds every diagnostic (warnings too) when at least
@@ -87,32 +87,41 @@ pub fn build(
 /// out.
 pub fn load_str(text: &str, path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnostic>> {
     let parsed = sdf::parse_source(text, path, opts);
-    let (jobs, mut built) = build_jobs(&parsed.statements, path, opts, Some(&parsed.omissions));
-    // Quoted here (not by `Parsed::quote_source`) so that each diagnostic copies only the part
-    // of its line it shows.
-    for d in &mut built {
+    let (jobs, built) = build_jobs(&parsed.statements, path, opts, Some(&parsed.omissions));
+    let mut diagnostics = parsed.diagnostics;
+    diagnostics.extend(built);
+    conclude(
+        jobs,
+        finish_diagnostics(diagnostics, opts),
+        path,
+        &parsed.lines,
+    )
+}
+
+/// `Err` with the diagnostics when one is an error. They are capped first, then the kept
+/// ones that lack their source line quote it from `lines`: quoting is done here (not by
+/// `Parsed::quote_source`) so that only the diagnostics shown are quoted, each copying only
+/// the part of its line it shows (a line of a million bad names would otherwise be scanned
+/// once per name).
+fn conclude(
+    jobs: Vec<RenderJob>,
+    diagnostics: Vec<Diagnostic>,
+    path: &Path,
+    lines: &[String],
+) -> Result<Loaded, Vec<Diagnostic>> {
+    let failed = diagnostics.iter().any(Diagnostic::is_error);
+    let mut diagnostics = cap(diagnostics, path);
+    for d in &mut diagnostics {
         let line = d
             .loc
             .as_ref()
             .and_then(|l| usize::try_from(l.line).ok())
             .and_then(|n| n.checked_sub(1))
-            .and_then(|i| parsed.lines.get(i));
+            .and_then(|i| lines.get(i));
         if let (None, Some(line)) = (&d.source_line, line) {
             d.quote(line);
         }
     }
-    let mut diagnostics = parsed.diagnostics;
-    diagnostics.extend(built);
-    conclude(jobs, finish_diagnostics(diagnostics, opts), path)
-}
-
-fn conclude(
-    jobs: Vec<RenderJob>,
-    diagnostics: Vec<Diagnostic>,
-    path: &Path,
-) -> Result<Loaded, Vec<Diagnostic>> {
-    let failed = diagnostics.iter().any(Diagnostic::is_error);
-    let diagnostics = cap(diagnostics, path);
     if failed {
         Err(diagnostics)
     } else {
