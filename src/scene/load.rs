@@ -24,9 +24,7 @@ pub struct Loaded {
 
 /// Reads and loads a file. `Err` holds every diagnostic (at least one error).
 pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnostic>> {
-    let bytes = read_input(path, opts.max_input, "file").map_err(|d| {
-        vec![d.with_help("scene files are text in the scene language (docs/scene-language.md)")]
-    })?;
+    let bytes = read_input(path, opts.max_input, "file")?;
     load_str(&String::from_utf8_lossy(&bytes), path, opts)
 }
 
@@ -35,15 +33,21 @@ pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnost
 /// so memory never grows past the limit. A file with a NUL byte in its first
 /// [`TEXT_SNIFF_BYTES`] is "not a text file", found before the rest is read (`/dev/zero`
 /// fails at once). `what` names the file in messages ("file", "the spec").
-pub fn read_input(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Diagnostic> {
+pub fn read_input(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Vec<Diagnostic>> {
+    read_bounded(path, limit, what).map_err(|d| vec![*d])
+}
+
+fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Box<Diagnostic>> {
     let cannot =
         |e: std::io::Error| Diagnostic::file_error(path, format!("cannot read {what}: {e}"));
     let too_big = |size: String| {
-        Diagnostic::file_error(
-            path,
-            format!("too large to read: {size}, more than the limit of {limit} bytes"),
+        Box::new(
+            Diagnostic::file_error(
+                path,
+                format!("too large to read: {size}, more than the limit of {limit} bytes"),
+            )
+            .with_help("raise the limit with --max-input BYTES if the file is meant"),
         )
-        .with_help("raise the limit with --max-input BYTES if the file is meant")
     };
     let file = std::fs::File::open(path).map_err(cannot)?;
     let meta = file.metadata().map_err(cannot)?;
@@ -59,10 +63,10 @@ pub fn read_input(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Diagno
         .read_to_end(&mut bytes)
         .map_err(cannot)?;
     if bytes.contains(&0) {
-        return Err(Diagnostic::file_error(
+        return Err(Box::new(Diagnostic::file_error(
             path,
             "not a text file (it holds NUL bytes)",
-        ));
+        )));
     }
     input.read_to_end(&mut bytes).map_err(cannot)?;
     if bytes.len() as u64 > limit {
