@@ -46,6 +46,9 @@ pub struct SceneArgs {
     /// default) or `local` (M ← M·T).
     #[arg(long, value_enum, default_value = "world")]
     pub transform_order: TransformOrderArg,
+    /// Largest scene file read, in bytes; larger files are refused unread.
+    #[arg(long, value_name = "BYTES", default_value_t = crate::sdf::DEFAULT_MAX_INPUT)]
+    pub max_input: u64,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -386,6 +389,7 @@ impl SceneArgs {
                 TransformOrderArg::World => TransformOrder::World,
                 TransformOrderArg::Local => TransformOrder::Local,
             },
+            max_input: self.max_input,
         }
     }
 }

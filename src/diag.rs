@@ -29,6 +29,9 @@ pub struct Diagnostic {
     pub message: String,
     /// The source line, shown with a caret under `loc.col` spanning `width` characters.
     pub source_line: Option<String>,
+    /// The column (in characters, from 1) of the line at which `source_line` starts: a
+    /// quote of a very long line keeps only the part around `loc.col`.
+    pub source_start: u32,
     pub width: u32,
     /// "did you mean `glass`?", the canonical form of a statement, ...
     pub help: Option<String>,
@@ -42,6 +45,7 @@ impl Diagnostic {
             loc: Some(loc),
             message: message.into(),
             source_line: None,
+            source_start: 1,
             width: 1,
             help: None,
         }
@@ -55,15 +59,37 @@ impl Diagnostic {
             file: file.to_path_buf(),
             message: message.into(),
             source_line: None,
+            source_start: 1,
             width: 1,
             help: None,
         }
     }
 
-    pub fn with_source(mut self, line: impl Into<String>, width: u32) -> Self {
-        self.source_line = Some(line.into());
+    pub fn with_source(mut self, line: impl AsRef<str>, width: u32) -> Self {
         self.width = width.max(1);
+        self.quote(line.as_ref());
         self
+    }
+
+    /// Sets the quoted source line from the whole `line`, keeping only the part shown (so
+    /// that diagnostics about a line of megabytes do not each hold a copy of it).
+    pub fn quote(&mut self, line: &str) {
+        let col = self.loc.as_ref().map_or(1, |l| l.col);
+        let (start, end) = quote_range(line, col);
+        let skipped = line[..start].chars().count();
+        // The `…` marks are kept in the quote; the opening one stands in the column of the
+        // last character left out, so columns still line up.
+        let mut quoted = String::with_capacity(end - start + 6);
+        if start > 0 {
+            quoted.push('…');
+        }
+        quoted.push_str(&line[start..end]);
+        if end < line.len() {
+            quoted.push('…');
+        }
+        let first = if start > 0 { skipped } else { 1 };
+        self.source_start = u32::try_from(first).unwrap_or(u32::MAX);
+        self.source_line = Some(quoted);
     }
 
     pub fn with_help(mut self, help: impl Into<String>) -> Self {
@@ -89,41 +115,160 @@ impl fmt::Display for Diagnostic {
             Severity::Warning => "warning",
             Severity::Error => "error",
         };
+        let message = shorten(&self.message);
+        let message = escape(&message);
         match &self.loc {
             Some(loc) => write!(
                 f,
-                "{}:{}:{}: {kind}: {}",
-                loc.file.display(),
+                "{}:{}:{}: {kind}: {message}",
+                escape(&loc.file.display().to_string()),
                 loc.line,
                 loc.col,
-                self.message
             )?,
-            None => write!(f, "{}: {kind}: {}", self.file.display(), self.message)?,
+            None => write!(
+                f,
+                "{}: {kind}: {message}",
+                escape(&self.file.display().to_string())
+            )?,
         }
         if let (Some(src), Some(loc)) = (&self.source_line, &self.loc) {
             let gutter = loc.line.to_string().len();
+            // The column within the quoted part of the line.
+            let col = loc
+                .col
+                .saturating_sub(self.source_start.saturating_sub(1))
+                .max(1);
+            let (start, end) = quote_range(src, col);
+            let before = src[..start].chars().count();
+            let open = if start > 0 { "…" } else { "" };
+            let close = if end < src.len() { "…" } else { "" };
+            let shown = &src[start..end];
+            // The caret goes under the escaped text, so its column counts escapes' widths.
+            let pad = open.chars().count()
+                + shown
+                    .chars()
+                    .take((col as usize - 1).saturating_sub(before))
+                    .map(shown_width)
+                    .sum::<usize>();
+            let carets: usize = shown
+                .chars()
+                .skip((col as usize - 1).saturating_sub(before))
+                .take(self.width as usize)
+                .map(shown_width)
+                .sum::<usize>()
+                .max(1);
             write!(
                 f,
-                "\n{:gutter$} |\n{} | {}\n{:gutter$} | ",
+                "\n{:gutter$} |\n{} | {open}{}{close}\n{:gutter$} | ",
                 "",
                 loc.line,
-                src.replace('\t', " "),
+                escape(&shown.replace('\t', " ")),
                 ""
             )?;
-            let pad = loc.col.saturating_sub(1) as usize;
-            write!(f, "{:pad$}{}", "", "^".repeat(self.width as usize))?;
+            write!(f, "{:pad$}{}", "", "^".repeat(carets))?;
         }
         if let Some(help) = &self.help {
-            write!(f, "\n  = help: {help}")?;
+            write!(f, "\n  = help: {}", shorten(&escape(help)))?;
         }
         Ok(())
     }
 }
 
+/// Characters of a source line quoted on each side of the column pointed at.
+const QUOTE_SIDE: usize = 100;
+/// Characters of a message or help shown at most (they quote tokens, which can be huge).
+const MAX_MESSAGE_CHARS: usize = 1000;
+
+/// The byte range of `line` quoted for a diagnostic at 1-based character column `col`:
+/// the whole line when short, else about [`QUOTE_SIDE`] characters on each side of `col`.
+fn quote_range(line: &str, col: u32) -> (usize, usize) {
+    // Two more for the `…` marks of a line quoted already.
+    if line.len() <= 2 * QUOTE_SIDE || line.chars().nth(2 * QUOTE_SIDE + 2).is_none() {
+        return (0, line.len());
+    }
+    let col = col.saturating_sub(1) as usize;
+    let first = col.saturating_sub(QUOTE_SIDE);
+    let mut start = line.len();
+    let mut end = line.len();
+    for (n, (i, _)) in line.char_indices().enumerate() {
+        if n == first {
+            start = i;
+        }
+        if n == first + 2 * QUOTE_SIDE {
+            end = i;
+            break;
+        }
+    }
+    if start == line.len() {
+        // The column lies past the end (a missing argument): quote the line's end.
+        let from = line
+            .char_indices()
+            .rev()
+            .nth(2 * QUOTE_SIDE - 1)
+            .map_or(0, |(i, _)| i);
+        return (from, line.len());
+    }
+    (start, end)
+}
+
+/// Whether `c` must not reach a terminal as it is: C0 and C1 controls and DEL (escape
+/// sequences could recolour, retitle or clear the user's terminal).
+fn is_control(c: char) -> bool {
+    c != '\n' && c != '\t' && c.is_control()
+}
+
+/// Width of a quoted character once escaped.
+fn shown_width(c: char) -> usize {
+    if is_control(c) {
+        format!("{}", c.escape_unicode()).chars().count()
+    } else {
+        1
+    }
+}
+
+/// `text` with control characters written as escapes (`\u{1b}`).
+pub fn escape(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text.chars().any(is_control) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if is_control(c) {
+            out.extend(c.escape_unicode());
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
+}
+
+/// `text` cut in the middle (with `…`) when longer than [`MAX_MESSAGE_CHARS`].
+fn shorten(text: &str) -> std::borrow::Cow<'_, str> {
+    if text.len() <= MAX_MESSAGE_CHARS {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let n = text.chars().count();
+    if n <= MAX_MESSAGE_CHARS {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let half = MAX_MESSAGE_CHARS / 2;
+    let head: String = text.chars().take(half).collect();
+    let tail: String = text.chars().skip(n - half).collect();
+    std::borrow::Cow::Owned(format!("{head}…{tail}"))
+}
+
 /// The closest name to `wanted` among `candidates`, if it is close enough to be a likely typo.
 pub fn suggest<'a>(wanted: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let len = wanted.chars().count();
     candidates
         .into_iter()
+        // The distance is at least the difference in length, and at most a third of the
+        // longer name is accepted: other names are not compared (the comparison costs the
+        // product of the lengths, which a huge token would make minutes).
+        .filter(|c| {
+            let other = c.chars().count();
+            other.abs_diff(len) <= (len.max(other) / 3).max(1)
+        })
         .map(|c| (strsim::damerau_levenshtein(wanted, c), c))
         .filter(|&(d, c)| d > 0 && d <= (wanted.chars().count().max(c.chars().count()) / 3).max(1))
         .min_by_key(|&(d, c)| (d, c.to_string()))
@@ -149,11 +294,60 @@ mod tests {
         assert!(text.contains("12 | abc 1O x\n   |     ^^"), "{text}");
     }
 
+    fn at(col: u32) -> Loc {
+        Loc {
+            file: Arc::from(Path::new("s.sdf")),
+            line: 3,
+            col,
+        }
+    }
+
+    #[test]
+    fn long_lines_are_quoted_around_the_column() {
+        let line = format!("{}BAD{}", "a ".repeat(5000), " b".repeat(5000));
+        let d = Diagnostic::new(Severity::Error, at(10_001), "bad").with_source(line.clone(), 3);
+        let text = d.to_string();
+        assert!(text.len() < 600, "{text}");
+        let quoted = text.lines().nth(2).unwrap();
+        let caret = text.lines().nth(3).unwrap();
+        assert!(
+            quoted.starts_with("3 | …") && quoted.ends_with('…'),
+            "{quoted}"
+        );
+        let col = quoted.chars().position(|c| c == 'B').unwrap();
+        assert_eq!(caret.chars().position(|c| c == '^'), Some(col), "{text}");
+        assert!(caret.ends_with("^^^"));
+        // Quoting from the loader's copy of the line gives the same picture.
+        let mut e = Diagnostic::new(Severity::Error, at(10_001), "bad");
+        e.width = 3;
+        e.quote(&line);
+        assert_eq!(e.to_string(), text);
+        // A column past the end quotes the end of the line.
+        let end = Diagnostic::new(Severity::Error, at(20_002), "missing").with_source(line, 1);
+        assert!(end.to_string().contains(" b b\n"), "{end}");
+    }
+
+    #[test]
+    fn control_characters_are_escaped() {
+        let d = Diagnostic::new(Severity::Error, at(4), "unknown '\u{1b}[31m'")
+            .with_source("ab \u{1b}[31m\0 \u{85}x", 6)
+            .with_help("\u{7}");
+        let text = d.to_string();
+        assert!(!text.chars().any(|c| c.is_control() && c != '\n'), "{text}");
+        assert!(text.contains("unknown '\\u{1b}[31m'"), "{text}");
+        assert!(
+            // `\u{1b}[31m\u{0}` takes 15 columns once escaped; the caret spans them all.
+            text.contains("ab \\u{1b}[31m\\u{0} \\u{85}x\n  |    ^^^^^^^^^^^^^^^\n"),
+            "{text}"
+        );
+    }
+
     #[test]
     fn suggestions_only_for_near_misses() {
         let names = ["glass", "red", "blue"];
         assert_eq!(suggest("glas", names), Some("glass"));
         assert_eq!(suggest("blu", names), Some("blue"));
         assert_eq!(suggest("zzzzzz", names), None);
+        assert_eq!(suggest(&"x".repeat(100_000), names), None);
     }
 }

@@ -187,6 +187,8 @@ mod tests {
             strict,
             material_fields,
             transform_order,
+            // The input limit decides whether a file is read at all, never what it renders.
+            max_input: _,
         } = load.clone();
         let variants: Vec<(RenderSettings, LoadOptions)> = vec![
             (

@@ -2,10 +2,18 @@
 
 use super::build::build_jobs;
 use super::RenderJob;
-use crate::diag::Diagnostic;
+use crate::diag::{Diagnostic, Severity};
 use crate::sdf::ast::Statement;
 use crate::sdf::{self, finish_diagnostics, LoadOptions};
+use std::io::Read;
 use std::path::Path;
+
+/// Diagnostics kept per file: a file with thousands of bad lines (a binary file, a file in
+/// another format) gets its first problems listed and a count of the rest, not pages of them.
+pub const MAX_DIAGNOSTICS: usize = 50;
+
+/// How much of the start of a file is looked at for NUL bytes, which text never holds.
+const TEXT_SNIFF_BYTES: usize = 8 << 10;
 
 /// A successfully loaded file: its images to render and the warnings met on the way.
 #[derive(Clone, Debug)]
@@ -16,13 +24,55 @@ pub struct Loaded {
 
 /// Reads and loads a file. `Err` holds every diagnostic (at least one error).
 pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnostic>> {
-    let text = std::fs::read(path).map_err(|e| {
-        vec![Diagnostic::file_error(
+    let bytes = read_input(path, opts.max_input, "file")?;
+    load_str(&String::from_utf8_lossy(&bytes), path, opts)
+}
+
+/// Reads a whole text file of at most `limit` bytes. Larger files are refused from their
+/// size when the file system knows it, else after reading `limit + 1` bytes (pipes, devices),
+/// so memory never grows past the limit. A file with a NUL byte in its first
+/// [`TEXT_SNIFF_BYTES`] is "not a text file", found before the rest is read (`/dev/zero`
+/// fails at once). `what` names the file in messages ("file", "the spec").
+pub fn read_input(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Vec<Diagnostic>> {
+    read_bounded(path, limit, what).map_err(|d| vec![*d])
+}
+
+fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Box<Diagnostic>> {
+    let cannot =
+        |e: std::io::Error| Diagnostic::file_error(path, format!("cannot read {what}: {e}"));
+    let too_big = |size: String| {
+        Box::new(
+            Diagnostic::file_error(
+                path,
+                format!("too large to read: {size}, more than the limit of {limit} bytes"),
+            )
+            .with_help("raise the limit with --max-input BYTES if the file is meant"),
+        )
+    };
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    let meta = file.metadata().map_err(cannot)?;
+    // Regular files tell their length; devices and pipes say 0 and are bounded by `take`.
+    if meta.is_file() && meta.len() > limit {
+        return Err(too_big(format!("{} bytes", meta.len())));
+    }
+    let expected = if meta.is_file() { meta.len() } else { 0 };
+    let mut bytes = Vec::with_capacity(usize::try_from(expected.min(limit)).unwrap_or(0));
+    let mut input = file.take(limit.saturating_add(1));
+    (&mut input)
+        .take(TEXT_SNIFF_BYTES as u64)
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.contains(&0) {
+        return Err(Box::new(Diagnostic::file_error(
             path,
-            format!("cannot read file: {e}"),
-        )]
-    })?;
-    load_str(&String::from_utf8_lossy(&text), path, opts)
+            "not a text file (it holds NUL bytes)",
+        )));
+    }
+    input.read_to_end(&mut bytes).map_err(cannot)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_big("it goes on past the limit".to_string()));
+    }
+    Ok(bytes)
 }
 
 /// Builds the render jobs of a statement list (from [`sdf::parse`], or made by a program, whose
@@ -33,24 +83,94 @@ pub fn build(
     opts: &LoadOptions,
 ) -> Result<Loaded, Vec<Diagnostic>> {
     let (jobs, diagnostics) = build_jobs(statements, path, opts, None);
-    conclude(jobs, finish_diagnostics(diagnostics, opts))
+    conclude(jobs, finish_diagnostics(diagnostics, opts), path, &[])
 }
 
 /// Parses and builds a file's text. `Err` holds every diagnostic (warnings too) when at least
-/// one is an error.
+/// one is an error. At most [`MAX_DIAGNOSTICS`] are kept, then one saying how many were left
+/// out.
 pub fn load_str(text: &str, path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnostic>> {
     let parsed = sdf::parse_source(text, path, opts);
-    let (jobs, mut built) = build_jobs(&parsed.statements, path, opts, Some(&parsed.omissions));
-    parsed.quote_source(&mut built);
+    let (jobs, built) = build_jobs(&parsed.statements, path, opts, Some(&parsed.omissions));
     let mut diagnostics = parsed.diagnostics;
     diagnostics.extend(built);
-    conclude(jobs, finish_diagnostics(diagnostics, opts))
+    conclude(
+        jobs,
+        finish_diagnostics(diagnostics, opts),
+        path,
+        &parsed.lines,
+    )
 }
 
-fn conclude(jobs: Vec<RenderJob>, diagnostics: Vec<Diagnostic>) -> Result<Loaded, Vec<Diagnostic>> {
-    if diagnostics.iter().any(Diagnostic::is_error) {
+/// `Err` with the diagnostics when one is an error. They are capped first, then the kept
+/// ones that lack their source line quote it from `lines`: quoting is done here (not by
+/// `Parsed::quote_source`) so that only the diagnostics shown are quoted, each copying only
+/// the part of its line it shows (a line of a million bad names would otherwise be scanned
+/// once per name).
+fn conclude(
+    jobs: Vec<RenderJob>,
+    diagnostics: Vec<Diagnostic>,
+    path: &Path,
+    lines: &[String],
+) -> Result<Loaded, Vec<Diagnostic>> {
+    let failed = diagnostics.iter().any(Diagnostic::is_error);
+    let mut diagnostics = cap(diagnostics, path);
+    for d in &mut diagnostics {
+        let line = d
+            .loc
+            .as_ref()
+            .and_then(|l| usize::try_from(l.line).ok())
+            .and_then(|n| n.checked_sub(1))
+            .and_then(|i| lines.get(i));
+        if let (None, Some(line)) = (&d.source_line, line) {
+            d.quote(line);
+        }
+    }
+    if failed {
         Err(diagnostics)
     } else {
         Ok(Loaded { jobs, diagnostics })
     }
+}
+
+/// The first [`MAX_DIAGNOSTICS`] diagnostics and, if there were more, one saying how many
+/// were left out (an error if any of those is one, so the count is never mistaken for
+/// harmless).
+fn cap(mut diagnostics: Vec<Diagnostic>, path: &Path) -> Vec<Diagnostic> {
+    if diagnostics.len() <= MAX_DIAGNOSTICS {
+        return diagnostics;
+    }
+    let rest = diagnostics.split_off(MAX_DIAGNOSTICS);
+    let errors = rest.iter().filter(|d| d.is_error()).count();
+    let warnings = rest.len() - errors;
+    let mut kinds = Vec::new();
+    if errors > 0 {
+        kinds.push(format!(
+            "{errors} error{}",
+            if errors == 1 { "" } else { "s" }
+        ));
+    }
+    if warnings > 0 {
+        kinds.push(format!(
+            "{warnings} warning{}",
+            if warnings == 1 { "" } else { "s" }
+        ));
+    }
+    let severity = if errors > 0 {
+        Severity::Error
+    } else {
+        Severity::Warning
+    };
+    diagnostics.push(
+        Diagnostic::file_error(
+            path,
+            format!(
+                "and {} more ({}) not shown: only the first {MAX_DIAGNOSTICS} problems of a file are listed",
+                rest.len(),
+                kinds.join(", ")
+            ),
+        )
+        .with_severity(severity),
+    );
+    diagnostics
 }

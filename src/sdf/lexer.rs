@@ -38,27 +38,74 @@ impl Line<'_> {
     }
 }
 
-/// Splits a whole file into lines (LF or CRLF, final newline optional) and tokenizes each.
-/// A byte-order mark at the start of the file is ignored.
+/// Tokens kept of one line. No statement needs more (a composite listing a million children
+/// is far beyond the shape limit); a line with more is reported by [`overlong_lines`] and
+/// only its first tokens are kept, so one huge line cannot take gigabytes of token records.
+pub const MAX_TOKENS_PER_LINE: usize = 1 << 20;
+
+/// Splits a whole file into lines and tokenizes each. LF, CRLF and a lone CR (old Mac files)
+/// all end a line; the final line ending is optional. A byte-order mark at the start of the
+/// file is ignored.
 pub fn lines(text: &str) -> Vec<Line<'_>> {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut out = Vec::new();
-    let mut raw_lines = text.split('\n').peekable();
-    let mut number: u32 = 0;
-    while let Some(raw) = raw_lines.next() {
-        // `split` yields one empty piece after a final newline; it is not a line.
-        if raw.is_empty() && raw_lines.peek().is_none() {
-            break;
-        }
-        number = number.saturating_add(1);
-        let raw = raw.strip_suffix('\r').unwrap_or(raw);
-        out.push(Line {
-            number,
+    raw_lines(text)
+        .enumerate()
+        .map(|(i, raw)| Line {
+            number: line_number(i),
             text: raw,
             tokens: tokenize(raw),
-        });
-    }
-    out
+        })
+        .collect()
+}
+
+/// The lines of a file without their line endings, without tokenizing them.
+pub fn raw_lines(text: &str) -> impl Iterator<Item = &str> {
+    let mut rest = text.strip_prefix('\u{feff}').unwrap_or(text);
+    std::iter::from_fn(move || {
+        if rest.is_empty() {
+            // A final line ending does not start another line.
+            return None;
+        }
+        let bytes = rest.as_bytes();
+        match bytes.iter().position(|&b| b == b'\n' || b == b'\r') {
+            None => {
+                let line = rest;
+                rest = "";
+                Some(line)
+            }
+            Some(end) => {
+                let line = &rest[..end];
+                let skip = if bytes[end] == b'\r' && bytes.get(end + 1) == Some(&b'\n') {
+                    2
+                } else {
+                    1
+                };
+                rest = &rest[end + skip..];
+                Some(line)
+            }
+        }
+    })
+}
+
+/// The 1-based number of the line at index `i`, saturating (a file cannot have 4 billion
+/// lines under the input limit, but the arithmetic must not wrap if it had).
+fn line_number(i: usize) -> u32 {
+    u32::try_from(i).map_or(u32::MAX, |n| n.saturating_add(1))
+}
+
+/// Lines holding more than [`MAX_TOKENS_PER_LINE`] tokens: (line number, tokens on it).
+pub fn overlong_lines(text: &str) -> Vec<(u32, usize)> {
+    raw_lines(text)
+        .enumerate()
+        .filter_map(|(i, raw)| {
+            // Only long lines can hold that many tokens; counting is skipped for the rest.
+            if raw.len() < MAX_TOKENS_PER_LINE {
+                return None;
+            }
+            let code = raw.split('#').next().unwrap_or("");
+            let count = code.split_whitespace().count();
+            (count > MAX_TOKENS_PER_LINE).then_some((line_number(i), count))
+        })
+        .collect()
 }
 
 /// The tokens of one line, comments removed.
@@ -76,6 +123,10 @@ pub fn tokenize(line: &str) -> Vec<Token<'_>> {
         if ch.is_whitespace() {
             if let Some((s, c)) = start.take() {
                 tokens.push(make_token(line, s, i, c));
+                if tokens.len() >= MAX_TOKENS_PER_LINE {
+                    // The rest is not kept (see `overlong_lines`, which reports the line).
+                    return tokens;
+                }
             }
         } else if start.is_none() {
             start = Some((i, col));
@@ -285,5 +336,26 @@ mod tests {
         assert_eq!(ls[3].tokens[0].text, "d");
         assert_eq!(lines("a\n").len(), 1);
         assert!(lines("").is_empty());
+    }
+
+    #[test]
+    fn a_lone_cr_ends_a_line() {
+        let ls = lines("// comment\rdefine x\r\rrender c\r");
+        assert_eq!(ls.len(), 4);
+        assert!(ls[0].tokens.is_empty());
+        assert_eq!(ls[1].tokens[0].text, "define");
+        assert_eq!(ls[3].number, 4);
+        assert_eq!(lines("a\r\nb\rc\n").len(), 3);
+        assert_eq!(lines("a\r\r\nb").len(), 3);
+        assert_eq!(lines("\r").len(), 1);
+    }
+
+    #[test]
+    fn tokens_of_one_line_are_capped_and_the_line_reported() {
+        let text = format!("a\n{}\n", "x ".repeat(MAX_TOKENS_PER_LINE + 3));
+        let ls = lines(&text);
+        assert_eq!(ls[1].tokens.len(), MAX_TOKENS_PER_LINE);
+        assert_eq!(overlong_lines(&text), vec![(2, MAX_TOKENS_PER_LINE + 3)]);
+        assert!(overlong_lines("a b c\n").is_empty());
     }
 }

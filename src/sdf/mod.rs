@@ -12,8 +12,9 @@ pub mod repair;
 
 pub use parse::{default_output, Omissions, Parsed};
 
-use crate::diag::{Diagnostic, Severity};
+use crate::diag::{Diagnostic, Loc, Severity};
 use std::path::Path;
+use std::sync::Arc;
 
 /// Meaning of the numbers after `m` in a material line (`--material-fields`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -42,7 +43,13 @@ pub struct LoadOptions {
     pub strict: bool,
     pub material_fields: Vec<MaterialField>,
     pub transform_order: TransformOrder,
+    /// Largest input file read, in bytes (`--max-input`); larger files are refused unread.
+    pub max_input: u64,
 }
+
+/// The default of `--max-input`: 1 GiB. Far beyond any hand-written or generated scene,
+/// and small enough that reading one whole cannot exhaust an ordinary machine.
+pub const DEFAULT_MAX_INPUT: u64 = 1 << 30;
 
 impl Default for LoadOptions {
     fn default() -> Self {
@@ -54,6 +61,7 @@ impl Default for LoadOptions {
                 MaterialField::Ior,
             ],
             transform_order: TransformOrder::World,
+            max_input: DEFAULT_MAX_INPUT,
         }
     }
 }
@@ -66,7 +74,7 @@ pub fn parse(
     path: &Path,
     opts: &LoadOptions,
 ) -> (Vec<ast::Statement>, Vec<Diagnostic>) {
-    let parsed = parse::parse(text, path, opts);
+    let parsed = parse_source(text, path, opts);
     (
         parsed.statements,
         finish_diagnostics(parsed.diagnostics, opts),
@@ -76,7 +84,25 @@ pub fn parse(
 /// A file's text as the reader leaves it: canonical statements (with the spans later problems
 /// point at), the problems met, and what it left out.
 pub fn parse_source(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
-    parse::parse(text, path, opts)
+    let mut parsed = parse::parse(text, path, opts);
+    // The lexer keeps only the first tokens of an overlong line; the line is refused here so
+    // that a truncated statement is never taken for what was written.
+    let file: Arc<Path> = Arc::from(path);
+    for (line, count) in lexer::overlong_lines(text) {
+        parsed.diagnostics.push(Diagnostic::new(
+            Severity::Error,
+            Loc {
+                file: file.clone(),
+                line,
+                col: 1,
+            },
+            format!(
+                "line holds {count} tokens, more than the {} a line may hold",
+                lexer::MAX_TOKENS_PER_LINE
+            ),
+        ));
+    }
+    parsed
 }
 
 /// Orders diagnostics by position (file-wide ones last) and applies `--strict`.

@@ -14,6 +14,18 @@ pub struct Source {
 }
 
 impl Source {
+    /// The largest spec read: as for scene files (`--max-input`'s default).
+    pub const MAX_BYTES: u64 = crate::sdf::DEFAULT_MAX_INPUT;
+
+    /// Reads a spec file: refused unread when larger than `limit` bytes (a device or pipe
+    /// after `limit + 1` bytes), when it holds NUL bytes, or when it is not UTF-8.
+    pub fn read(path: &Path, limit: u64) -> Result<Source, Vec<Diagnostic>> {
+        let bytes = crate::scene::read_input(path, limit, "the spec")?;
+        let text = String::from_utf8(bytes)
+            .map_err(|_| vec![Diagnostic::file_error(path, "the spec is not UTF-8 text")])?;
+        Ok(Source::new(path, text))
+    }
+
     pub fn new(path: &Path, text: String) -> Source {
         let locations = Locations::scan(&text);
         Source {

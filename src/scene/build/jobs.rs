@@ -3,7 +3,7 @@
 
 use super::definitions::{Definitions, ObjectKind};
 use super::transforms::{finite_transform, Snapshot, Space};
-use super::{At, Builder, MAX_INSTANCES, MAX_TOTAL_INSTANCES};
+use super::{At, Builder, MAX_INSTANCES, MAX_TOTAL_INSTANCES, MAX_WALK};
 use crate::diag::Diagnostic;
 use crate::diag::Severity;
 use crate::limits::{self, DEFAULT_IMAGE_SIZE, MAX_NESTING};
@@ -23,6 +23,13 @@ impl Builder<'_> {
         d: &Definitions<'s>,
     ) -> Vec<RenderJob> {
         let snapshots = self.snapshots(statements, d);
+        // The composite tree is the same for every job; only the transforms differ.
+        let roots = roots(d);
+        let expansion = expansion(d, &roots);
+        let tree = Tree {
+            roots: &roots,
+            expansion: &expansion,
+        };
         let mut jobs = Vec::new();
         for (render, snapshot) in &snapshots {
             let job = match render {
@@ -34,7 +41,7 @@ impl Builder<'_> {
                         continue;
                     };
                     RenderJob {
-                        scene: self.scene(d, snapshot),
+                        scene: self.scene(d, &tree, snapshot),
                         camera,
                         output: PathBuf::from(&r.output),
                         width: r.width,
@@ -66,7 +73,7 @@ impl Builder<'_> {
                     w.severity = Severity::Warning;
                     self.diagnostics.push(w);
                     RenderJob {
-                        scene: self.scene(d, snapshot),
+                        scene: self.scene(d, &tree, snapshot),
                         camera,
                         output: PathBuf::from(output),
                         width: DEFAULT_IMAGE_SIZE.0,
@@ -110,42 +117,22 @@ impl Builder<'_> {
         }
     }
 
-    pub(super) fn scene(&mut self, d: &Definitions, snapshot: &Snapshot) -> Scene {
-        let roots: Vec<usize> = match d.object_index.get("root") {
-            Some(&i) if matches!(d.objects[i].kind, ObjectKind::Composite { .. }) => vec![i],
-            _ => {
-                let contained: HashSet<&str> = d
-                    .object_index
-                    .values()
-                    .filter_map(|&i| match &d.objects[i].kind {
-                        ObjectKind::Composite { children } => Some(children.iter().copied()),
-                        ObjectKind::Shape { .. } => None,
-                    })
-                    .flatten()
-                    .collect();
-                let mut roots: Vec<usize> = d
-                    .object_index
-                    .iter()
-                    .filter(|(name, _)| !contained.contains(*name))
-                    .map(|(_, &i)| i)
-                    .collect();
-                roots.sort_unstable(); // definition order
-                roots
-            }
-        };
+    pub(super) fn scene(&mut self, d: &Definitions, tree: &Tree, snapshot: &Snapshot) -> Scene {
         let mut instances = Vec::new();
-        let mut stack = Vec::new();
-        for root in roots {
-            let name = d.objects[root].name;
-            self.flatten(
-                d,
-                snapshot,
-                name,
-                &Transform::IDENTITY,
-                "",
-                &mut stack,
-                &mut instances,
-            );
+        if self.expansion_fits(d, tree) {
+            let mut stack = Vec::new();
+            for &root in tree.roots {
+                let name = d.objects[root].name;
+                self.flatten(
+                    d,
+                    snapshot,
+                    name,
+                    &Transform::IDENTITY,
+                    "",
+                    &mut stack,
+                    &mut instances,
+                );
+            }
         }
         let lights = d
             .lights
@@ -282,6 +269,179 @@ impl Builder<'_> {
                 }
                 stack.pop();
             }
+        }
+    }
+}
+
+/// The objects a scene is drawn from, and what each expands to.
+pub(super) struct Tree<'t> {
+    roots: &'t [usize],
+    expansion: &'t [Expansion],
+}
+
+/// What the tree below one object expands to when flattened.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct Expansion {
+    /// Instances made (shapes with a material).
+    shapes: u64,
+    /// Objects visited on the way, shapes and composites (composites holding nothing cost
+    /// walking time too).
+    nodes: u64,
+}
+
+/// The roots of the composite tree, in definition order: the composite `root` if there is
+/// one, else every object no composite lists.
+fn roots(d: &Definitions) -> Vec<usize> {
+    if let Some(&i) = d.object_index.get("root") {
+        if matches!(d.objects[i].kind, ObjectKind::Composite { .. }) {
+            return vec![i];
+        }
+    }
+    let contained: HashSet<&str> = d
+        .object_index
+        .values()
+        .filter_map(|&i| match &d.objects[i].kind {
+            ObjectKind::Composite { children } => Some(children.iter().copied()),
+            ObjectKind::Shape { .. } => None,
+        })
+        .flatten()
+        .collect();
+    let mut roots: Vec<usize> = d
+        .object_index
+        .iter()
+        .filter(|(name, _)| !contained.contains(*name))
+        .map(|(_, &i)| i)
+        .collect();
+    roots.sort_unstable(); // definition order
+    roots
+}
+
+/// What each object expands to, by dynamic programming over the composite DAG (each object
+/// computed once from its children's counts): a chain of composites that each list the next
+/// twice doubles at every level, and must be refused from its counts, not by walking it.
+/// Counts saturate; a child that closes a cycle counts nothing (`flatten` reports the cycle).
+/// The walk is iterative, as a chain of composites can be longer than the stack is deep.
+fn expansion(d: &Definitions, roots: &[usize]) -> Vec<Expansion> {
+    const NEW: u8 = 0;
+    const OPEN: u8 = 1;
+    const DONE: u8 = 2;
+    let n = d.objects.len();
+    let mut memo = vec![Expansion::default(); n];
+    let mut state = vec![NEW; n];
+    let child_index = |name: &str| d.object_index.get(name).copied().filter(|&i| i < n);
+    for &root in roots {
+        if state[root] != NEW {
+            continue;
+        }
+        state[root] = OPEN;
+        // (object, index of the next child to visit)
+        let mut stack: Vec<(usize, usize)> = vec![(root, 0)];
+        while let Some(top) = stack.last_mut() {
+            let (i, next) = *top;
+            let children: &[&str] = match &d.objects[i].kind {
+                ObjectKind::Shape { material, .. } => {
+                    memo[i] = Expansion {
+                        shapes: u64::from(material.is_some()),
+                        nodes: 1,
+                    };
+                    state[i] = DONE;
+                    stack.pop();
+                    continue;
+                }
+                ObjectKind::Composite { children } => children,
+            };
+            if let Some(child) = children.get(next) {
+                top.1 += 1;
+                if let Some(c) = child_index(child) {
+                    if state[c] == NEW {
+                        state[c] = OPEN;
+                        stack.push((c, 0));
+                    }
+                }
+                continue;
+            }
+            let mut total = Expansion {
+                shapes: 0,
+                nodes: 1,
+            };
+            for c in children.iter().filter_map(|c| child_index(c)) {
+                if state[c] == DONE {
+                    total.shapes = total.shapes.saturating_add(memo[c].shapes);
+                    total.nodes = total.nodes.saturating_add(memo[c].nodes);
+                }
+            }
+            memo[i] = total;
+            state[i] = DONE;
+            stack.pop();
+        }
+    }
+    memo
+}
+
+impl Builder<'_> {
+    /// Whether the scene of one job can be flattened: its tree expands to at most
+    /// [`MAX_INSTANCES`] shapes (and [`MAX_WALK`] objects), and the file's jobs together to at
+    /// most [`MAX_TOTAL_INSTANCES`]. Otherwise reports why, once per file.
+    fn expansion_fits(&mut self, d: &Definitions, tree: &Tree) -> bool {
+        if self.too_many_reported {
+            return false; // the scene is refused anyway
+        }
+        let mut shapes: u64 = 0;
+        let mut nodes: u64 = 0;
+        let mut largest: Option<(u64, usize)> = None;
+        for &root in tree.roots {
+            let e = tree.expansion[root];
+            shapes = shapes.saturating_add(e.shapes);
+            nodes = nodes.saturating_add(e.nodes);
+            if largest.is_none_or(|(n, _)| e.nodes > n) {
+                largest = Some((e.nodes, root));
+            }
+        }
+        let Some((_, largest)) = largest else {
+            return true;
+        };
+        let object = &d.objects[largest];
+        let count = |n: u64| {
+            if n == u64::MAX {
+                "more than 10^19".to_string()
+            } else {
+                n.to_string()
+            }
+        };
+        let problem = if shapes > MAX_INSTANCES as u64 {
+            Some((
+                format!(
+                    "the composite tree expands to more than {MAX_INSTANCES} shapes: it would make {} (`{}` is the largest part)",
+                    count(shapes),
+                    object.name
+                ),
+                "a composite listing another twice, level after level, doubles the scene each time",
+            ))
+        } else if nodes > MAX_WALK {
+            Some((
+                format!(
+                    "the composite tree expands to {} composites and shapes, more than the {MAX_WALK} that are walked (`{}` is the largest part)",
+                    count(nodes),
+                    object.name
+                ),
+                "a composite listing another twice, level after level, doubles the scene each time",
+            ))
+        } else if (self.total_instances as u64).saturating_add(shapes) > MAX_TOTAL_INSTANCES as u64
+        {
+            Some((
+                format!("the file's render statements together need more than {MAX_TOTAL_INSTANCES} shapes"),
+                "write one file per frame (as `anim generate` does) instead of many render lines",
+            ))
+        } else {
+            None
+        };
+        match problem {
+            Some((message, help)) => {
+                self.too_many_reported = true;
+                self.error(At::Name(object.statement), message, Some(help.to_string()));
+                false
+            }
+            None => true,
         }
     }
 }

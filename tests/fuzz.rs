@@ -1,0 +1,637 @@
+//! A stable-Rust fuzz harness for the two readers of user text: the SDF reader (parse and
+//! build, no rendering) and the RON keyframe spec reader (parse, then validate against a
+//! small base scene). See FUZZING.md; `scripts/fuzz.sh` runs it.
+//!
+//! Deterministic: the inputs are mutations of seed files (the shared corpus, `scenes/`,
+//! `animations/`) drawn from a seeded xorshift generator, so a run is reproduced by its seed
+//! and execution count. Each input runs on a worker thread under `catch_unwind`; the main
+//! thread waits for it at most the per-input time limit and otherwise records a hang (and
+//! carries on with a fresh worker). Crashing and hanging inputs are saved to the findings
+//! directory, to become regression tests in tests/hostile.rs.
+//!
+//! Settings come from the environment (the test harness owns the command line):
+//! `FUZZ_EXECS` (default 100 000), `FUZZ_SEED` (1), `FUZZ_CORPUS` (`../shared/corpus`),
+//! `FUZZ_TIMEOUT_MS` (2000), `FUZZ_OUT` (`target/fuzz-findings`).
+
+use anim::anim::generate::BaseScene;
+use anim::anim::spec::{self, Source};
+use anim::scene::load_str;
+use anim::sdf::{LoadOptions, MaterialField, TransformOrder};
+use std::panic::{self, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
+use std::sync::{Arc, Mutex};
+use std::thread;
+use std::time::{Duration, Instant};
+
+/// Inputs grown past this by mutation are cut: the harness looks for wrong behaviour, not
+/// for slowness proportional to size (tests/hostile.rs checks that with large inputs).
+const MAX_INPUT: usize = 64 << 10;
+
+/// Numbers a mutation writes in place of a number: the edges of what parsers get wrong.
+const EXTREMES: &[&str] = &[
+    "0",
+    "-0",
+    "0.0",
+    "-0.0",
+    "1e308",
+    "-1e308",
+    "1e-308",
+    "1e999",
+    "4.9e-324",
+    "99999999999999999999999999",
+    "-99999999999999999999999999",
+    "4294967295",
+    "4294967296",
+    "18446744073709551616",
+    "2147483648",
+    "-2147483649",
+    "999999999999",
+    "1e12",
+    "65536",
+    "65537",
+    "NaN",
+    "nan",
+    "inf",
+    "-inf",
+    "1,5",
+    "1.0f",
+    ".",
+    "-",
+    "1e",
+    "0x10",
+];
+
+/// Words a mutation inserts: keywords of both languages and bytes that end or split lines.
+const WORDS: &[&str] = &[
+    "define",
+    "shape",
+    "composite",
+    "sphere",
+    "box",
+    "triangle",
+    "cylinder",
+    "cone",
+    "plane",
+    "material",
+    "light",
+    "camera",
+    "ambient",
+    "background",
+    "transform",
+    "translate",
+    "rotate",
+    "scale",
+    "render",
+    "root",
+    "#",
+    "//",
+    "\r",
+    "\n",
+    "\r\n",
+    "\t",
+    "\u{1b}[31m",
+    "\u{0}",
+    "\u{feff}",
+    "ö",
+    "(",
+    ")",
+    "[",
+    "]",
+    "{",
+    "}",
+    ":",
+    ",",
+    "\"",
+    "r#\"",
+    "\"#",
+    "Some(",
+    "None",
+    "File(",
+    "Inline(",
+    "keys",
+    "tracks",
+    "target",
+    "at",
+    "duration",
+    "fps",
+    "orbit",
+];
+
+/// One generator state; xorshift64* (good enough to pick mutations, and reproducible).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        if n == 0 {
+            0
+        } else {
+            (self.next() % n as u64) as usize
+        }
+    }
+
+    fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
+        &items[self.below(items.len())]
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Target {
+    Sdf,
+    Spec,
+}
+
+/// Seed inputs of one target.
+struct Seeds {
+    files: Vec<Vec<u8>>,
+}
+
+fn read_seeds(dirs: &[PathBuf], wanted: &dyn Fn(&Path) -> bool) -> Seeds {
+    let mut paths = Vec::new();
+    for dir in dirs {
+        collect(dir, wanted, &mut paths);
+    }
+    paths.sort();
+    let files = paths
+        .iter()
+        .filter_map(|p| std::fs::read(p).ok())
+        .filter(|b| b.len() <= MAX_INPUT)
+        .collect();
+    Seeds { files }
+}
+
+fn collect(dir: &Path, wanted: &dyn Fn(&Path) -> bool, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            collect(&path, wanted, out);
+        } else if wanted(&path) {
+            out.push(path);
+        }
+    }
+}
+
+fn lines_of(bytes: &[u8]) -> Vec<&[u8]> {
+    bytes.split_inclusive(|&b| b == b'\n').collect()
+}
+
+/// Byte ranges of the whitespace-separated tokens of `bytes`.
+fn token_ranges(bytes: &[u8]) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for (i, &b) in bytes.iter().enumerate() {
+        if b.is_ascii_whitespace() {
+            if let Some(s) = start.take() {
+                out.push((s, i));
+            }
+        } else if start.is_none() {
+            start = Some(i);
+        }
+    }
+    if let Some(s) = start {
+        out.push((s, bytes.len()));
+    }
+    out
+}
+
+/// One mutation of `input`, using `other` (another seed) for splices.
+fn mutate_once(rng: &mut Rng, input: &mut Vec<u8>, other: &[u8]) {
+    match rng.below(12) {
+        // Flip one bit.
+        0 if !input.is_empty() => {
+            let i = rng.below(input.len());
+            input[i] ^= 1 << rng.below(8);
+        }
+        // Overwrite one byte with a byte parsers treat specially.
+        1 if !input.is_empty() => {
+            let i = rng.below(input.len());
+            input[i] = *rng.pick(&[
+                0u8, 0x1b, b'\r', b'\n', b'#', b' ', 0xff, 0xc3, b'(', b')', b'"', b',', b'-',
+                b'.', b'e', b'/',
+            ]);
+        }
+        // Insert a line (from this input or the other seed).
+        2 => {
+            let source = if rng.below(2) == 0 { &input[..] } else { other };
+            let lines = lines_of(source);
+            if lines.is_empty() {
+                return;
+            }
+            let line = rng.pick(&lines).to_vec();
+            let at = line_start(input, rng);
+            input.splice(at..at, line);
+        }
+        // Delete a line.
+        3 => {
+            let ranges = line_ranges(input);
+            if !ranges.is_empty() {
+                let (a, b) = *rng.pick(&ranges);
+                input.drain(a..b);
+            }
+        }
+        // Duplicate a line, a few or many times.
+        4 => {
+            let ranges = line_ranges(input);
+            if !ranges.is_empty() {
+                let (a, b) = *rng.pick(&ranges);
+                let line = input[a..b].to_vec();
+                let times = if rng.below(8) == 0 {
+                    1 + rng.below(200)
+                } else {
+                    1
+                };
+                for _ in 0..times {
+                    input.splice(b..b, line.iter().copied());
+                }
+            }
+        }
+        // Replace a token by one of the other seed.
+        5 => {
+            let mine = token_ranges(input);
+            let theirs = token_ranges(other);
+            if mine.is_empty() || theirs.is_empty() {
+                return;
+            }
+            let (a, b) = *rng.pick(&mine);
+            let (c, d) = *rng.pick(&theirs);
+            input.splice(a..b, other[c..d].iter().copied());
+        }
+        // Replace a number by an extreme.
+        6 | 7 => {
+            let numbers: Vec<(usize, usize)> = token_ranges(input)
+                .into_iter()
+                .filter(|&(a, _)| {
+                    let c = input[a];
+                    c.is_ascii_digit() || c == b'-' || c == b'.' || c == b'+'
+                })
+                .collect();
+            if numbers.is_empty() {
+                return;
+            }
+            let (a, b) = *rng.pick(&numbers);
+            input.splice(a..b, rng.pick(EXTREMES).bytes());
+        }
+        // Insert a word.
+        8 => {
+            let at = rng.below(input.len() + 1);
+            let word = format!(" {} ", rng.pick(WORDS));
+            input.splice(at..at, word.bytes());
+        }
+        // Cut the input short.
+        9 if !input.is_empty() => {
+            let at = rng.below(input.len());
+            input.truncate(at);
+        }
+        // Swap two lines.
+        10 => {
+            let mut lines: Vec<Vec<u8>> = lines_of(input).iter().map(|l| l.to_vec()).collect();
+            if lines.len() >= 2 {
+                let (i, j) = (rng.below(lines.len()), rng.below(lines.len()));
+                lines.swap(i, j);
+                *input = lines.concat();
+            }
+        }
+        // Delete a token.
+        _ => {
+            let tokens = token_ranges(input);
+            if !tokens.is_empty() {
+                let (a, b) = *rng.pick(&tokens);
+                input.drain(a..b);
+            }
+        }
+    }
+}
+
+fn line_ranges(bytes: &[u8]) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    for line in lines_of(bytes) {
+        out.push((start, start + line.len()));
+        start += line.len();
+    }
+    out
+}
+
+fn line_start(bytes: &[u8], rng: &mut Rng) -> usize {
+    let ranges = line_ranges(bytes);
+    if ranges.is_empty() {
+        0
+    } else {
+        rng.pick(&ranges).0
+    }
+}
+
+/// Runs one input through a reader. Errors are the expected outcome of most inputs: only a
+/// panic (caught by the caller) or not returning is a finding.
+fn execute(target: Target, input: &[u8], variant: u64, base: &BaseScene) {
+    let text = String::from_utf8_lossy(input);
+    match target {
+        Target::Sdf => {
+            let opts = match variant % 4 {
+                0 => LoadOptions::default(),
+                1 => LoadOptions {
+                    strict: true,
+                    ..LoadOptions::default()
+                },
+                2 => LoadOptions {
+                    transform_order: TransformOrder::Local,
+                    ..LoadOptions::default()
+                },
+                _ => LoadOptions {
+                    material_fields: vec![
+                        MaterialField::Reflectivity,
+                        MaterialField::Transparency,
+                        MaterialField::Ior,
+                        MaterialField::Roughness,
+                    ],
+                    ..LoadOptions::default()
+                },
+            };
+            let result = load_str(&text, Path::new("fuzz.sdf"), &opts);
+            // Every message must format (the windowing and escaping of long or hostile lines).
+            let diagnostics = match &result {
+                Ok(loaded) => &loaded.diagnostics,
+                Err(d) => d,
+            };
+            for d in diagnostics {
+                let shown = d.to_string();
+                assert!(
+                    !shown.contains('\u{1b}') && !shown.contains('\0'),
+                    "a raw control byte reaches the terminal: {shown:?}"
+                );
+            }
+        }
+        Target::Spec => {
+            let src = Source::new(Path::new("fuzz.ron"), text.into_owned());
+            if let Ok(file) = spec::parse(&src) {
+                let names = match &file.scene {
+                    spec::SceneSource::Inline(scene) => {
+                        let (statements, _) =
+                            anim::sdf::parse(scene, Path::new("fuzz.ron"), &LoadOptions::default());
+                        Some(BaseScene::new(statements))
+                    }
+                    spec::SceneSource::File(_) => None,
+                };
+                let _ = spec::validate(&file, names.as_ref().unwrap_or(base), &src);
+            }
+        }
+    }
+}
+
+/// The scene specs are validated against when they name a file: every name the example
+/// specs use.
+fn base_scene(repo: &Path) -> BaseScene {
+    let mut text = String::new();
+    for f in [
+        "animations/showcase.sdf",
+        "animations/motion.sdf",
+        "scenes/assignment.sdf",
+    ] {
+        text.push_str(&std::fs::read_to_string(repo.join(f)).unwrap_or_default());
+        text.push('\n');
+    }
+    let (statements, _) = anim::sdf::parse(&text, Path::new("base.sdf"), &LoadOptions::default());
+    BaseScene::new(statements)
+}
+
+type Job = (Target, Vec<u8>, u64);
+/// `Err` holds the panic message.
+type Outcome = Result<(), String>;
+
+/// A worker thread running inputs; replaced when one hangs (the hung thread is left behind).
+struct Worker {
+    jobs: Sender<Job>,
+    outcomes: Receiver<Outcome>,
+}
+
+fn spawn_worker(base: Arc<BaseScene>, last_panic: Arc<Mutex<String>>) -> Worker {
+    let (job_tx, job_rx) = mpsc::channel::<Job>();
+    let (out_tx, out_rx) = mpsc::channel::<Outcome>();
+    thread::Builder::new()
+        .name("fuzz-worker".to_string())
+        // As deep as the render threads may recurse; the readers must not need more.
+        .stack_size(8 << 20)
+        .spawn(move || {
+            for (target, input, variant) in job_rx {
+                let outcome = panic::catch_unwind(AssertUnwindSafe(|| {
+                    execute(target, &input, variant, &base)
+                }))
+                .map_err(|_| last_panic.lock().map(|m| m.clone()).unwrap_or_default());
+                if out_tx.send(outcome).is_err() {
+                    return;
+                }
+            }
+        })
+        .expect("a worker thread starts");
+    Worker {
+        jobs: job_tx,
+        outcomes: out_rx,
+    }
+}
+
+struct Settings {
+    execs: u64,
+    seed: u64,
+    timeout: Duration,
+    corpus: PathBuf,
+    out: PathBuf,
+}
+
+fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or(default)
+}
+
+struct Report {
+    execs: u64,
+    crashes: u64,
+    hangs: u64,
+    elapsed: Duration,
+}
+
+fn run(settings: &Settings) -> Report {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sdf_seeds = read_seeds(
+        &[
+            settings.corpus.clone(),
+            repo.join("scenes"),
+            repo.join("animations"),
+        ],
+        &|p| {
+            let name = p.to_string_lossy();
+            name.ends_with(".sdf") || name.ends_with(".txt")
+        },
+    );
+    let spec_seeds = read_seeds(&[repo.join("animations"), settings.corpus.clone()], &|p| {
+        p.extension().is_some_and(|e| e == "ron")
+    });
+    assert!(
+        !sdf_seeds.files.is_empty() && !spec_seeds.files.is_empty(),
+        "no seeds found (corpus {})",
+        settings.corpus.display()
+    );
+    eprintln!(
+        "fuzz: {} SDF seeds, {} spec seeds, seed {}, {} executions, {:?} per input",
+        sdf_seeds.files.len(),
+        spec_seeds.files.len(),
+        settings.seed,
+        settings.execs,
+        settings.timeout
+    );
+    let base = Arc::new(base_scene(repo));
+    let last_panic = Arc::new(Mutex::new(String::new()));
+    {
+        let last_panic = last_panic.clone();
+        panic::set_hook(Box::new(move |info| {
+            if let Ok(mut m) = last_panic.lock() {
+                *m = info.to_string();
+            }
+        }));
+    }
+    let mut worker = spawn_worker(base.clone(), last_panic.clone());
+    let mut rng = Rng(settings.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1);
+    let start = Instant::now();
+    let (mut crashes, mut hangs) = (0u64, 0u64);
+    let mut slowest = (Duration::ZERO, 0u64);
+    let report_every = (settings.execs / 20).max(1);
+    for exec in 0..settings.execs {
+        // Four in five inputs are scenes: the SDF reader has far more paths than the spec's.
+        let (target, seeds) = if rng.below(5) == 0 {
+            (Target::Spec, &spec_seeds)
+        } else {
+            (Target::Sdf, &sdf_seeds)
+        };
+        let mut input = rng.pick(&seeds.files).clone();
+        let other = rng.pick(&seeds.files);
+        for _ in 0..1 + rng.below(4) {
+            mutate_once(&mut rng, &mut input, other);
+        }
+        input.truncate(MAX_INPUT);
+        let variant = rng.next();
+        let began = Instant::now();
+        worker
+            .jobs
+            .send((target, input.clone(), variant))
+            .expect("the worker takes inputs");
+        match worker.outcomes.recv_timeout(settings.timeout) {
+            Ok(Ok(())) => {}
+            Ok(Err(message)) => {
+                crashes += 1;
+                let path = save(settings, "crash", exec, target, &input);
+                eprintln!("fuzz: CRASH at exec {exec}: {message}\n  saved to {path:?}");
+            }
+            Err(RecvTimeoutError::Timeout) => {
+                hangs += 1;
+                let path = save(settings, "hang", exec, target, &input);
+                eprintln!(
+                    "fuzz: HANG at exec {exec} (over {:?}), saved to {path:?}",
+                    settings.timeout
+                );
+                // The hung thread keeps running its input; later inputs get a new worker.
+                worker = spawn_worker(base.clone(), last_panic.clone());
+            }
+            Err(RecvTimeoutError::Disconnected) => {
+                crashes += 1;
+                save(settings, "crash", exec, target, &input);
+                worker = spawn_worker(base.clone(), last_panic.clone());
+            }
+        }
+        let took = began.elapsed();
+        if took > slowest.0 {
+            slowest = (took, exec);
+        }
+        if (exec + 1) % report_every == 0 {
+            let secs = start.elapsed().as_secs_f64();
+            eprintln!(
+                "fuzz: {} execs, {:.0}/s, {crashes} crashes, {hangs} hangs, slowest input {:?} (exec {})",
+                exec + 1,
+                (exec + 1) as f64 / secs,
+                slowest.0,
+                slowest.1
+            );
+        }
+        if hangs >= 20 {
+            eprintln!("fuzz: stopping after 20 hangs");
+            let _ = panic::take_hook();
+            return Report {
+                execs: exec + 1,
+                crashes,
+                hangs,
+                elapsed: start.elapsed(),
+            };
+        }
+    }
+    let _ = panic::take_hook();
+    Report {
+        execs: settings.execs,
+        crashes,
+        hangs,
+        elapsed: start.elapsed(),
+    }
+}
+
+fn save(settings: &Settings, kind: &str, exec: u64, target: Target, input: &[u8]) -> PathBuf {
+    let ext = match target {
+        Target::Sdf => "sdf",
+        Target::Spec => "ron",
+    };
+    let _ = std::fs::create_dir_all(&settings.out);
+    let path = settings
+        .out
+        .join(format!("{kind}-seed{}-{exec}.{ext}", settings.seed));
+    let _ = std::fs::write(&path, input);
+    path
+}
+
+fn settings_from_env(default_execs: u64) -> Settings {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    Settings {
+        execs: env_or("FUZZ_EXECS", default_execs),
+        seed: env_or("FUZZ_SEED", 1),
+        timeout: Duration::from_millis(env_or("FUZZ_TIMEOUT_MS", 2000)),
+        corpus: std::env::var_os("FUZZ_CORPUS")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| repo.join("../shared/corpus")),
+        out: std::env::var_os("FUZZ_OUT")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| repo.join("target/fuzz-findings")),
+    }
+}
+
+/// The fuzz run proper (`scripts/fuzz.sh`).
+#[test]
+#[ignore = "long; run with scripts/fuzz.sh"]
+fn fuzz() {
+    let report = run(&settings_from_env(100_000));
+    let secs = report.elapsed.as_secs_f64();
+    eprintln!(
+        "fuzz: done: {} execs in {secs:.1} s ({:.0}/s), {} crashes, {} hangs",
+        report.execs,
+        report.execs as f64 / secs.max(1e-9),
+        report.crashes,
+        report.hangs
+    );
+    assert_eq!((report.crashes, report.hangs), (0, 0));
+}
+
+/// A short run on every test pass, so the harness keeps compiling and working.
+#[test]
+fn fuzz_smoke() {
+    let mut settings = settings_from_env(2_000);
+    settings.execs = 2_000;
+    // The shared corpus may be absent on other machines; the repository's seeds suffice.
+    let report = run(&settings);
+    assert_eq!((report.crashes, report.hangs), (0, 0));
+}
