@@ -53,19 +53,7 @@ pub struct GenerateReport {
 /// `anim generate`: reads the spec, writes the frames. `Err` holds every error found.
 pub fn run_generate(config: &GenerateConfig) -> Result<GenerateReport, Vec<Diagnostic>> {
     let spec_path = config.spec.as_path();
-    let bytes = std::fs::read(spec_path).map_err(|e| {
-        vec![Diagnostic::file_error(
-            spec_path,
-            format!("cannot read the spec: {e}"),
-        )]
-    })?;
-    let text = String::from_utf8(bytes).map_err(|_| {
-        vec![Diagnostic::file_error(
-            spec_path,
-            "the spec is not UTF-8 text",
-        )]
-    })?;
-    let src = Source::new(spec_path, text);
+    let src = Source::read(spec_path, Source::MAX_BYTES)?;
     let spec_file = spec::parse(&src)?;
     let spec_dir = spec_path
         .parent()
@@ -160,12 +148,16 @@ fn load_base(
     let (statements, mut diags, path) = match scene {
         SceneSource::File(rel) => {
             let path = spec_dir.join(rel);
-            let bytes = std::fs::read(&path).map_err(|e| {
-                vec![src.error(
-                    &["scene[0]", "scene"],
-                    format!("cannot read the base scene '{}': {e}", path.display()),
-                )]
-            })?;
+            let bytes =
+                crate::scene::read_input(&path, opts.max_input, "the base scene").map_err(|e| {
+                    // The reader's own words, naming the file.
+                    let why = e.first().map_or(String::new(), |d| d.message.clone());
+                    let named = format!("the base scene '{}'", path.display());
+                    vec![src.error(
+                        &["scene[0]", "scene"],
+                        why.replacen("the base scene", &named, 1),
+                    )]
+                })?;
             let (statements, diags) =
                 crate::sdf::parse(&String::from_utf8_lossy(&bytes), &path, &opts);
             (statements, diags, path)
