@@ -5,7 +5,7 @@ use crate::bench::{BenchConfig, PovMode, Preset};
 use crate::limits;
 use crate::pipeline::{FrameOptions, Shard};
 use crate::render::RenderSettings;
-use crate::sdf::{LoadOptions, MaterialField, TransformOrder};
+use crate::sdf::{LoadOptions, MaterialField, MaterialLayout, TransformOrder};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::{Path, PathBuf};
 
@@ -381,9 +381,9 @@ impl SceneArgs {
             strict: self.strict,
             // `auto` anywhere in the list means the whole list is inferred.
             material_fields: if self.material_fields.contains(&None) {
-                Vec::new()
+                MaterialLayout::Auto
             } else {
-                self.material_fields.iter().flatten().copied().collect()
+                MaterialLayout::Fields(self.material_fields.iter().flatten().copied().collect())
             },
             transform_order: match self.transform_order {
                 TransformOrderArg::World => TransformOrder::World,

@@ -348,12 +348,12 @@ fn execute(target: Target, input: &[u8], variant: u64, base: &BaseScene) {
                     ..LoadOptions::default()
                 },
                 _ => LoadOptions {
-                    material_fields: vec![
+                    material_fields: anim::sdf::MaterialLayout::Fields(vec![
                         MaterialField::Reflectivity,
                         MaterialField::Transparency,
                         MaterialField::Ior,
                         MaterialField::Roughness,
-                    ],
+                    ]),
                     ..LoadOptions::default()
                 },
             };

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 /// `--material-fields auto`, as the command line's default.
 fn auto() -> LoadOptions {
     LoadOptions {
-        material_fields: Vec::new(),
+        material_fields: anim::sdf::MaterialLayout::Auto,
         ..LoadOptions::default()
     }
 }

@@ -163,7 +163,7 @@ pub(super) fn is_up_to_date(out_dir: &Path, name: &str, hash: u64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sdf::{MaterialField, TransformOrder};
+    use crate::sdf::{MaterialField, MaterialLayout, TransformOrder};
 
     /// Changing any one setting changes the key. The structs are taken apart field by field
     /// without `..`, so a new setting does not compile here until it has a case of its own.
@@ -271,11 +271,10 @@ mod tests {
             (
                 base.clone(),
                 LoadOptions {
-                    material_fields: material_fields
-                        .iter()
-                        .copied()
-                        .chain([MaterialField::Roughness])
-                        .collect(),
+                    material_fields: match material_fields {
+                        MaterialLayout::Auto => MaterialLayout::Fields(vec![MaterialField::Ior]),
+                        MaterialLayout::Fields(_) => MaterialLayout::Auto,
+                    },
                     ..load.clone()
                 },
             ),

@@ -427,8 +427,13 @@ mod tests {
     use crate::scene::load_str;
 
     fn probe(text: &str) -> Option<String> {
-        let loaded = load_str(text, Path::new("probe.sdf"), &LoadOptions::default())
-            .unwrap_or_else(|d| panic!("{d:?}"));
+        // The materials here mean the standard layout, whatever inference would make of them.
+        let opts = LoadOptions {
+            material_fields: crate::sdf::MaterialLayout::standard(),
+            ..LoadOptions::default()
+        };
+        let loaded =
+            load_str(text, Path::new("probe.sdf"), &opts).unwrap_or_else(|d| panic!("{d:?}"));
         loaded.jobs.iter().find_map(blank_image).map(|b| b.reason)
     }
 

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::diag::{Diagnostic, Severity};
-use crate::sdf::{ast, parse, LoadOptions, MaterialField, TransformOrder};
+use crate::sdf::{ast, parse, LoadOptions, MaterialField, MaterialLayout, TransformOrder};
 use glam::{DVec3, Vec3};
 use std::path::Path;
 
@@ -368,11 +368,11 @@ fn materials_read_their_extras_by_the_field_list() {
         (0.5, 0.25, 1.5)
     );
     let opts = LoadOptions {
-        material_fields: vec![
+        material_fields: MaterialLayout::Fields(vec![
             MaterialField::Reflectivity,
             MaterialField::Transparency,
             MaterialField::Ior,
-        ],
+        ]),
         ..LoadOptions::default()
     };
     let materials = &load_with(text, &opts).jobs[0].scene.materials;
@@ -700,7 +700,7 @@ fn warnings(loaded: &Loaded) -> String {
 
 fn auto() -> LoadOptions {
     LoadOptions {
-        material_fields: Vec::new(),
+        material_fields: MaterialLayout::Auto,
         ..LoadOptions::default()
     }
 }
@@ -825,9 +825,15 @@ fn implausible_values_are_warned() {
 
 #[test]
 fn every_invisible_material_is_reported_and_same_outputs_warned() {
-    let l = load(
+    // Read in the standard layout (inference would take the zeros for transparency).
+    let standard = LoadOptions {
+        material_fields: MaterialLayout::standard(),
+        ..LoadOptions::default()
+    };
+    let l = load_with(
         "define material a 1 1 1 1 1 1 1 1 1 10 0 0 1\ndefine material b 1 1 1 1 1 1 1 1 1 10 0 0 1\n\
          define camera eye 60\nrender eye out.png 8 8\nrender eye out.png 8 8\n",
+        &standard,
     );
     let w = warnings(&l);
     assert!(w.contains("material `a` is invisible"), "{w}");
@@ -856,11 +862,11 @@ fn inferred_layouts_read_the_materials_as_meant() {
     assert!(w.contains("transparency"), "{w}");
     // An explicit list wins.
     let explicit = LoadOptions {
-        material_fields: vec![
+        material_fields: MaterialLayout::Fields(vec![
             MaterialField::Reflectivity,
             MaterialField::Opacity,
             MaterialField::Ior,
-        ],
+        ]),
         ..LoadOptions::default()
     };
     assert!(!warnings(&load_with(text, &explicit)).contains("are read as"));

@@ -38,10 +38,40 @@ pub enum TransformOrder {
     Local,
 }
 
+/// How the numbers after `m` in material lines are read (`--material-fields`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum MaterialLayout {
+    /// The layout that makes every material of the file most plausible, the standard one when
+    /// it ties (docs/scene-language.md §3.1).
+    Auto,
+    /// These fields, in this order.
+    Fields(Vec<MaterialField>),
+}
+
+impl MaterialLayout {
+    /// `reflectivity,opacity,ior`: the most common layout, and the one inference prefers on a
+    /// tie.
+    pub fn standard() -> MaterialLayout {
+        MaterialLayout::Fields(vec![
+            MaterialField::Reflectivity,
+            MaterialField::Opacity,
+            MaterialField::Ior,
+        ])
+    }
+
+    /// The fields asked for, or `None` for inference.
+    pub fn explicit(&self) -> Option<&[MaterialField]> {
+        match self {
+            MaterialLayout::Auto => None,
+            MaterialLayout::Fields(fields) => Some(fields),
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct LoadOptions {
     pub strict: bool,
-    pub material_fields: Vec<MaterialField>,
+    pub material_fields: MaterialLayout,
     pub transform_order: TransformOrder,
     /// Largest input file read, in bytes (`--max-input`); larger files are refused unread.
     pub max_input: u64,
@@ -55,11 +85,9 @@ impl Default for LoadOptions {
     fn default() -> Self {
         LoadOptions {
             strict: false,
-            material_fields: vec![
-                MaterialField::Reflectivity,
-                MaterialField::Opacity,
-                MaterialField::Ior,
-            ],
+            // Programs (the animation generator, tests) state what they mean; inference is
+            // the command line's default, for files written by hand.
+            material_fields: MaterialLayout::standard(),
             transform_order: TransformOrder::World,
             max_input: DEFAULT_MAX_INPUT,
         }

@@ -153,7 +153,7 @@ impl Parser<'_> {
     /// Says once, at the first material with extras, how they were read when the layout was
     /// inferred and is not the default (`--material-fields auto`).
     fn explain_layout(&mut self, line: &Line) {
-        if !self.opts.material_fields.is_empty() || self.layout == default_layout() {
+        if self.opts.material_fields.explicit().is_some() || self.layout == default_layout() {
             return;
         }
         if !self.variants_noted.insert("material-layout") {
@@ -184,7 +184,8 @@ impl Parser<'_> {
     }
 
     fn too_many_numbers(&mut self, line: &Line, n: usize) -> Fail {
-        let fields = &self.opts.material_fields;
+        // No fields: the layout was inferred (`--material-fields auto`).
+        let fields = self.opts.material_fields.explicit().unwrap_or(&[]);
         let field_list = field_names(fields);
         let extras = n - 10;
         let most = self.layout.slots.len() + 9;

@@ -192,11 +192,11 @@ struct Parser<'a> {
 }
 
 /// The layout of the numbers after the colours of the file's materials: the one named by
-/// `--material-fields`, or with `auto` (an empty list) the most plausible one for every
+/// `--material-fields`, or with `auto` the most plausible one for every
 /// material line of the file (`docs/scene-language.md §3.1`).
 fn material_layout(lines: &[Line], opts: &LoadOptions) -> layout::Layout {
-    if !opts.material_fields.is_empty() {
-        return layout::Layout::explicit(&opts.material_fields);
+    if let Some(fields) = opts.material_fields.explicit() {
+        return layout::Layout::explicit(fields);
     }
     let extras: Vec<Vec<f64>> = lines
         .iter()
