@@ -67,7 +67,8 @@ fn code_lines(text: &str) -> impl Iterator<Item = &str> {
     })
 }
 
-/// Paths written after `prefix` in `line`: `crate::a::b::{c, d}` gives `a::b`.
+/// Paths written after `prefix` in `line`: `crate::a::b::{c, d::e}` gives `a::b::c` and
+/// `a::b::d::e`.
 fn paths_after<'a>(line: &'a str, prefix: &str) -> Vec<Vec<&'a str>> {
     let mut found = Vec::new();
     let mut rest = line;
@@ -77,18 +78,51 @@ fn paths_after<'a>(line: &'a str, prefix: &str) -> Vec<Vec<&'a str>> {
         if before.ends_with(|c: char| c.is_alphanumeric() || c == '_') {
             continue;
         }
-        let path: Vec<&str> = rest
-            .split("::")
-            .map(|seg| {
-                seg.split(|c: char| !(c.is_alphanumeric() || c == '_'))
-                    .next()
-                    .unwrap_or("")
-            })
-            .take_while(|seg| !seg.is_empty())
-            .collect();
-        found.push(path);
+        expand(rest, Vec::new(), &mut found);
     }
     found
+}
+
+/// The paths a `use` tree starting at `text` names, each after `base`.
+fn expand<'a>(text: &'a str, base: Vec<&'a str>, out: &mut Vec<Vec<&'a str>>) {
+    let mut path = base;
+    let mut rest = text;
+    loop {
+        if let Some(group) = rest.strip_prefix('{') {
+            // Items of a group, split at the commas of its own level.
+            let (mut depth, mut start) = (0usize, 0usize);
+            for (i, c) in group.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 0 => {
+                        expand(group[start..i].trim_start(), path.clone(), out);
+                        return;
+                    }
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => {
+                        expand(group[start..i].trim_start(), path.clone(), out);
+                        start = i + 1;
+                    }
+                    _ => {}
+                }
+            }
+            return;
+        }
+        let end = rest
+            .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+            .unwrap_or(rest.len());
+        if end == 0 {
+            break;
+        }
+        path.push(&rest[..end]);
+        match rest[end..].strip_prefix("::") {
+            Some(next) => rest = next,
+            None => break,
+        }
+    }
+    if !path.is_empty() {
+        out.push(path);
+    }
 }
 
 struct Crate {

@@ -2,7 +2,6 @@
 //! DejaVu Sans (assets/fonts, Bitstream Vera licence), so no system font library is needed,
 //! and encoded with the `image` crate the renderer already uses.
 
-use super::report::series;
 use super::{Renderer, Row};
 use plotters::prelude::*;
 use std::path::Path;
@@ -118,4 +117,17 @@ fn short(v: f64) -> String {
     } else {
         s.to_string()
     }
+}
+
+/// Plot lines: rows grouped by renderer and mode, in first-seen order.
+fn series<'a>(rows: &[&'a Row]) -> Vec<((Renderer, String), Vec<&'a Row>)> {
+    let mut out: Vec<((Renderer, String), Vec<&Row>)> = Vec::new();
+    for &r in rows {
+        let key = (r.renderer, r.mode.clone());
+        match out.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, v)) => v.push(r),
+            None => out.push((key, vec![r])),
+        }
+    }
+    out
 }

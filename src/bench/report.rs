@@ -1,7 +1,7 @@
 //! The bench's outputs: `bench.csv` (one row per scene × renderer × setting), `bench.md` (the
 //! tables) and one time-against-error plot per scene.
 
-use super::{plot, BenchReport, Renderer, Row};
+use super::{plot, BenchReport, Row};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -138,19 +138,6 @@ pub fn write_outputs(report: &BenchReport, dir: &Path) -> Result<Vec<PathBuf>, S
 pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), String> {
     crate::util::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes()))
         .map_err(|e| format!("cannot write {}: {e}", path.display()))
-}
-
-/// Plot lines: rows grouped by renderer and mode, in first-seen order.
-pub(crate) fn series<'a>(rows: &[&'a Row]) -> Vec<((Renderer, String), Vec<&'a Row>)> {
-    let mut out: Vec<((Renderer, String), Vec<&Row>)> = Vec::new();
-    for &r in rows {
-        let key = (r.renderer, r.mode.clone());
-        match out.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, v)) => v.push(r),
-            None => out.push((key, vec![r])),
-        }
-    }
-    out
 }
 
 #[cfg(test)]
