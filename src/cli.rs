@@ -47,7 +47,7 @@ pub struct SceneArgs {
     #[arg(long, value_enum, default_value = "world")]
     pub transform_order: TransformOrderArg,
     /// Largest scene file read, in bytes; larger files are refused unread.
-    #[arg(long, value_name = "BYTES", default_value_t = crate::sdf::DEFAULT_MAX_INPUT)]
+    #[arg(long, value_name = "BYTES", default_value_t = limits::DEFAULT_MAX_INPUT)]
     pub max_input: u64,
 }
 

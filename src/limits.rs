@@ -100,6 +100,30 @@ pub fn image_extensions_list() -> String {
         .join(", ")
 }
 
+/// More instances than this means a composite tree that multiplies out of all proportion
+/// (each level listing the one below twice, ...): refused before it exhausts memory.
+pub const MAX_INSTANCES: usize = 250_000;
+
+/// The same over all the jobs of a file (each job holds its own scene).
+pub const MAX_TOTAL_INSTANCES: usize = 2_000_000;
+
+/// Objects (shapes and composites) visited while flattening one job's tree: a tree of
+/// composites holding nothing expands to no shapes but can still take forever to walk.
+pub const MAX_WALK: u64 = 2_000_000;
+
+/// Diagnostics kept per file: a file with thousands of bad lines (a binary file, a file in
+/// another format) gets its first problems listed and a count of the rest, not pages of them.
+pub const MAX_DIAGNOSTICS: usize = 50;
+
+/// Tokens kept of one line. No statement needs more (a composite listing a million children
+/// is far beyond the shape limit); a line with more is reported by the SDF lexer and
+/// only its first tokens are kept, so one huge line cannot take gigabytes of token records.
+pub const MAX_TOKENS_PER_LINE: usize = 1 << 20;
+
+/// The default of `--max-input`: 1 GiB. Far beyond any hand-written or generated scene,
+/// and small enough that reading one whole cannot exhaust an ordinary machine.
+pub const DEFAULT_MAX_INPUT: u64 = 1 << 30;
+
 #[cfg(test)]
 mod tests {
     use super::*;

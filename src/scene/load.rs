@@ -3,14 +3,11 @@
 use super::build::build_jobs;
 use super::RenderJob;
 use crate::diag::{Diagnostic, Severity};
+use crate::limits::MAX_DIAGNOSTICS;
 use crate::sdf::ast::Statement;
 use crate::sdf::{self, finish_diagnostics, LoadOptions};
 use std::io::Read;
 use std::path::Path;
-
-/// Diagnostics kept per file: a file with thousands of bad lines (a binary file, a file in
-/// another format) gets its first problems listed and a count of the rest, not pages of them.
-pub const MAX_DIAGNOSTICS: usize = 50;
 
 /// How much of the start of a file is looked at for NUL bytes, which text never holds.
 const TEXT_SNIFF_BYTES: usize = 8 << 10;

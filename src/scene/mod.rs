@@ -10,7 +10,7 @@ pub mod probe;
 mod tests;
 
 pub use crate::shape::Geometry;
-pub use load::{build, load_file, load_str, read_input, Loaded, MAX_DIAGNOSTICS};
+pub use load::{build, load_file, load_str, read_input, Loaded};
 
 use crate::diag::Loc;
 use crate::math::Transform;

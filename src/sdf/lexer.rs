@@ -38,11 +38,6 @@ impl Line<'_> {
     }
 }
 
-/// Tokens kept of one line. No statement needs more (a composite listing a million children
-/// is far beyond the shape limit); a line with more is reported by [`overlong_lines`] and
-/// only its first tokens are kept, so one huge line cannot take gigabytes of token records.
-pub const MAX_TOKENS_PER_LINE: usize = 1 << 20;
-
 /// Splits a whole file into lines and tokenizes each. LF, CRLF and a lone CR (old Mac files)
 /// all end a line; the final line ending is optional. A byte-order mark at the start of the
 /// file is ignored.
@@ -92,18 +87,18 @@ fn line_number(i: usize) -> u32 {
     u32::try_from(i).map_or(u32::MAX, |n| n.saturating_add(1))
 }
 
-/// Lines holding more than [`MAX_TOKENS_PER_LINE`] tokens: (line number, tokens on it).
+/// Lines holding more than [`crate::limits::MAX_TOKENS_PER_LINE`] tokens: (line number, tokens on it).
 pub fn overlong_lines(text: &str) -> Vec<(u32, usize)> {
     raw_lines(text)
         .enumerate()
         .filter_map(|(i, raw)| {
             // Only long lines can hold that many tokens; counting is skipped for the rest.
-            if raw.len() < MAX_TOKENS_PER_LINE {
+            if raw.len() < crate::limits::MAX_TOKENS_PER_LINE {
                 return None;
             }
             let code = raw.split('#').next().unwrap_or("");
             let count = code.split_whitespace().count();
-            (count > MAX_TOKENS_PER_LINE).then_some((line_number(i), count))
+            (count > crate::limits::MAX_TOKENS_PER_LINE).then_some((line_number(i), count))
         })
         .collect()
 }
@@ -123,7 +118,7 @@ pub fn tokenize(line: &str) -> Vec<Token<'_>> {
         if ch.is_whitespace() {
             if let Some((s, c)) = start.take() {
                 tokens.push(make_token(line, s, i, c));
-                if tokens.len() >= MAX_TOKENS_PER_LINE {
+                if tokens.len() >= crate::limits::MAX_TOKENS_PER_LINE {
                     // The rest is not kept (see `overlong_lines`, which reports the line).
                     return tokens;
                 }
@@ -352,10 +347,16 @@ mod tests {
 
     #[test]
     fn tokens_of_one_line_are_capped_and_the_line_reported() {
-        let text = format!("a\n{}\n", "x ".repeat(MAX_TOKENS_PER_LINE + 3));
+        let text = format!(
+            "a\n{}\n",
+            "x ".repeat(crate::limits::MAX_TOKENS_PER_LINE + 3)
+        );
         let ls = lines(&text);
-        assert_eq!(ls[1].tokens.len(), MAX_TOKENS_PER_LINE);
-        assert_eq!(overlong_lines(&text), vec![(2, MAX_TOKENS_PER_LINE + 3)]);
+        assert_eq!(ls[1].tokens.len(), crate::limits::MAX_TOKENS_PER_LINE);
+        assert_eq!(
+            overlong_lines(&text),
+            vec![(2, crate::limits::MAX_TOKENS_PER_LINE + 3)]
+        );
         assert!(overlong_lines("a b c\n").is_empty());
     }
 }

@@ -77,10 +77,6 @@ pub struct LoadOptions {
     pub max_input: u64,
 }
 
-/// The default of `--max-input`: 1 GiB. Far beyond any hand-written or generated scene,
-/// and small enough that reading one whole cannot exhaust an ordinary machine.
-pub const DEFAULT_MAX_INPUT: u64 = 1 << 30;
-
 impl Default for LoadOptions {
     fn default() -> Self {
         LoadOptions {
@@ -89,7 +85,7 @@ impl Default for LoadOptions {
             // the command line's default, for files written by hand.
             material_fields: MaterialLayout::standard(),
             transform_order: TransformOrder::World,
-            max_input: DEFAULT_MAX_INPUT,
+            max_input: crate::limits::DEFAULT_MAX_INPUT,
         }
     }
 }
@@ -126,7 +122,7 @@ pub fn parse_source(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
             },
             format!(
                 "line holds {count} tokens, more than the {} a line may hold",
-                lexer::MAX_TOKENS_PER_LINE
+                crate::limits::MAX_TOKENS_PER_LINE
             ),
         ));
     }

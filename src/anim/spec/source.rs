@@ -15,7 +15,7 @@ pub struct Source {
 
 impl Source {
     /// The largest spec read: as for scene files (`--max-input`'s default).
-    pub const MAX_BYTES: u64 = crate::sdf::DEFAULT_MAX_INPUT;
+    pub const MAX_BYTES: u64 = crate::limits::DEFAULT_MAX_INPUT;
 
     /// Reads a spec file: refused unread when larger than `limit` bytes (a device or pipe
     /// after `limit + 1` bytes), when it holds NUL bytes, or when it is not UTF-8.

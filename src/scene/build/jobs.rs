@@ -3,10 +3,11 @@
 
 use super::definitions::{Definitions, ObjectKind};
 use super::transforms::{finite_transform, Snapshot, Space};
-use super::{At, Builder, MAX_INSTANCES, MAX_TOTAL_INSTANCES, MAX_WALK};
+use super::{At, Builder};
 use crate::diag::Diagnostic;
 use crate::diag::Severity;
 use crate::limits::{self, DEFAULT_IMAGE_SIZE, MAX_NESTING};
+use crate::limits::{MAX_INSTANCES, MAX_TOTAL_INSTANCES, MAX_WALK};
 use crate::math::Transform;
 use crate::scene::{Camera, Geometry, Instance, Light, RenderJob, Scene};
 use crate::sdf::ast::{CameraDef, NameRef, Statement, StatementKind};

@@ -18,14 +18,6 @@ use crate::sdf::{LoadOptions, Omissions};
 use std::collections::HashSet;
 use std::path::Path;
 
-/// More instances than this means a composite tree that multiplies out of all proportion
-/// (each level listing the one below twice, ...): refused before it exhausts memory.
-const MAX_INSTANCES: usize = 250_000;
-/// The same over all the jobs of a file (each job holds its own scene).
-const MAX_TOTAL_INSTANCES: usize = 2_000_000;
-/// Objects (shapes and composites) visited while flattening one job's tree: a tree of
-/// composites holding nothing expands to no shapes but can still take forever to walk.
-const MAX_WALK: u64 = 2_000_000;
 /// Name comparisons allowed for "did you mean" suggestions in one file (about a second's
 /// work at worst).
 const SUGGESTION_BUDGET: usize = 1_000_000;
