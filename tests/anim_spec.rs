@@ -583,3 +583,51 @@ fn frames_are_deterministic() {
         "{text30}"
     );
 }
+
+/// A base scene written for another material layout keeps its meaning in the frames:
+/// generate reads it as `anim render` reads a file (layout inferred), and the frames, printed
+/// in the standard layout, read back the same whichever way they are read.
+#[test]
+fn frames_keep_the_materials_of_a_base_scene_in_another_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    // `m reflectivity transparency ior`: 0 transparency is opaque, which the standard
+    // layout would read as opacity 0 (invisible).
+    std::fs::write(
+        dir.path().join("base.sdf"),
+        "define material red 0.2 0 0 0.8 0.1 0.1 0.5 0.5 0.5 20 0 0 1\n\
+         define material blue 0 0 0.2 0.1 0.1 0.8 0.3 0.3 0.3 10 0.2 0 1\n\
+         define shape sphere ball 0 0 -5 1 red\n\
+         define light sun 5 5 5 1 1 1 1\n\
+         define camera cam 60\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("spec.ron"),
+        "(scene: File(\"base.sdf\"), length: Frames(1), resolution: (8, 6))\n",
+    )
+    .unwrap();
+    let config = anim::anim::GenerateConfig {
+        spec: dir.path().join("spec.ron"),
+        out: Some(dir.path().join("frames")),
+    };
+    anim::anim::run_generate(&config).unwrap_or_else(|e| panic!("{e:?}"));
+    let frame = dir.path().join("frames/frame_0000.sdf");
+    let text = std::fs::read_to_string(&frame).unwrap();
+    for layout in [
+        anim::sdf::MaterialLayout::Auto,
+        anim::sdf::MaterialLayout::standard(),
+    ] {
+        let opts = LoadOptions {
+            material_fields: layout.clone(),
+            ..LoadOptions::default()
+        };
+        let loaded = anim::scene::load_str(&text, &frame, &opts)
+            .unwrap_or_else(|e| panic!("{layout:?}: {e:?}\n{text}"));
+        let red = &loaded.jobs[0].scene.materials[0];
+        assert_eq!(
+            (red.opacity, red.reflectivity, red.ior),
+            (1.0, 0.0, 1.0),
+            "{layout:?}\n{text}"
+        );
+    }
+}

@@ -144,7 +144,13 @@ fn load_base(
     spec_dir: &Path,
     src: &Source,
 ) -> Result<(Vec<crate::sdf::ast::Statement>, Vec<Diagnostic>), Vec<Diagnostic>> {
-    let opts = LoadOptions::default();
+    // The base scene is a file written by hand, read as `anim render` reads one: with its
+    // material layout inferred. The frames then print the materials in the standard layout,
+    // which inference reads back as written.
+    let opts = LoadOptions {
+        material_fields: crate::sdf::MaterialLayout::Auto,
+        ..LoadOptions::default()
+    };
     let (statements, mut diags, path) = match scene {
         SceneSource::File(rel) => {
             let path = spec_dir.join(rel);
