@@ -7,21 +7,6 @@ use anim::diag::Diagnostic;
 use anim::scene::load_file;
 use anim::sdf::LoadOptions;
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::path::{Path, PathBuf};
-
-fn files_below(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries.flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            files_below(&path, out);
-        } else if path.file_name().is_some_and(|n| n != "MANIFEST.tsv") {
-            out.push(path);
-        }
-    }
-}
 
 /// Whether a file-wide diagnostic (no line) is about reading the file rather than its text.
 fn is_io_problem(d: &Diagnostic) -> bool {
@@ -36,7 +21,8 @@ fn every_corpus_file_loads_or_is_rejected_with_located_errors() {
     let corpus = shared.join("corpus/wild");
     let dir = corpus.as_path();
     let mut files = Vec::new();
-    files_below(dir, &mut files);
+    common::files_below(dir, &mut files);
+    files.retain(|f| f.file_name().is_some_and(|n| n != "MANIFEST.tsv"));
     files.sort();
     assert!(!files.is_empty(), "the corpus folder holds no files");
 
@@ -88,7 +74,8 @@ fn canonical_text_of_corpus_files_loads_to_the_same_jobs() {
     let corpus = shared.join("corpus/wild");
     let dir = corpus.as_path();
     let mut files = Vec::new();
-    files_below(dir, &mut files);
+    common::files_below(dir, &mut files);
+    files.retain(|f| f.file_name().is_some_and(|n| n != "MANIFEST.tsv"));
     files.sort();
     let opts = LoadOptions::default();
     let mut compared = 0;

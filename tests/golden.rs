@@ -15,23 +15,9 @@ const MANIFEST: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/golden/manife
 /// Small enough to keep the suite fast, big enough that every object covers pixels.
 const SIZE: [&str; 4] = ["--width", "48", "--height", "36"];
 
-fn files_below(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries.flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            files_below(&path, out);
-        } else {
-            out.push(path);
-        }
-    }
-}
-
 fn image_files(dir: &Path) -> Vec<PathBuf> {
     let mut all = Vec::new();
-    files_below(dir, &mut all);
+    common::files_below(dir, &mut all);
     let mut images: Vec<PathBuf> = all
         .into_iter()
         .filter(|p| {
@@ -138,7 +124,7 @@ fn every_scene_renders_the_pixels_of_the_golden_manifest() {
     let mut scenes: Vec<(String, PathBuf)> = Vec::new();
     for folder in ["scenes", "animations"] {
         let mut files = Vec::new();
-        files_below(&root.join(folder), &mut files);
+        common::files_below(&root.join(folder), &mut files);
         for f in files
             .into_iter()
             .filter(|f| f.extension().is_some_and(|e| e == "sdf"))
@@ -153,7 +139,7 @@ fn every_scene_renders_the_pixels_of_the_golden_manifest() {
     if let Some(shared) = &shared {
         let corpus = shared.join("corpus/wild");
         let mut files = Vec::new();
-        files_below(&corpus, &mut files);
+        common::files_below(&corpus, &mut files);
         for f in files
             .into_iter()
             .filter(|f| f.file_name().is_some_and(|n| n != "MANIFEST.tsv"))
