@@ -1,12 +1,16 @@
 //! Differential test of the wide BVH against brute force over real primitives: random scenes
 //! of spheres, boxes and triangles (some transformed, so kept in object space); the closest
-//! hit's distance and primitive, and any-hit answers, must equal testing every primitive.
+//! hit's distance and primitive, and any-hit answers, must equal testing every primitive. The
+//! render scene (spheres packed four to a test, leaf-ordered storage) is held to the same
+//! standard, and its hits to the bits `Primitive` computes.
 
 use anim::accel::Bvh;
 use anim::math::{Ray, Transform};
+use anim::render::compile::RenderScene;
 use anim::render::primitive::Primitive;
+use anim::scene::{Instance, Material, Scene};
 use anim::shape::Geometry;
-use glam::{DVec3, Vec3A};
+use glam::{DVec3, Vec3, Vec3A};
 
 struct Rng(u64);
 
@@ -115,5 +119,142 @@ fn wide_bvh_equals_brute_force_on_random_scenes() {
         }
         // Not vacuous: a fair share of the rays meet something.
         assert!(n < 1500 || hits > 1000, "{hits} hits");
+    }
+}
+
+/// Mostly world-space spheres (so leaves of four spheres, and leaves mixing spheres with other
+/// kinds), with boxes, triangles, rotated and stretched shapes, an exact duplicate sphere (a
+/// tie) and a plane. Instance `i` has material `i`, which names it after renumbering.
+fn mixed_instances(rng: &mut Rng, n: usize) -> Vec<Instance> {
+    fn push(out: &mut Vec<Instance>, geometry: Geometry, transform: Transform) {
+        let material = out.len();
+        out.push(Instance {
+            name: format!("p{material}"),
+            geometry,
+            material,
+            transform,
+            loc: None,
+        });
+    }
+    let mut out = Vec::new();
+    for i in 0..n {
+        let c = rng.vec(50.0);
+        let spin = |rng: &mut Rng| {
+            let turn = Transform::rotate(10.0 + rng.next() * 70.0, DVec3::Y).unwrap();
+            Transform::translate(c).then_after(&turn.then_after(&Transform::translate(-c)))
+        };
+        match i % 10 {
+            0 => push(
+                &mut out,
+                Geometry::Triangle {
+                    vertices: [c, c + rng.vec(4.0), c + rng.vec(4.0)],
+                },
+                Transform::IDENTITY,
+            ),
+            1 => push(
+                &mut out,
+                Geometry::Box {
+                    p1: c,
+                    p2: c + rng.vec(3.0) + DVec3::splat(0.05),
+                },
+                spin(rng),
+            ),
+            2 => {
+                let stretch = Transform::scale(DVec3::new(2.0, 0.5, 1.0)).unwrap();
+                push(
+                    &mut out,
+                    Geometry::Sphere {
+                        center: DVec3::ZERO,
+                        radius: 0.5 + rng.next(),
+                    },
+                    Transform::translate(c).then_after(&stretch),
+                )
+            }
+            _ => push(
+                &mut out,
+                Geometry::Sphere {
+                    center: c,
+                    radius: 0.2 + rng.next() * 2.0,
+                },
+                Transform::IDENTITY,
+            ),
+        }
+    }
+    let twin = out[3].geometry.clone();
+    push(&mut out, twin, Transform::IDENTITY);
+    push(
+        &mut out,
+        Geometry::Plane {
+            point: DVec3::new(0.0, -5.0, 0.0),
+            normal: DVec3::new(0.1, 1.0, 0.05),
+        },
+        Transform::IDENTITY,
+    );
+    out
+}
+
+#[test]
+fn render_scene_equals_brute_force_on_mixed_scenes() {
+    let mut rng = Rng(0x2545F4914F6CDD1D);
+    for n in [4, 40, 2000] {
+        let instances = mixed_instances(&mut rng, n);
+        let prims: Vec<Primitive> = instances
+            .iter()
+            .map(|i| Primitive::new(&i.geometry, &i.transform, i.material as u32).unwrap())
+            .collect();
+        let scene = Scene {
+            materials: (0..instances.len())
+                .map(|i| Material::phong(&format!("m{i}"), Vec3::ONE, Vec3::ONE, Vec3::ONE, 1.0))
+                .collect(),
+            instances,
+            lights: Vec::new(),
+            ambient: Vec3::ZERO,
+            background: Vec3::ZERO,
+        };
+        let (render, dropped) = RenderScene::compile(&scene);
+        assert!(dropped.is_empty());
+        assert_eq!(render.len(), prims.len());
+        let mut hits = 0;
+        for i in 0..4000 {
+            let ray = random_ray(&mut rng, i);
+            let t_limit = if i.is_multiple_of(3) {
+                40.0
+            } else {
+                f32::INFINITY
+            };
+            let mut brute: Option<(usize, f32)> = None;
+            for (k, p) in prims.iter().enumerate() {
+                let t_max = brute.map_or(t_limit, |(_, t)| t);
+                if let Some(h) = p.hit(&ray, t_max) {
+                    brute = Some((k, h.t));
+                }
+            }
+            let found = render.closest(&ray, t_limit);
+            assert_eq!(
+                brute.map(|(_, t)| t.to_bits()),
+                found.map(|(_, h)| h.t.to_bits()),
+                "n={n} ray {i}"
+            );
+            if let (Some((a, t)), Some((slot, h))) = (brute, found) {
+                let b = render.material_of(slot) as usize;
+                // The same primitive, unless two are hit at exactly the same distance.
+                assert!(a == b || prims[b].hit(&ray, t_limit).map(|h| h.t) == Some(t));
+                let expected = prims[b].intersect(&ray, t_limit).unwrap();
+                assert_eq!(
+                    (expected.point.to_array(), expected.normal.to_array()),
+                    (h.point.to_array(), h.normal.to_array()),
+                    "n={n} ray {i}: surface of primitive {b}"
+                );
+                let again = render.intersect(slot, &ray, t_limit).unwrap();
+                assert_eq!(again.t.to_bits(), h.t.to_bits());
+                hits += 1;
+            }
+            assert_eq!(
+                render.occluded(&ray, t_limit),
+                brute.is_some(),
+                "n={n} ray {i}"
+            );
+        }
+        assert!(n < 2000 || hits > 1000, "{hits} hits");
     }
 }

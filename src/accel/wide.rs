@@ -181,14 +181,52 @@ impl Bvh {
         &self.prims[start + 1..start + 1 + count]
     }
 
+    /// Renumbers the primitives in leaf order, so that every leaf holds consecutive indices
+    /// (`first..first + len`) and neighbouring leaves neighbouring ones: storage laid out in
+    /// this order is read front to back by a leaf. Returns `order`, `order[new] = old`. The
+    /// traversal order is unchanged.
+    pub fn renumber_in_leaf_order(&mut self) -> Vec<u32> {
+        let mut order = Vec::with_capacity(self.prims.len());
+        let mut header = 0;
+        while header < self.prims.len() {
+            let count = self.prims[header] as usize;
+            for id in &mut self.prims[header + 1..header + 1 + count] {
+                order.push(*id);
+                *id = order.len() as u32 - 1;
+            }
+            header += 1 + count;
+        }
+        order
+    }
+
     /// Closest hit: calls `hit(prim, t_max)` for candidate primitives in roughly front-to-back
     /// order; it returns the new `t_max` when the primitive is hit closer.
     #[inline]
     pub fn closest(
         &self,
         ray: &Ray,
-        mut t_max: f32,
+        t_max: f32,
         mut hit: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> f32 {
+        self.closest_leaves(ray, t_max, |leaf, mut t_max| {
+            for &prim in leaf {
+                if let Some(t) = hit(prim, t_max) {
+                    t_max = t;
+                }
+            }
+            t_max
+        })
+    }
+
+    /// Closest hit a leaf at a time: `leaf(prims, t_max)` tests a leaf's primitives in their
+    /// order and returns the new `t_max` (the old one if nothing was hit closer). Leaves come
+    /// in the order `closest` offers their primitives.
+    #[inline]
+    pub fn closest_leaves(
+        &self,
+        ray: &Ray,
+        mut t_max: f32,
+        mut leaf: impl FnMut(&[u32], f32) -> f32,
     ) -> f32 {
         if self.nodes.is_empty() {
             return t_max;
@@ -209,11 +247,7 @@ impl Bvh {
                 continue;
             }
             if reference & LEAF != 0 {
-                for &prim in self.leaf(reference) {
-                    if let Some(t) = hit(prim, t_max) {
-                        t_max = t;
-                    }
-                }
+                t_max = leaf(self.leaf(reference), t_max);
                 continue;
             }
             let node = &self.nodes[reference as usize];
@@ -239,6 +273,17 @@ impl Bvh {
     /// offered left to right, the binary tree's order.
     #[inline]
     pub fn any(&self, ray: &Ray, t_max: f32, mut occludes: impl FnMut(u32) -> bool) -> bool {
+        self.any_leaves(ray, t_max, |leaf| leaf.iter().any(|&p| occludes(p)))
+    }
+
+    /// Any hit a leaf at a time: stops as soon as `occludes(prims)` says yes.
+    #[inline]
+    pub fn any_leaves(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut occludes: impl FnMut(&[u32]) -> bool,
+    ) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
@@ -249,7 +294,7 @@ impl Bvh {
             top -= 1;
             let reference = stack[top];
             if reference & LEAF != 0 {
-                if self.leaf(reference).iter().any(|&p| occludes(p)) {
+                if occludes(self.leaf(reference)) {
                     return true;
                 }
                 continue;
@@ -264,6 +309,11 @@ impl Bvh {
             }
         }
         false
+    }
+
+    /// Bytes held by the hierarchy.
+    pub fn memory_bytes(&self) -> usize {
+        self.nodes.capacity() * std::mem::size_of::<Node>() + self.prims.capacity() * 4
     }
 }
 
@@ -496,6 +546,40 @@ mod tests {
             box_t(&boxes[i as usize], &ray).filter(|&t| t < t_max)
         });
         assert_eq!(t, 1.0);
+    }
+
+    /// Renumbered, leaves hold consecutive indices and offer the same primitives (under their
+    /// new names) in the same order.
+    #[test]
+    fn renumbering_keeps_the_offer_order() {
+        let mut rng = Rng(0x94D049BB133111EB);
+        let boxes = random_boxes(&mut rng, 1500);
+        let bvh = Bvh::build(&boxes, 0..boxes.len() as u32);
+        let mut renamed = bvh.clone();
+        let order = renamed.renumber_in_leaf_order();
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..boxes.len() as u32).collect::<Vec<_>>());
+        for i in 0..1000 {
+            let ray = random_ray(&mut rng, &boxes, i);
+            let mut seen = [Vec::new(), Vec::new()];
+            bvh.closest(&ray, f32::INFINITY, |p, t_max| {
+                seen[0].push(p);
+                box_t(&boxes[p as usize], &ray).filter(|&t| t < t_max)
+            });
+            renamed.closest_leaves(&ray, f32::INFINITY, |leaf, mut t_max| {
+                for (k, &p) in leaf.iter().enumerate() {
+                    assert_eq!(p, leaf[0] + k as u32, "consecutive");
+                    let old = order[p as usize];
+                    seen[1].push(old);
+                    if let Some(t) = box_t(&boxes[old as usize], &ray).filter(|&t| t < t_max) {
+                        t_max = t;
+                    }
+                }
+                t_max
+            });
+            assert_eq!(seen[0], seen[1]);
+        }
     }
 
     #[test]

@@ -5,7 +5,8 @@ use super::primitive::{Primitive, SurfaceHit};
 use crate::accel::Bvh;
 use crate::math::Ray;
 use crate::scene::{Material, Scene};
-use glam::Vec3A;
+use crate::shape::{ShapeHit, Sphere, SphereRay};
+use glam::{Vec3A, Vec4};
 
 #[derive(Clone, Debug)]
 pub struct ShadeMaterial {
@@ -42,12 +43,27 @@ pub struct PointLight {
     pub intensity: Vec3A,
 }
 
+/// `RenderScene::kind` of a primitive that is a packed world-space sphere.
+const SPHERE: u32 = u32::MAX;
+/// Spheres tested at once.
+const LANES: usize = 4;
+
+/// Primitives are numbered in the BVH's leaf order (so a leaf reads consecutive entries),
+/// then the unbounded ones. World-space spheres, the common case, are packed into 16 bytes
+/// and tested four at a time with no dispatch; everything else is a [`Primitive`].
 #[derive(Clone, Debug)]
 pub struct RenderScene {
-    pub prims: Vec<Primitive>,
+    /// Per primitive: its material.
+    material: Vec<u32>,
+    /// Per primitive: [`SPHERE`], or its index in `objects`.
+    kind: Vec<u32>,
+    /// Per primitive: the packed sphere (`Sphere::packed`; NaN for other kinds, which no
+    /// sphere test hits), then `LANES - 1` NaN entries so a leaf can always load four.
+    spheres: Vec<Vec4>,
+    objects: Vec<Primitive>,
     bvh: Bvh,
-    /// Primitives without finite bounds (planes), tested on every ray.
-    unbounded: Vec<u32>,
+    /// The first primitive without finite bounds (planes); these are tested on every ray.
+    unbounded: u32,
     pub materials: Vec<ShadeMaterial>,
     pub lights: Vec<PointLight>,
     pub ambient: Vec3A,
@@ -68,21 +84,45 @@ pub struct Dropped {
 
 impl RenderScene {
     pub fn compile(scene: &Scene) -> (RenderScene, Vec<Dropped>) {
-        let mut prims = Vec::with_capacity(scene.instances.len());
+        let n = scene.instances.len();
+        let mut material = Vec::with_capacity(n);
+        let mut kind = Vec::with_capacity(n);
+        let mut spheres = Vec::with_capacity(n + LANES - 1);
+        let mut bounds = Vec::with_capacity(n);
+        let mut objects = Vec::new();
         let mut dropped = Vec::new();
         for inst in &scene.instances {
             match Primitive::new(&inst.geometry, &inst.transform, inst.material as u32) {
-                Ok(p) => prims.push(p),
+                Ok(p) => {
+                    bounds.push(p.bounds);
+                    material.push(p.material);
+                    if let Some(s) = p.world_sphere() {
+                        spheres.push(s.packed());
+                        kind.push(SPHERE);
+                    } else {
+                        spheres.push(Vec4::NAN);
+                        kind.push(objects.len() as u32);
+                        objects.push(p);
+                    }
+                }
                 Err(_) => dropped.push(Dropped {
                     instance: inst.name.clone(),
                     loc: inst.loc.clone(),
                 }),
             }
         }
-        let bounds: Vec<_> = prims.iter().map(|p| p.bounds).collect();
         let (bounded, unbounded): (Vec<u32>, Vec<u32>) =
-            (0..prims.len() as u32).partition(|&i| prims[i as usize].is_bounded());
-        let bvh = Bvh::build(&bounds, bounded);
+            (0..material.len() as u32).partition(|&i| bounds[i as usize].is_finite());
+        let mut bvh = Bvh::build(&bounds, bounded);
+        drop(bounds);
+        let mut order = bvh.renumber_in_leaf_order();
+        let first_unbounded = order.len() as u32;
+        order.extend(unbounded);
+        let permute = |v: &[u32]| order.iter().map(|&i| v[i as usize]).collect::<Vec<u32>>();
+        let (material, kind) = (permute(&material), permute(&kind));
+        let mut spheres: Vec<Vec4> = order.iter().map(|&i| spheres[i as usize]).collect();
+        spheres.resize(order.len() + LANES - 1, Vec4::NAN);
+        drop(order);
         let materials: Vec<ShadeMaterial> =
             scene.materials.iter().map(ShadeMaterial::from).collect();
         let lights: Vec<PointLight> = scene
@@ -95,11 +135,16 @@ impl RenderScene {
             .collect();
         let ambient: Vec3A = scene.ambient.into();
         let background: Vec3A = scene.background.into();
-        let used = |i: usize| prims.iter().any(|p| p.material as usize == i);
+        let mut used = vec![false; materials.len()];
+        for &m in &material {
+            if let Some(u) = used.get_mut(m as usize) {
+                *u = true;
+            }
+        }
         let any_transparent = materials
             .iter()
-            .enumerate()
-            .any(|(i, m)| m.is_transparent() && used(i));
+            .zip(&used)
+            .any(|(m, &used)| m.is_transparent() && used);
         // Every shaded colour is a convex combination of local colours and the background
         // (the weights in docs/shading.md §3 sum to 1), so the largest local colour bounds them all.
         let total_light: Vec3A = lights.iter().map(|l| l.intensity.max(Vec3A::ZERO)).sum();
@@ -112,9 +157,12 @@ impl RenderScene {
             .fold(0.0f32, f32::max);
         let max_radiance = max_local.max(background.max_element());
         let scene = RenderScene {
-            prims,
+            material,
+            kind,
+            spheres,
+            objects,
             bvh,
-            unbounded,
+            unbounded: first_unbounded,
             materials,
             lights,
             ambient,
@@ -125,30 +173,133 @@ impl RenderScene {
         (scene, dropped)
     }
 
+    /// Number of primitives.
+    pub fn len(&self) -> usize {
+        self.material.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.material.is_empty()
+    }
+
+    /// The material of primitive `i`.
+    #[inline]
+    pub fn material_of(&self, i: u32) -> u32 {
+        self.material[i as usize]
+    }
+
+    #[inline]
+    fn sphere(&self, i: usize) -> Sphere {
+        let s = self.spheres[i];
+        Sphere {
+            center: s.truncate().into(),
+            radius: s.w,
+        }
+    }
+
+    /// The four packed spheres from primitive `i` on.
+    #[inline(always)]
+    fn four_spheres(&self, i: usize) -> [Vec4; LANES] {
+        let s = &self.spheres[i..i + LANES];
+        [s[0], s[1], s[2], s[3]]
+    }
+
+    /// Distance to primitive `i` along the ray, if it is hit with `0 < t < t_max`.
+    #[inline]
+    pub fn hit(&self, i: u32, ray: &Ray, t_max: f32) -> Option<f32> {
+        match self.kind[i as usize] {
+            SPHERE => self.sphere(i as usize).intersect(ray, t_max).map(|h| h.t),
+            k => self.objects[k as usize].hit(ray, t_max).map(|h| h.t),
+        }
+    }
+
+    /// Primitive `i`'s hit with `0 < t < t_max`, in world space.
+    #[inline]
+    pub fn intersect(&self, i: u32, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
+        match self.kind[i as usize] {
+            SPHERE => self
+                .sphere(i as usize)
+                .intersect(ray, t_max)
+                .map(|h| sphere_surface(&h)),
+            k => self.objects[k as usize].intersect(ray, t_max),
+        }
+    }
+
     /// Nearest surface along the ray with `t < t_max`.
     #[inline]
     pub fn closest(&self, ray: &Ray, t_max: f32) -> Option<(u32, SurfaceHit)> {
-        let mut best = None;
+        // The winner's object-space hit, kept for its surface (spheres recompute theirs).
+        let mut best: Option<(u32, f32, Option<ShapeHit>)> = None;
         let mut t_best = t_max;
-        for &i in &self.unbounded {
-            if let Some(h) = self.prims[i as usize].hit(ray, t_best) {
+        for i in self.unbounded..self.len() as u32 {
+            if let Some(h) = self.shape_hit(i, ray, t_best) {
                 t_best = h.t;
-                best = Some((i, h));
+                best = Some((i, h.t, Some(h)));
             }
         }
-        self.bvh.closest(ray, t_best, |i, t_max| {
-            let h = self.prims[i as usize].hit(ray, t_max)?;
-            best = Some((i, h));
-            Some(h.t)
+        let lanes = SphereRay::new(ray);
+        // Primitives in the order the hierarchy offers them, a strictly closer hit replacing
+        // the kept one: of equally close hits the first offered wins.
+        self.bvh.closest_leaves(ray, t_best, |leaf, mut t_max| {
+            let first = leaf[0] as usize;
+            for start in (first..first + leaf.len()).step_by(LANES) {
+                let (mask, t) = lanes.hit4(self.four_spheres(start), t_max);
+                for k in 0..(first + leaf.len() - start).min(LANES) {
+                    let i = start + k;
+                    match self.kind[i] {
+                        SPHERE => {
+                            if mask & (1 << k) != 0 && t[k] < t_max {
+                                t_max = t[k];
+                                best = Some((i as u32, t_max, None));
+                            }
+                        }
+                        o => {
+                            if let Some(h) = self.objects[o as usize].hit(ray, t_max) {
+                                t_max = h.t;
+                                best = Some((i as u32, t_max, Some(h)));
+                            }
+                        }
+                    }
+                }
+            }
+            t_max
         });
-        best.map(|(i, h)| (i, self.prims[i as usize].surface(&h)))
+        let (i, t, hit) = best?;
+        let surface = match (self.kind[i as usize], hit) {
+            (SPHERE, _) => sphere_surface(&self.sphere(i as usize).hit_at(ray, t)),
+            (o, Some(h)) => self.objects[o as usize].surface(&h),
+            (_, None) => unreachable!("objects keep their hit"),
+        };
+        Some((i, surface))
+    }
+
+    #[inline]
+    fn shape_hit(&self, i: u32, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
+        match self.kind[i as usize] {
+            SPHERE => self.sphere(i as usize).intersect(ray, t_max),
+            k => self.objects[k as usize].hit(ray, t_max),
+        }
     }
 
     /// Whether anything lies on the ray before `t_max`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.any_candidate(ray, t_max, |i| {
-            self.prims[i as usize].hit(ray, t_max).is_some()
+        if (self.unbounded..self.len() as u32).any(|i| self.hit(i, ray, t_max).is_some()) {
+            return true;
+        }
+        let lanes = SphereRay::new(ray);
+        self.bvh.any_leaves(ray, t_max, |leaf| {
+            let first = leaf[0] as usize;
+            (first..first + leaf.len()).step_by(LANES).any(|start| {
+                let live = (first + leaf.len() - start).min(LANES);
+                let (mask, _) = lanes.hit4(self.four_spheres(start), t_max);
+                // Other kinds hold NaN, which no sphere test hits.
+                mask & ((1 << live) - 1) != 0
+                    || (start..start + live).any(|i| {
+                        let k = self.kind[i];
+                        k != SPHERE && self.objects[k as usize].hit(ray, t_max).is_some()
+                    })
+            })
         })
     }
 
@@ -156,6 +307,25 @@ impl RenderScene {
     /// order, until it returns true (then true).
     #[inline]
     pub fn any_candidate(&self, ray: &Ray, t_max: f32, mut stop: impl FnMut(u32) -> bool) -> bool {
-        self.unbounded.iter().any(|&i| stop(i)) || self.bvh.any(ray, t_max, stop)
+        (self.unbounded..self.len() as u32).any(&mut stop) || self.bvh.any(ray, t_max, stop)
+    }
+
+    /// Bytes the scene's geometry holds (primitives and hierarchy, not materials or lights).
+    pub fn geometry_bytes(&self) -> usize {
+        self.material.capacity() * 4
+            + self.kind.capacity() * 4
+            + self.spheres.capacity() * std::mem::size_of::<Vec4>()
+            + self.objects.capacity() * std::mem::size_of::<Primitive>()
+            + self.bvh.memory_bytes()
+    }
+}
+
+/// What `Primitive::surface` makes of a world-space hit: the normal renormalised.
+#[inline]
+fn sphere_surface(h: &ShapeHit) -> SurfaceHit {
+    SurfaceHit {
+        t: h.t,
+        point: h.point,
+        normal: h.normal.normalize_or_zero(),
     }
 }

@@ -69,7 +69,7 @@ impl Integrator<'_> {
         counts: &mut RayCounts,
     ) -> Vec3A {
         let scene = self.scene;
-        let mat = &scene.materials[scene.prims[prim as usize].material as usize];
+        let mat = &scene.materials[scene.material_of(prim) as usize];
         let entering = hit.normal.dot(ray.dir) < 0.0;
         // Shading normal faces the incoming ray; the geometric one decides inside/outside.
         let n = if entering { hit.normal } else { -hit.normal };
@@ -164,16 +164,15 @@ impl Integrator<'_> {
         }
         let mut transmit = 1.0f32;
         let blocked = scene.any_candidate(&ray, remaining, |i| {
-            let prim = &scene.prims[i as usize];
-            let opacity = scene.materials[prim.material as usize].opacity;
+            let opacity = scene.materials[scene.material_of(i) as usize].opacity;
             if opacity >= 1.0 {
-                return prim.hit(&ray, remaining).is_some();
+                return scene.hit(i, &ray, remaining).is_some();
             }
             // Count this object's crossings along the segment, stepping past each one.
             let mut segment = ray;
             let mut left = remaining;
             for _ in 0..MAX_SHADOW_CROSSINGS {
-                let Some(hit) = prim.intersect(&segment, left) else {
+                let Some(hit) = scene.intersect(i, &segment, left) else {
                     break;
                 };
                 transmit *= 1.0 - opacity;

@@ -174,6 +174,15 @@ impl Primitive {
     pub fn is_bounded(&self) -> bool {
         self.bounds.is_finite()
     }
+
+    /// The sphere, when this is one baked into world space (the render scene keeps those
+    /// packed, four to a SIMD test).
+    pub fn world_sphere(&self) -> Option<&Sphere> {
+        match (&self.shape, &self.object) {
+            (Shape::Sphere(s), None) => Some(s),
+            _ => None,
+        }
+    }
 }
 
 /// Builds the shape for `geometry` mapped through `xf` (which must keep its class).

@@ -22,7 +22,7 @@ pub use cone::Cone;
 pub use cylinder::Cylinder;
 pub use geometry::{degeneracy, Geometry};
 pub use plane::Plane;
-pub use sphere::Sphere;
+pub use sphere::{Sphere, SphereRay};
 pub use triangle::Triangle;
 
 use crate::math::{Aabb, Ray};

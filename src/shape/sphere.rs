@@ -1,6 +1,6 @@
 use super::ShapeHit;
 use crate::math::{Aabb, Ray};
-use glam::Vec3A;
+use glam::{Mat4, Vec3A, Vec4};
 
 #[derive(Clone, Debug)]
 pub struct Sphere {
@@ -51,11 +51,71 @@ impl Sphere {
         if !(t > 0.0 && t < t_max) {
             return None;
         }
+        Some(self.hit_at(ray, t))
+    }
+
+    /// The hit at `t` (found by `intersect` or [`SphereRay::hit4`]): the point re-projected
+    /// onto the surface, so its error is a few ulps of its magnitude.
+    #[inline]
+    pub fn hit_at(&self, ray: &Ray, t: f32) -> ShapeHit {
         let offset = ray.at(t) - self.center;
-        // Re-project onto the surface so the hit point's error is a few ulps of its magnitude.
         let normal = offset.normalize_or_zero();
         let point = self.center + normal * self.radius;
-        Some(ShapeHit { t, point, normal })
+        ShapeHit { t, point, normal }
+    }
+
+    /// The sphere packed for [`SphereRay::hit4`]: centre in `xyz`, radius in `w`.
+    pub fn packed(&self) -> Vec4 {
+        self.center.extend(self.radius)
+    }
+}
+
+/// One ray splatted over four lanes, to test four spheres at once.
+pub struct SphereRay {
+    origin: [Vec4; 3],
+    dir: [Vec4; 3],
+    /// `|dir|²`, as `Sphere::intersect` computes it.
+    a: Vec4,
+}
+
+impl SphereRay {
+    #[inline]
+    pub fn new(ray: &Ray) -> SphereRay {
+        SphereRay {
+            origin: [0, 1, 2].map(|i| Vec4::splat(ray.origin[i])),
+            dir: [0, 1, 2].map(|i| Vec4::splat(ray.dir[i])),
+            a: Vec4::splat(ray.dir.length_squared()),
+        }
+    }
+
+    /// `Sphere::intersect`'s distance for four packed spheres (see [`Sphere::packed`]), lane
+    /// by lane the same operations in the same order, so the same floats: `(mask, t)` with
+    /// bit `i` of the mask set when sphere `i` is hit at `0 < t[i] < t_max`. A lane holding
+    /// NaN is never hit.
+    #[inline(always)]
+    pub fn hit4(&self, spheres: [Vec4; 4], t_max: f32) -> (u32, Vec4) {
+        let m = Mat4::from_cols(spheres[0], spheres[1], spheres[2], spheres[3]).transpose();
+        let (r, [dx, dy, dz]) = (m.w_axis, self.dir);
+        let fx = self.origin[0] - m.x_axis;
+        let fy = self.origin[1] - m.y_axis;
+        let fz = self.origin[2] - m.z_axis;
+        // Vec3A's dot product adds (x + y) + z.
+        let beta = fx * dx + fy * dy + fz * dz;
+        let k = beta / self.a;
+        let (px, py, pz) = (fx - dx * k, fy - dy * k, fz - dz * k);
+        let r2 = r * r;
+        let disc = self.a * (r2 - (px * px + py * py + pz * pz));
+        let c = (fx * fx + fy * fy + fz * fz) - r2;
+        // A negative discriminant gives NaN here, and NaN fails every comparison below.
+        let q = -(beta + disc.map(f32::sqrt).copysign(beta));
+        let x = q / self.a;
+        let y = c / q;
+        let ordered = x.cmple(y);
+        let t0 = Vec4::select(ordered, x, y);
+        let t1 = Vec4::select(ordered, y, x);
+        let t = Vec4::select(t0.cmpgt(Vec4::ZERO), t0, t1);
+        let hit = t.cmpgt(Vec4::ZERO) & t.cmplt(Vec4::splat(t_max));
+        (hit.bitmask(), t)
     }
 }
 
@@ -119,5 +179,50 @@ mod tests {
             .intersect(&Ray::new(Vec3A::ZERO, -Vec3A::Z), 3.9)
             .is_none());
         assert!(Sphere::new(Vec3A::ZERO, 0.0).is_none());
+    }
+
+    /// The four-lane test gives `intersect`'s distance bit for bit, hit or miss, for rays
+    /// from near and far, inside and outside, grazing and non-unit.
+    #[test]
+    fn four_lanes_equal_the_scalar_test() {
+        let mut state = 0x9E3779B97F4A7C15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut v = move || {
+            let x = [next(), next(), next(), next()];
+            (Vec3A::new(x[0], x[1], x[2]) * 2.0 - Vec3A::ONE, x[3])
+        };
+        let mut hits = 0;
+        for i in 0..20_000 {
+            let scale = [1e-3f32, 1.0, 1e3][i % 3];
+            let spheres: Vec<Sphere> = (0..4)
+                .map(|_| {
+                    let (c, r) = v();
+                    Sphere::new(c * scale, (r * 0.6 + 0.01) * scale).unwrap()
+                })
+                .collect();
+            let (o, limit) = v();
+            let origin = o * scale * [1.0, 0.5, 30.0][i % 3];
+            let target = spheres[i % 4].center + v().0 * spheres[i % 4].radius;
+            let ray = Ray::new(origin, (target - origin) * [1.0, 0.3, 7.0][i / 3 % 3]);
+            let t_max = if i % 5 == 0 {
+                limit * scale * 30.0
+            } else {
+                f32::INFINITY
+            };
+            let (mask, t) =
+                SphereRay::new(&ray).hit4([0, 1, 2, 3].map(|k| spheres[k].packed()), t_max);
+            for (k, s) in spheres.iter().enumerate() {
+                let scalar = s.intersect(&ray, t_max).map(|h| h.t.to_bits());
+                let lane = (mask & (1 << k) != 0).then(|| t[k].to_bits());
+                assert_eq!(scalar, lane, "ray {i} sphere {k}");
+                hits += usize::from(scalar.is_some());
+            }
+        }
+        assert!(hits > 10_000, "{hits} hits");
     }
 }
