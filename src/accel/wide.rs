@@ -99,6 +99,10 @@ impl Bvh {
         if !bin.nodes.is_empty() {
             bvh.collapse(bin, 0);
         }
+        // Collapsing leaves far fewer wide nodes than the capacity guessed from the binary
+        // tree; the hierarchy lives as long as the render, so its slack is worth returning.
+        bvh.nodes.shrink_to_fit();
+        bvh.prims.shrink_to_fit();
         bvh
     }
 
@@ -273,12 +277,20 @@ impl Bvh {
     /// offered left to right, the binary tree's order.
     #[inline]
     pub fn any(&self, ray: &Ray, t_max: f32, mut occludes: impl FnMut(u32) -> bool) -> bool {
-        self.any_leaves(ray, t_max, |leaf| leaf.iter().any(|&p| occludes(p)))
+        self.any_in_order::<false>(ray, t_max, |leaf| leaf.iter().any(|&p| occludes(p)))
     }
 
-    /// Any hit a leaf at a time: stops as soon as `occludes(prims)` says yes.
+    /// Any hit a leaf at a time: stops as soon as `occludes(prims)` says yes. Children are
+    /// visited nearest first (the order `closest` uses), where an occluder near the ray's
+    /// origin is found without visiting what lies behind it; so the order in which leaves
+    /// come differs from `any`'s.
     #[inline]
-    pub fn any_leaves(
+    pub fn any_leaves(&self, ray: &Ray, t_max: f32, occludes: impl FnMut(&[u32]) -> bool) -> bool {
+        self.any_in_order::<true>(ray, t_max, occludes)
+    }
+
+    #[inline(always)]
+    fn any_in_order<const NEAR_FIRST: bool>(
         &self,
         ray: &Ray,
         t_max: f32,
@@ -288,6 +300,9 @@ impl Bvh {
             return false;
         }
         let lanes = RayLanes::new(ray);
+        let octant = usize::from(ray.dir.x < 0.0)
+            | usize::from(ray.dir.y < 0.0) << 1
+            | usize::from(ray.dir.z < 0.0) << 2;
         let mut stack = [0u32; STACK_SIZE];
         let mut top = 1;
         while top > 0 {
@@ -301,7 +316,16 @@ impl Bvh {
             }
             let node = &self.nodes[reference as usize];
             let (mask, _) = node.hit(&lanes, t_max);
-            for slot in (0..usize::from(node.len)).rev() {
+            if mask == 0 {
+                continue;
+            }
+            let order = node.order[octant];
+            for k in (0..node.len).rev() {
+                let slot = if NEAR_FIRST {
+                    usize::from((order >> (2 * k)) & 3)
+                } else {
+                    usize::from(k)
+                };
                 if mask & (1 << slot) != 0 {
                     stack[top] = node.child[slot];
                     top += 1;

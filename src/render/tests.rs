@@ -293,3 +293,37 @@ fn shadow_through_glass_is_attenuated_per_surface_crossed() {
         img.pixels[4]
     );
 }
+
+/// Issue 8's budget: a world-space sphere costs at most 100 bytes of the render scene, its
+/// share of the hierarchy included (a million spheres must fit a small process).
+#[test]
+fn a_world_space_sphere_costs_at_most_100_bytes() {
+    let mut state = 0x853C49E6748FEA9Bu64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let n = 20_000;
+    let instances = (0..n)
+        .map(|_| {
+            let c = [next() * 100.0, next() * 100.0, next() * 100.0];
+            sphere(c, 0.1 + next() * 0.4, 0)
+        })
+        .collect();
+    let scene = Scene {
+        materials: vec![material("m", 0.1, [0.5; 3], 0.0, 1.0)],
+        instances,
+        lights: Vec::new(),
+        ambient: Vec3::ZERO,
+        background: Vec3::ZERO,
+    };
+    let (compiled, dropped) = RenderScene::compile(&scene);
+    assert!(dropped.is_empty());
+    assert_eq!(compiled.len(), n);
+    let per_sphere = compiled.geometry_bytes() as f64 / n as f64;
+    assert!(per_sphere <= 100.0, "{per_sphere:.1} bytes per sphere");
+    // Not vacuous: the packed sphere alone is 16 bytes, its material 4.
+    assert!(per_sphere >= 20.0, "{per_sphere:.1} bytes per sphere");
+}
