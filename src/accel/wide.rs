@@ -50,6 +50,15 @@ struct RayLanes {
 }
 
 impl RayLanes {
+    /// Whether no slab test of this ray can make NaN: `(b − o) · (1/d)` is NaN only for
+    /// `0 · ∞` or `∞ − ∞`, and with a finite origin and every `1/d` finite and non-zero the
+    /// factors are never 0 and ∞ together (box coordinates are finite, or ±∞ in unused lanes).
+    #[inline(always)]
+    fn nan_free(ray: &Ray) -> bool {
+        let inv = ray.dir.recip();
+        ray.origin.is_finite() && inv.is_finite() && inv.cmpne(glam::Vec3A::ZERO).all()
+    }
+
     #[inline(always)]
     fn new(ray: &Ray) -> RayLanes {
         // 1/0 = ±inf for zero components; `Node::hit` deals with the NaNs they can make.
@@ -67,16 +76,24 @@ impl Node {
     /// answer): a ray parallel to a slab with its origin on one of the planes gives
     /// `0 · inf = NaN` there, and is inside that slab, so NaN becomes the unbounded interval
     /// before SSE min/max (which would not drop it) see it.
+    ///
+    /// `NAN_FREE` skips that repair for rays that cannot make NaN (see [`RayLanes::nan_free`]),
+    /// where it changes nothing.
     #[inline(always)]
-    fn hit(&self, ray: &RayLanes, t_max: f32) -> (u32, Vec4) {
+    fn hit<const NAN_FREE: bool>(&self, ray: &RayLanes, t_max: f32) -> (u32, Vec4) {
         let mut enter = Vec4::ZERO;
         let mut exit = Vec4::INFINITY;
         for axis in 0..3 {
             let t0 = (self.min[axis] - ray.origin[axis]) * ray.inv_dir[axis];
             let t1 = (self.max[axis] - ray.origin[axis]) * ray.inv_dir[axis];
-            let on_plane = t0.is_nan_mask() | t1.is_nan_mask();
-            enter = enter.max(Vec4::select(on_plane, Vec4::NEG_INFINITY, t0.min(t1)));
-            exit = exit.min(Vec4::select(on_plane, Vec4::INFINITY, t0.max(t1)));
+            if NAN_FREE {
+                enter = enter.max(t0.min(t1));
+                exit = exit.min(t0.max(t1));
+            } else {
+                let on_plane = t0.is_nan_mask() | t1.is_nan_mask();
+                enter = enter.max(Vec4::select(on_plane, Vec4::NEG_INFINITY, t0.min(t1)));
+                exit = exit.min(Vec4::select(on_plane, Vec4::INFINITY, t0.max(t1)));
+            }
         }
         let exit = (exit * SLAB_WIDEN).min(Vec4::splat(t_max));
         let live = (1u32 << self.len) - 1;
@@ -229,6 +246,20 @@ impl Bvh {
     pub fn closest_leaves(
         &self,
         ray: &Ray,
+        t_max: f32,
+        leaf: impl FnMut(&[u32], f32) -> f32,
+    ) -> f32 {
+        if RayLanes::nan_free(ray) {
+            self.closest_impl::<true>(ray, t_max, leaf)
+        } else {
+            self.closest_impl::<false>(ray, t_max, leaf)
+        }
+    }
+
+    #[inline(always)]
+    fn closest_impl<const NAN_FREE: bool>(
+        &self,
+        ray: &Ray,
         mut t_max: f32,
         mut leaf: impl FnMut(&[u32], f32) -> f32,
     ) -> f32 {
@@ -255,7 +286,7 @@ impl Bvh {
                 continue;
             }
             let node = &self.nodes[reference as usize];
-            let (mask, enter) = node.hit(&lanes, t_max);
+            let (mask, enter) = node.hit::<NAN_FREE>(&lanes, t_max);
             if mask == 0 {
                 continue;
             }
@@ -277,7 +308,12 @@ impl Bvh {
     /// offered left to right, the binary tree's order.
     #[inline]
     pub fn any(&self, ray: &Ray, t_max: f32, mut occludes: impl FnMut(u32) -> bool) -> bool {
-        self.any_in_order::<false>(ray, t_max, |leaf| leaf.iter().any(|&p| occludes(p)))
+        let leaf = |leaf: &[u32]| leaf.iter().any(|&p| occludes(p));
+        if RayLanes::nan_free(ray) {
+            self.any_in_order::<false, true>(ray, t_max, leaf)
+        } else {
+            self.any_in_order::<false, false>(ray, t_max, leaf)
+        }
     }
 
     /// Any hit a leaf at a time: stops as soon as `occludes(prims)` says yes. Children are
@@ -286,11 +322,15 @@ impl Bvh {
     /// come differs from `any`'s.
     #[inline]
     pub fn any_leaves(&self, ray: &Ray, t_max: f32, occludes: impl FnMut(&[u32]) -> bool) -> bool {
-        self.any_in_order::<true>(ray, t_max, occludes)
+        if RayLanes::nan_free(ray) {
+            self.any_in_order::<true, true>(ray, t_max, occludes)
+        } else {
+            self.any_in_order::<true, false>(ray, t_max, occludes)
+        }
     }
 
     #[inline(always)]
-    fn any_in_order<const NEAR_FIRST: bool>(
+    fn any_in_order<const NEAR_FIRST: bool, const NAN_FREE: bool>(
         &self,
         ray: &Ray,
         t_max: f32,
@@ -315,7 +355,7 @@ impl Bvh {
                 continue;
             }
             let node = &self.nodes[reference as usize];
-            let (mask, _) = node.hit(&lanes, t_max);
+            let (mask, _) = node.hit::<NAN_FREE>(&lanes, t_max);
             if mask == 0 {
                 continue;
             }

@@ -183,7 +183,7 @@ impl RenderScene {
     }
 
     /// The material of primitive `i`.
-    #[inline]
+    #[inline(always)]
     pub fn material_of(&self, i: u32) -> u32 {
         self.material[i as usize]
     }
@@ -205,7 +205,7 @@ impl RenderScene {
     }
 
     /// Distance to primitive `i` along the ray, if it is hit with `0 < t < t_max`.
-    #[inline]
+    #[inline(always)]
     pub fn hit(&self, i: u32, ray: &Ray, t_max: f32) -> Option<f32> {
         match self.kind[i as usize] {
             SPHERE => self.sphere(i as usize).intersect(ray, t_max).map(|h| h.t),
@@ -240,29 +240,8 @@ impl RenderScene {
         let lanes = SphereRay::new(ray);
         // Primitives in the order the hierarchy offers them, a strictly closer hit replacing
         // the kept one: of equally close hits the first offered wins.
-        self.bvh.closest_leaves(ray, t_best, |leaf, mut t_max| {
-            let first = leaf[0] as usize;
-            for start in (first..first + leaf.len()).step_by(LANES) {
-                let (mask, t) = lanes.hit4(self.four_spheres(start), t_max);
-                for k in 0..(first + leaf.len() - start).min(LANES) {
-                    let i = start + k;
-                    match self.kind[i] {
-                        SPHERE => {
-                            if mask & (1 << k) != 0 && t[k] < t_max {
-                                t_max = t[k];
-                                best = Some((i as u32, t_max, None));
-                            }
-                        }
-                        o => {
-                            if let Some(h) = self.objects[o as usize].hit(ray, t_max) {
-                                t_max = h.t;
-                                best = Some((i as u32, t_max, Some(h)));
-                            }
-                        }
-                    }
-                }
-            }
-            t_max
+        self.bvh.closest_leaves(ray, t_best, |leaf, t_max| {
+            self.closest_in_leaf(&lanes, ray, leaf, t_max, &mut best)
         });
         let (i, t, hit) = best?;
         let surface = match (self.kind[i as usize], hit) {
@@ -271,6 +250,43 @@ impl RenderScene {
             (_, None) => unreachable!("objects keep their hit"),
         };
         Some((i, surface))
+    }
+
+    /// Tests one leaf's primitives in their order (see `closest`); returns the new `t_max`.
+    #[inline(always)]
+    fn closest_in_leaf(
+        &self,
+        lanes: &SphereRay,
+        ray: &Ray,
+        leaf: &[u32],
+        mut t_max: f32,
+        best: &mut Option<(u32, f32, Option<ShapeHit>)>,
+    ) -> f32 {
+        let first = leaf[0] as usize;
+        for start in (first..first + leaf.len()).step_by(LANES) {
+            // Tested when the first sphere comes up, so leaves of other kinds skip it.
+            let mut four = None;
+            for k in 0..(first + leaf.len() - start).min(LANES) {
+                let i = start + k;
+                match self.kind[i] {
+                    SPHERE => {
+                        let (mask, t) = *four
+                            .get_or_insert_with(|| lanes.hit4(self.four_spheres(start), t_max));
+                        if mask & (1 << k) != 0 && t[k] < t_max {
+                            t_max = t[k];
+                            *best = Some((i as u32, t_max, None));
+                        }
+                    }
+                    o => {
+                        if let Some(h) = self.objects[o as usize].hit(ray, t_max) {
+                            t_max = h.t;
+                            *best = Some((i as u32, t_max, Some(h)));
+                        }
+                    }
+                }
+            }
+        }
+        t_max
     }
 
     #[inline]
@@ -292,13 +308,13 @@ impl RenderScene {
             let first = leaf[0] as usize;
             (first..first + leaf.len()).step_by(LANES).any(|start| {
                 let live = (first + leaf.len() - start).min(LANES);
-                let (mask, _) = lanes.hit4(self.four_spheres(start), t_max);
+                let kinds = &self.kind[start..start + live];
                 // Other kinds hold NaN, which no sphere test hits.
-                mask & ((1 << live) - 1) != 0
-                    || (start..start + live).any(|i| {
-                        let k = self.kind[i];
-                        k != SPHERE && self.objects[k as usize].hit(ray, t_max).is_some()
-                    })
+                (kinds.contains(&SPHERE)
+                    && lanes.hit4(self.four_spheres(start), t_max).0 & ((1 << live) - 1) != 0)
+                    || kinds
+                        .iter()
+                        .any(|&k| k != SPHERE && self.objects[k as usize].hit(ray, t_max).is_some())
             })
         })
     }
