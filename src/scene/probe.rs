@@ -266,12 +266,18 @@ pub fn blank_image(job: &RenderJob) -> Option<Blank> {
         return blank("the scene has no shapes at all: the image is only the background".into());
     }
     let rays = primary_rays(&job.camera, job.width, job.height)?;
-    let probe = Probe::new(scene);
-    if probe.placed.len().saturating_mul(rays.len()) > PROBE_BUDGET {
+    // Counted before the shapes are placed, so that a huge scene costs no memory here.
+    let placeable = scene
+        .instances
+        .iter()
+        .filter(|i| scene.materials.get(i.material).is_some() && shape_of(&i.geometry).is_some())
+        .count();
+    if placeable.saturating_mul(rays.len()) > PROBE_BUDGET {
         // Scenes this big are generated, and their images are rarely empty: the probe
         // stays cheap rather than exhaustive (the reasons above still apply).
         return None;
     }
+    let probe = Probe::new(scene);
     let mut seen = Vec::with_capacity(rays.len());
     for ray in &rays {
         seen.push(probe.trace(ray, 0));

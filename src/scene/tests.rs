@@ -496,12 +496,45 @@ fn composite_cycles_and_explosions_are_errors_not_hangs() {
         ));
     }
     text.push_str("define camera c 60\nrender c o.png 1 1\n");
-    let ds = errors(&text);
-    assert!(
-        ds.iter()
-            .any(|d| d.message.contains("expands to more than")),
-        "{ds:?}"
+    // 2^25 shapes: refused from its counts under a budget of 1 GiB, on any machine.
+    let opts = LoadOptions {
+        max_memory: 1 << 30,
+        ..LoadOptions::default()
+    };
+    let ds = load_str(&text, Path::new("scene.sdf"), &opts).unwrap_err();
+    let want = format!(
+        "the composite tree expands to 33554432 shapes, which need about {} of memory, more than the 1.0 GiB allowed (`s25` is the largest part)",
+        crate::util::human_bytes(crate::limits::scene_memory(1 << 25))
     );
+    assert!(ds.iter().any(|d| d.message == want), "{ds:?}");
+}
+
+#[test]
+fn a_flat_scene_is_refused_only_beyond_the_memory_budget() {
+    let mut text = format!("{MATERIAL}define camera c 60\nrender c o.png 1 1\n");
+    for i in 0..1000 {
+        text.push_str(&format!("define shape sphere s{i} {i} 0 -5 0.5 m\n"));
+    }
+    let fits = LoadOptions {
+        max_memory: crate::limits::scene_memory(1000),
+        ..LoadOptions::default()
+    };
+    let loaded = load_str(&text, Path::new("scene.sdf"), &fits).unwrap();
+    assert_eq!(loaded.jobs[0].scene.instances.len(), 1000);
+    let tight = LoadOptions {
+        max_memory: crate::limits::scene_memory(999),
+        ..LoadOptions::default()
+    };
+    let ds = load_str(&text, Path::new("scene.sdf"), &tight).unwrap_err();
+    let want = format!(
+        "the scene's 1000 shapes need about {} of memory, more than the {} allowed",
+        crate::util::human_bytes(crate::limits::scene_memory(1000)),
+        crate::util::human_bytes(crate::limits::scene_memory(999))
+    );
+    assert_eq!(ds.len(), 1, "{ds:?}");
+    assert_eq!(ds[0].message, want);
+    // Located at the first shape, the largest part of a flat scene.
+    assert_eq!(ds[0].loc.as_ref().map(|l| l.line), Some(4));
 }
 
 #[test]

@@ -6,12 +6,13 @@ use super::transforms::{finite_transform, Snapshot, Space};
 use super::{At, Builder};
 use crate::diag::Diagnostic;
 use crate::diag::Severity;
+use crate::limits::MAX_WALK;
 use crate::limits::{self, DEFAULT_IMAGE_SIZE, MAX_NESTING};
-use crate::limits::{MAX_INSTANCES, MAX_TOTAL_INSTANCES, MAX_WALK};
 use crate::math::Transform;
 use crate::scene::{Camera, Geometry, Instance, Light, RenderJob, Scene};
 use crate::sdf::ast::{CameraDef, NameRef, Statement, StatementKind};
 use crate::sdf::default_output;
+use crate::util::human_bytes;
 use std::collections::HashSet;
 use std::path::PathBuf;
 
@@ -206,21 +207,19 @@ impl Builder<'_> {
                 let Some(material) = *material else {
                     return;
                 };
-                if out.len() >= MAX_INSTANCES || self.total_instances >= MAX_TOTAL_INSTANCES {
+                if limits::scene_memory(self.total_instances as u64 + 1) > self.opts.max_memory {
+                    // Counted before flattening, the tree fits; only a cycle (reported when
+                    // it is met) can make the walk go on past the count.
                     if !self.too_many_reported {
                         self.too_many_reported = true;
-                        let (message, help) = if out.len() >= MAX_INSTANCES {
-                            (
-                                format!("the composite tree expands to more than {MAX_INSTANCES} shapes"),
-                                "a composite listing another twice, level after level, doubles the scene each time",
-                            )
-                        } else {
-                            (
-                                format!("the file's render statements together need more than {MAX_TOTAL_INSTANCES} shapes"),
-                                "write one file per frame (as `anim generate` does) instead of many render lines",
-                            )
-                        };
-                        self.error(At::Name(object.statement), message, Some(help.to_string()));
+                        self.error(
+                            At::Name(object.statement),
+                            format!(
+                                "the composite tree expands to more shapes than the {} allowed can hold",
+                                human_bytes(self.opts.max_memory)
+                            ),
+                            Some(format!("{DOUBLING}; {RAISE}")),
+                        );
                     }
                     return;
                 }
@@ -380,9 +379,10 @@ fn expansion(d: &Definitions, roots: &[usize]) -> Vec<Expansion> {
 }
 
 impl Builder<'_> {
-    /// Whether the scene of one job can be flattened: its tree expands to at most
-    /// [`MAX_INSTANCES`] shapes (and [`MAX_WALK`] objects), and the file's jobs together to at
-    /// most [`MAX_TOTAL_INSTANCES`]. Otherwise reports why, once per file.
+    /// Whether the scene of one job can be flattened: its tree expands to shapes that fit in
+    /// the memory budget (`--max-memory`) together with those of the file's other jobs, and
+    /// to at most [`MAX_WALK`] objects that make no shape. Otherwise reports why, once per
+    /// file, with the memory the scene would need.
     fn expansion_fits(&mut self, d: &Definitions, tree: &Tree) -> bool {
         if self.too_many_reported {
             return false; // the scene is refused anyway
@@ -402,6 +402,7 @@ impl Builder<'_> {
             return true;
         };
         let object = &d.objects[largest];
+        let composite = matches!(object.kind, ObjectKind::Composite { .. });
         let count = |n: u64| {
             if n == u64::MAX {
                 "more than 10^19".to_string()
@@ -409,29 +410,49 @@ impl Builder<'_> {
                 n.to_string()
             }
         };
-        let problem = if shapes > MAX_INSTANCES as u64 {
-            Some((
-                format!(
-                    "the composite tree expands to more than {MAX_INSTANCES} shapes: it would make {} (`{}` is the largest part)",
-                    count(shapes),
-                    object.name
-                ),
-                "a composite listing another twice, level after level, doubles the scene each time",
-            ))
-        } else if nodes > MAX_WALK {
+        let budget = self.opts.max_memory;
+        let needed = limits::scene_memory(shapes);
+        let all_jobs = limits::scene_memory((self.total_instances as u64).saturating_add(shapes));
+        let problem = if needed > budget {
+            Some(if composite {
+                (
+                    format!(
+                        "the composite tree expands to {} shapes, which need about {} of memory, more than the {} allowed (`{}` is the largest part)",
+                        count(shapes),
+                        human_bytes(needed),
+                        human_bytes(budget),
+                        object.name
+                    ),
+                    format!("{DOUBLING}; {RAISE}"),
+                )
+            } else {
+                (
+                    format!(
+                        "the scene's {} shapes need about {} of memory, more than the {} allowed",
+                        count(shapes),
+                        human_bytes(needed),
+                        human_bytes(budget)
+                    ),
+                    RAISE.to_string(),
+                )
+            })
+        } else if nodes.saturating_sub(shapes) > MAX_WALK {
             Some((
                 format!(
                     "the composite tree expands to {} composites and shapes, more than the {MAX_WALK} that are walked (`{}` is the largest part)",
                     count(nodes),
                     object.name
                 ),
-                "a composite listing another twice, level after level, doubles the scene each time",
+                DOUBLING.to_string(),
             ))
-        } else if (self.total_instances as u64).saturating_add(shapes) > MAX_TOTAL_INSTANCES as u64
-        {
+        } else if all_jobs > budget {
             Some((
-                format!("the file's render statements together need more than {MAX_TOTAL_INSTANCES} shapes"),
-                "write one file per frame (as `anim generate` does) instead of many render lines",
+                format!(
+                    "the file's render statements together need about {} of memory for their shapes, more than the {} allowed",
+                    human_bytes(all_jobs),
+                    human_bytes(budget)
+                ),
+                format!("write one file per frame (as `anim generate` does) instead of many render lines; {RAISE}"),
             ))
         } else {
             None
@@ -439,13 +460,20 @@ impl Builder<'_> {
         match problem {
             Some((message, help)) => {
                 self.too_many_reported = true;
-                self.error(At::Name(object.statement), message, Some(help.to_string()));
+                self.error(At::Name(object.statement), message, Some(help));
                 false
             }
             None => true,
         }
     }
 }
+
+/// Why a small file can expand to a huge scene.
+const DOUBLING: &str =
+    "a composite listing another twice, level after level, doubles the scene each time";
+
+/// How to allow a bigger scene.
+const RAISE: &str = "--max-memory raises the limit";
 
 /// A camera definition with its transform applied: the eye as a point, dir and up as vectors.
 pub(super) fn place_camera(c: &CameraDef, snapshot: &Snapshot) -> Camera {
