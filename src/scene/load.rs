@@ -6,6 +6,7 @@ use crate::diag::{Diagnostic, Severity};
 use crate::limits::MAX_DIAGNOSTICS;
 use crate::sdf::ast::Statement;
 use crate::sdf::{self, finish_diagnostics, LoadOptions};
+use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;
 
@@ -80,7 +81,7 @@ pub fn build(
     opts: &LoadOptions,
 ) -> Result<Loaded, Vec<Diagnostic>> {
     let (jobs, diagnostics) = build_jobs(statements, path, opts, None);
-    conclude(jobs, finish_diagnostics(diagnostics, opts), path, &[])
+    conclude(jobs, finish_diagnostics(diagnostics, opts), path, "")
 }
 
 /// Parses and builds a file's text. `Err` holds every diagnostic (warnings too) when at least
@@ -89,38 +90,49 @@ pub fn build(
 pub fn load_str(text: &str, path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnostic>> {
     let parsed = sdf::parse_source(text, path, opts);
     let (jobs, built) = build_jobs(&parsed.statements, path, opts, Some(&parsed.omissions));
+    // The statements are no longer needed once the jobs hold the scenes: freed before the
+    // images are made.
+    drop(parsed.statements);
     let mut diagnostics = parsed.diagnostics;
     diagnostics.extend(built);
-    conclude(
-        jobs,
-        finish_diagnostics(diagnostics, opts),
-        path,
-        &parsed.lines,
-    )
+    conclude(jobs, finish_diagnostics(diagnostics, opts), path, text)
 }
 
 /// `Err` with the diagnostics when one is an error. They are capped first, then the kept
-/// ones that lack their source line quote it from `lines`: quoting is done here (not by
-/// `Parsed::quote_source`) so that only the diagnostics shown are quoted, each copying only
-/// the part of its line it shows (a line of a million bad names would otherwise be scanned
-/// once per name).
+/// ones that lack their source line quote it from `text` (the file's text, empty for
+/// statements made by a program): quoting is done here so that only the diagnostics shown
+/// are quoted, each copying only the part of its line it shows (a line of a million bad names
+/// would otherwise be scanned once per name), in one pass over the text.
 fn conclude(
     jobs: Vec<RenderJob>,
     diagnostics: Vec<Diagnostic>,
     path: &Path,
-    lines: &[String],
+    text: &str,
 ) -> Result<Loaded, Vec<Diagnostic>> {
     let failed = diagnostics.iter().any(Diagnostic::is_error);
     let mut diagnostics = cap(diagnostics, path);
-    for d in &mut diagnostics {
-        let line = d
-            .loc
-            .as_ref()
-            .and_then(|l| usize::try_from(l.line).ok())
-            .and_then(|n| n.checked_sub(1))
-            .and_then(|i| lines.get(i));
-        if let (None, Some(line)) = (&d.source_line, line) {
-            d.quote(line);
+    let mut wanted: Vec<u32> = diagnostics
+        .iter()
+        .filter(|d| d.source_line.is_none())
+        .filter_map(|d| d.loc.as_ref().map(|l| l.line))
+        .collect();
+    wanted.sort_unstable();
+    wanted.dedup();
+    if !wanted.is_empty() {
+        let mut lines: HashMap<u32, &str> = HashMap::with_capacity(wanted.len());
+        let mut next = wanted.iter().peekable();
+        for (i, raw) in sdf::raw_lines(text).enumerate() {
+            let Some(&&want) = next.peek() else { break };
+            if u32::try_from(i + 1) == Ok(want) {
+                lines.insert(want, raw);
+                next.next();
+            }
+        }
+        for d in &mut diagnostics {
+            let line = d.loc.as_ref().and_then(|l| lines.get(&l.line));
+            if let (None, Some(line)) = (&d.source_line, line) {
+                d.quote(line);
+            }
         }
     }
     if failed {

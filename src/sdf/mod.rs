@@ -10,6 +10,7 @@ mod lexer;
 mod parse;
 pub mod repair;
 
+pub use lexer::raw_lines;
 pub use parse::{default_output, Omissions, Parsed};
 
 use crate::diag::{Diagnostic, Loc, Severity};
