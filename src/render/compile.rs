@@ -70,12 +70,16 @@ impl RenderScene {
     pub fn compile(scene: &Scene) -> (RenderScene, Vec<Dropped>) {
         let mut prims = Vec::with_capacity(scene.instances.len());
         let mut dropped = Vec::new();
-        for inst in &scene.instances {
-            match Primitive::new(&inst.geometry, &inst.transform, inst.material as u32) {
+        for inst in scene.instances.iter() {
+            match Primitive::new(
+                &inst.geometry,
+                scene.transform_of(inst),
+                inst.material as u32,
+            ) {
                 Ok(p) => prims.push(p),
                 Err(_) => dropped.push(Dropped {
-                    instance: inst.name.clone(),
-                    loc: inst.loc.clone(),
+                    instance: scene.instance_name(inst),
+                    loc: scene.instance_loc(inst),
                 }),
             }
         }

@@ -33,6 +33,14 @@ fn errors(text: &str) -> Vec<Diagnostic> {
     }
 }
 
+fn instance_names(scene: &crate::scene::Scene) -> Vec<String> {
+    scene
+        .instances
+        .iter()
+        .map(|i| scene.instance_name(i))
+        .collect()
+}
+
 fn close(a: DVec3, b: DVec3) -> bool {
     a.abs_diff_eq(b, 1e-9)
 }
@@ -47,7 +55,8 @@ fn world_of(ops: &str, order: TransformOrder) -> crate::math::Transform {
         ..LoadOptions::default()
     };
     let loaded = load_with(&text, &opts);
-    loaded.jobs[0].scene.instances[0].transform
+    let scene = &loaded.jobs[0].scene;
+    *scene.transform_of(&scene.instances[0])
 }
 
 #[test]
@@ -120,24 +129,20 @@ fn a_composite_transform_moves_every_child_alike() {
         .then_after(&crate::math::Transform::rotate(90.0, DVec3::Z).unwrap());
     let a = &scene.instances[0];
     let b = &scene.instances[1];
-    assert_eq!(a.name, "root/a");
+    assert_eq!(scene.instance_name(a), "root/a");
+    let (a, b) = (scene.transform_of(a), scene.transform_of(b));
     // a: parent · own, where own moves it up by 5 first.
     let expected_a = root.then_after(&crate::math::Transform::translate(DVec3::new(
         0.0, 5.0, 0.0,
     )));
     assert!(a
-        .transform
         .world_from_object
         .abs_diff_eq(expected_a.world_from_object, 1e-12));
     assert!(b
-        .transform
         .world_from_object
         .abs_diff_eq(root.world_from_object, 1e-12));
     // (1, 0, 0) of b: rotated to (0, 1, 0), then moved to (10, 1, 0).
-    assert!(close(
-        b.transform.point(DVec3::X),
-        DVec3::new(10.0, 1.0, 0.0)
-    ));
+    assert!(close(b.point(DVec3::X), DVec3::new(10.0, 1.0, 0.0)));
 }
 
 #[test]
@@ -150,14 +155,18 @@ fn a_shape_in_two_composites_is_drawn_twice() {
          define camera c 60\nrender c out.png 10 10\n"
     );
     let scene = &load(&text).jobs[0].scene;
-    let names: Vec<&str> = scene.instances.iter().map(|i| i.name.as_str()).collect();
+    let names: Vec<String> = scene
+        .instances
+        .iter()
+        .map(|i| scene.instance_name(i))
+        .collect();
     assert_eq!(names, ["both/left/ball", "both/right/ball"]);
     assert!(close(
-        scene.instances[0].transform.point(DVec3::ZERO),
+        scene.transform_of(&scene.instances[0]).point(DVec3::ZERO),
         DVec3::new(-5.0, 0.0, 0.0)
     ));
     assert!(close(
-        scene.instances[1].transform.point(DVec3::ZERO),
+        scene.transform_of(&scene.instances[1]).point(DVec3::ZERO),
         DVec3::new(5.0, 0.0, 0.0)
     ));
 }
@@ -169,12 +178,7 @@ fn root_rule() {
         "{MATERIAL}define shape sphere a 0 0 0 1 m\ndefine shape sphere b 0 0 0 1 m\n\
          define shape composite root a\ndefine camera c 60\nrender c o.png 1 1\n"
     );
-    let names: Vec<String> = load(&with_root).jobs[0]
-        .scene
-        .instances
-        .iter()
-        .map(|i| i.name.clone())
-        .collect();
+    let names = instance_names(&load(&with_root).jobs[0].scene);
     assert_eq!(names, ["root/a"]);
     // Without it: every shape no composite contains, and uncontained composites.
     let without = format!(
@@ -182,12 +186,7 @@ fn root_rule() {
          define shape sphere c 0 0 0 1 m\ndefine shape composite g a\n\
          define camera cam 60\nrender cam o.png 1 1\n"
     );
-    let names: Vec<String> = load(&without).jobs[0]
-        .scene
-        .instances
-        .iter()
-        .map(|i| i.name.clone())
-        .collect();
+    let names = instance_names(&load(&without).jobs[0].scene);
     assert_eq!(names, ["b", "c", "g/a"]);
 }
 
@@ -199,7 +198,8 @@ fn one_render_line_sees_every_transform_wherever_it_stands() {
     );
     let loaded = load(&text);
     assert!(loaded.diagnostics.is_empty(), "{:?}", loaded.diagnostics);
-    let t = loaded.jobs[0].scene.instances[0].transform;
+    let scene = &loaded.jobs[0].scene;
+    let t = *scene.transform_of(&scene.instances[0]);
     assert!(close(t.point(DVec3::ZERO), DVec3::X));
 }
 
@@ -214,7 +214,12 @@ fn several_render_lines_see_the_transforms_before_them() {
     let xs: Vec<f64> = loaded
         .jobs
         .iter()
-        .map(|j| j.scene.instances[0].transform.point(DVec3::ZERO).x)
+        .map(|j| {
+            j.scene
+                .transform_of(&j.scene.instances[0])
+                .point(DVec3::ZERO)
+                .x
+        })
         .collect();
     // Every job sees the sphere (definitions are global), moved as far as its line allows.
     assert_eq!(xs, [0.0, 1.0, 2.0]);
@@ -412,12 +417,7 @@ fn degenerate_shapes_are_dropped_and_their_transforms_ignored() {
          define camera c 60\nrender c o.png 1 1\n"
     );
     let loaded = load(&text);
-    let names: Vec<&str> = loaded.jobs[0]
-        .scene
-        .instances
-        .iter()
-        .map(|i| i.name.as_str())
-        .collect();
+    let names = instance_names(&loaded.jobs[0].scene);
     assert_eq!(names, ["g/ok"]);
     assert_eq!(
         loaded
@@ -572,7 +572,14 @@ fn canonical_text_reads_back_to_the_same_jobs() {
             j.scene
                 .instances
                 .iter()
-                .map(|i| (i.name.clone(), i.geometry.clone(), i.material, i.transform))
+                .map(|i| {
+                    (
+                        j.scene.instance_name(i),
+                        i.geometry.clone(),
+                        i.material,
+                        *j.scene.transform_of(i),
+                    )
+                })
                 .collect()
         };
         assert_eq!(strip(a), strip(b));
@@ -672,9 +679,10 @@ mod fuzz {
                 if let Ok(loaded) = result {
                     for job in &loaded.jobs {
                         prop_assert!(job.camera.eye.is_finite() && job.camera.dir.is_finite());
-                        for i in &job.scene.instances {
-                            prop_assert!(i.transform.world_from_object.is_finite());
-                            prop_assert!(i.transform.object_from_world.is_finite());
+                        for i in job.scene.instances.iter() {
+                            let t = job.scene.transform_of(i);
+                            prop_assert!(t.world_from_object.is_finite());
+                            prop_assert!(t.object_from_world.is_finite());
                         }
                     }
                 }
@@ -810,7 +818,8 @@ fn a_name_after_the_material_is_the_shapes_name() {
     let l = load(&format!(
         "{MATERIAL}define shape sphere 0 0 -5 1 m ball\ndefine camera eye 60\nrender eye out.png 8 8\n"
     ));
-    assert_eq!(l.jobs[0].scene.instances[0].name, "ball");
+    let scene = &l.jobs[0].scene;
+    assert_eq!(scene.instance_name(&scene.instances[0]), "ball");
 }
 
 #[test]

@@ -43,7 +43,6 @@ pub(super) fn build_jobs(
         too_many_reported: false,
 
         suggestion_budget: SUGGESTION_BUDGET,
-        total_instances: 0,
     };
     let defs = b.definitions(statements);
     b.check_cycles(&defs);
@@ -78,8 +77,6 @@ struct Builder<'a> {
 
     /// Name comparisons left for "did you mean" suggestions.
     suggestion_budget: usize,
-    /// Instances made so far, over all jobs.
-    total_instances: usize,
 }
 
 impl<'a> Builder<'a> {
