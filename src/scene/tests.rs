@@ -234,6 +234,52 @@ fn several_render_lines_see_the_transforms_before_them() {
 }
 
 #[test]
+fn the_jobs_of_a_file_share_their_instances_and_unmoved_ones_share_one_transform() {
+    let text = format!(
+        "{MATERIAL}define shape sphere a 0 0 0 1 m
+define shape sphere b 0 0 0 1 m
+         define shape sphere s 0 0 0 1 m
+define shape composite g s b
+         define camera c 60
+render c f0.png 1 1
+transform s translate 1 0 0
+         render c f1.png 1 1
+transform g translate 0 2 0
+render c f2.png 1 1
+"
+    );
+    let loaded = load(&text);
+    let [j0, j1, j2] = &loaded.jobs[..] else {
+        panic!("{:?}", loaded.jobs.len())
+    };
+    assert!(std::sync::Arc::ptr_eq(
+        &j0.scene.instances,
+        &j1.scene.instances
+    ));
+    assert!(std::sync::Arc::ptr_eq(
+        &j0.scene.instances,
+        &j2.scene.instances
+    ));
+    // a: slot 0; g: its own slot; s in g: another; b in g: g's.
+    assert_eq!(j0.scene.transforms.len(), 3);
+    let slot = |name: &str| {
+        let i = j2
+            .scene
+            .instances
+            .iter()
+            .find(|i| j2.scene.instance_name(i) == name)
+            .unwrap_or_else(|| panic!("{name}"));
+        (i.transform, j2.scene.transform_of(i).point(DVec3::ZERO))
+    };
+    assert_eq!(slot("a"), (0, DVec3::ZERO));
+    assert_eq!(slot("g/b").1, DVec3::new(0.0, 2.0, 0.0));
+    assert_eq!(slot("g/s").1, DVec3::new(1.0, 2.0, 0.0));
+    assert_ne!(slot("g/b").0, slot("g/s").0);
+    let loc = j2.scene.instance_loc(&j2.scene.instances[0]).unwrap();
+    assert_eq!((loc.line, loc.col), (2, 1));
+}
+
+#[test]
 fn transforms_after_the_last_of_several_renders_are_reported() {
     let text = format!(
         "{MATERIAL}define shape sphere s 0 0 0 1 m\ndefine camera c 60\n\

@@ -39,12 +39,16 @@ impl Builder<'_> {
             }
         }
         let roots = roots(d);
-        let expansion = expansion(d, &roots, &moved);
-        let tree = Tree {
-            roots: &roots,
-            expansion: &expansion,
+        let shapes = {
+            let expansion = expansion(d, &roots, &moved);
+            let tree = Tree {
+                roots: &roots,
+                expansion: &expansion,
+            };
+            self.expansion_fits(d, &tree, snapshots.len() as u64)
         };
-        let flat = self.flatten_tree(d, &tree, &moved, snapshots.len() as u64);
+        // The counts are freed before the instances are made.
+        let flat = self.flatten_tree(d, &roots, shapes, &moved);
         let mut jobs = Vec::new();
         for (render, snapshot) in &snapshots {
             let job = match render {
@@ -186,20 +190,26 @@ impl Builder<'_> {
         }
     }
 
-    /// The composite tree flattened into instances, when it fits the memory budget for
-    /// `jobs` jobs (else reported, and no instances).
-    fn flatten_tree(&mut self, d: &Definitions, tree: &Tree, moved: &[bool], jobs: u64) -> Flat {
+    /// The composite tree below `roots` flattened into instances: `shapes` of them, or none
+    /// when the tree does not fit the memory budget (reported).
+    fn flatten_tree(
+        &mut self,
+        d: &Definitions,
+        roots: &[usize],
+        shapes: Option<u64>,
+        moved: &[bool],
+    ) -> Flat {
         let mut flat = Flatten {
             instances: Vec::new(),
             slots: Vec::new(),
             names: Names::default(),
             name_ids: vec![NO_NAME; d.objects.len()],
         };
-        if let Some(shapes) = self.expansion_fits(d, tree, jobs) {
+        if let Some(shapes) = shapes {
             flat.instances
                 .reserve_exact(usize::try_from(shapes).unwrap_or(0));
             let mut stack = Vec::new();
-            for &root in tree.roots {
+            for &root in roots {
                 self.flatten(d, moved, root, 0, NO_NAME, &mut stack, &mut flat);
             }
         }

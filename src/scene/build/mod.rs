@@ -87,12 +87,16 @@ impl<'a> Builder<'a> {
     fn place(&self, at: At) -> (Loc, u32) {
         match at {
             At::Ref(r) => (r.loc.clone(), r.name.chars().count() as u32),
-            At::Name(stmt) if self.from_reader => {
-                match stmt.spans.as_ref().and_then(|s| s.name.as_ref()) {
-                    Some(name) => (name.loc.clone(), name.width),
-                    None => self.place(At::Statement(stmt)),
-                }
-            }
+            At::Name(stmt) if self.from_reader => match stmt.spans.as_ref().and_then(|s| s.name) {
+                Some(name) => (
+                    Loc {
+                        col: name.col,
+                        ..stmt.loc.clone()
+                    },
+                    name.width,
+                ),
+                None => self.place(At::Statement(stmt)),
+            },
             At::Name(stmt) | At::Statement(stmt) => (
                 stmt.loc.clone(),
                 stmt.spans.as_ref().map_or(1, |s| s.first_width),

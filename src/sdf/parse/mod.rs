@@ -313,14 +313,7 @@ impl Parser<'_> {
     /// known (a duplicate, a cycle) point at it.
     fn emit_named(&mut self, line: &Line, name_at: usize, kind: StatementKind) {
         let (col, width) = Self::place(line, At::Tok(name_at));
-        let name = Span {
-            loc: Loc {
-                file: self.file.clone(),
-                line: line.number,
-                col,
-            },
-            width,
-        };
+        let name = Span { col, width };
         self.push(line, kind, Some(name));
     }
 
