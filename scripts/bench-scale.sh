@@ -48,8 +48,10 @@ measure() { # label count command...
     }
     read -r user sys kb <"$dir/time"
     awk -v l="$label" -v n="$n" -v u="$user" -v s="$sys" -v kb="$kb" -v lines="$((n + 6))" \
-        'BEGIN { cpu = u + s; printf "%-7s %9d spheres  %7.2f CPU s  %8.1f MiB peak  %6.0f B/sphere  %5.2f M lines/s\n",
-                 l, n, cpu, kb / 1024, kb * 1024 / n, lines / (cpu > 0 ? cpu : 1e-9) / 1e6 }'
+        'BEGIN { cpu = u + s; rate = "";
+                 if (l == "check") rate = sprintf("  %5.2f M lines/s", lines / (cpu > 0 ? cpu : 1e-9) / 1e6);
+                 printf "%-7s %9d spheres  %7.2f CPU s  %8.1f MiB peak  %6.0f B/sphere%s\n",
+                 l, n, cpu, kb / 1024, kb * 1024 / n, rate }'
 }
 
 for n in "${counts[@]}"; do
