@@ -49,6 +49,11 @@ pub struct SceneArgs {
     /// Largest scene file read, in bytes; larger files are refused unread.
     #[arg(long, value_name = "BYTES", default_value_t = limits::DEFAULT_MAX_INPUT)]
     pub max_input: u64,
+    /// Memory a scene, and each image, may take while it is made, e.g. 512M or 8G (default:
+    /// half the machine's memory). Bigger scenes and images are refused before they are
+    /// built, with the memory they would need.
+    #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
+    pub max_memory: Option<u64>,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -91,10 +96,6 @@ pub struct RenderArgs {
     /// absolute paths and paths climbing out with `..`.
     #[arg(long)]
     pub allow_any_output: bool,
-    /// Memory one image may take while it is made, e.g. 512M or 8G (default: half the
-    /// machine's memory). Bigger images are refused before anything is allocated.
-    #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
-    pub max_memory: Option<u64>,
     /// Render frames even if their input and settings are unchanged since the last run.
     #[arg(long)]
     pub force: bool,
@@ -346,9 +347,7 @@ impl RenderArgs {
             ppm_ascii: self.ppm_ascii,
             out_dir: self.out.clone(),
             allow_any_output: self.allow_any_output,
-            max_memory: self
-                .max_memory
-                .unwrap_or_else(limits::default_memory_budget),
+            max_memory: self.scene.max_memory(),
         }
     }
 }
@@ -390,6 +389,13 @@ impl SceneArgs {
                 TransformOrderArg::Local => TransformOrder::Local,
             },
             max_input: self.max_input,
+            max_memory: self.max_memory(),
         }
+    }
+
+    /// `--max-memory`, else the machine's default budget.
+    pub fn max_memory(&self) -> u64 {
+        self.max_memory
+            .unwrap_or_else(limits::default_memory_budget)
     }
 }

@@ -50,7 +50,8 @@ pub const RENDER_STACK_BYTES: usize = 64 << 20;
 /// the encoded file (at most about as large again).
 pub const IMAGE_BYTES_PER_PIXEL: u64 = 12 + 3 + 3 + 6;
 
-/// The memory an image may take when neither `--max-memory` nor the machine says: 4 GiB.
+/// The memory a scene or an image may take when neither `--max-memory` nor the machine says:
+/// 4 GiB.
 const FALLBACK_MEMORY_BUDGET: u64 = 4 << 30;
 
 /// The default memory budget: half the machine's memory, leaving the rest to everything else.
@@ -100,12 +101,19 @@ pub fn image_extensions_list() -> String {
         .join(", ")
 }
 
-/// More instances than this means a composite tree that multiplies out of all proportion
-/// (each level listing the one below twice, ...): refused before it exhausts memory.
-pub const MAX_INSTANCES: usize = 250_000;
+/// Memory one shape of a scene costs from reading to rendering, in bytes: its statement, its
+/// instance and its share of the render scene and its BVH. A scene whose shapes would need more
+/// than the memory budget (`--max-memory`, else [`default_memory_budget`]) is refused before
+/// it is built: a composite tree that multiplies out of all proportion (each level listing
+/// the one below twice) is refused from its counts, and a flat file from its size.
+/// Measured with scripts/bench-scale.sh (peak RSS of `anim render --spp 1` on 10^6 spheres,
+/// BENCHMARKS.md "Scale"), rounded up.
+pub const SCENE_BYTES_PER_SHAPE: u64 = 512;
 
-/// The same over all the jobs of a file (each job holds its own scene).
-pub const MAX_TOTAL_INSTANCES: usize = 2_000_000;
+/// Bytes needed to build and render a scene of `shapes` shapes.
+pub fn scene_memory(shapes: u64) -> u64 {
+    shapes.saturating_mul(SCENE_BYTES_PER_SHAPE)
+}
 
 /// Objects (shapes and composites) visited while flattening one job's tree: a tree of
 /// composites holding nothing expands to no shapes but can still take forever to walk.

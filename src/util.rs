@@ -113,9 +113,28 @@ pub fn physical_memory() -> Option<u64> {
     kib.checked_mul(1024)
 }
 
+/// `bytes` for messages: in MiB below a GiB, else in GiB, one decimal.
+pub fn human_bytes(bytes: u64) -> String {
+    const MIB: f64 = (1u64 << 20) as f64;
+    const GIB: f64 = (1u64 << 30) as f64;
+    let b = bytes as f64;
+    if b < GIB {
+        format!("{:.1} MiB", b / MIB)
+    } else {
+        format!("{:.1} GiB", b / GIB)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bytes_read_in_mib_or_gib() {
+        assert_eq!(human_bytes(3 << 20), "3.0 MiB");
+        assert_eq!(human_bytes(1536 << 20), "1.5 GiB");
+        assert_eq!(human_bytes(0), "0.0 MiB");
+    }
 
     #[test]
     fn fnv_known_values() {

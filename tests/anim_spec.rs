@@ -428,9 +428,9 @@ fn world_point(job: &RenderJob, name: &str, p: DVec3) -> DVec3 {
         .scene
         .instances
         .iter()
-        .find(|inst| inst.name == name)
+        .find(|inst| job.scene.instance_name(inst) == name)
         .unwrap_or_else(|| panic!("no instance {name}"));
-    instance.transform.point(p)
+    job.scene.transform_of(instance).point(p)
 }
 
 fn assert_near(got: DVec3, want: DVec3) {

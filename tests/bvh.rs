@@ -125,17 +125,16 @@ fn wide_bvh_equals_brute_force_on_random_scenes() {
 /// Mostly world-space spheres (so leaves of four spheres, and leaves mixing spheres with other
 /// kinds), with boxes, triangles, rotated and stretched shapes, an exact duplicate sphere (a
 /// tie) and a plane. Instance `i` has material `i`, which names it after renumbering.
-fn mixed_instances(rng: &mut Rng, n: usize) -> Vec<Instance> {
-    fn push(out: &mut Vec<Instance>, geometry: Geometry, transform: Transform) {
+/// Each instance has its own transform slot, with the same index.
+fn mixed_instances(rng: &mut Rng, n: usize) -> (Vec<Instance>, Vec<Transform>) {
+    let mut transforms = Vec::new();
+    let mut push = |out: &mut Vec<Instance>, geometry: Geometry, transform: Transform| {
         let material = out.len();
-        out.push(Instance {
-            name: format!("p{material}"),
-            geometry,
-            material,
-            transform,
-            loc: None,
-        });
-    }
+        let mut instance = Instance::new(geometry, material);
+        instance.transform = transforms.len() as u32;
+        transforms.push(transform);
+        out.push(instance);
+    };
     let mut out = Vec::new();
     for i in 0..n {
         let c = rng.vec(50.0);
@@ -190,26 +189,28 @@ fn mixed_instances(rng: &mut Rng, n: usize) -> Vec<Instance> {
         },
         Transform::IDENTITY,
     );
-    out
+    (out, transforms)
 }
 
 #[test]
 fn render_scene_equals_brute_force_on_mixed_scenes() {
     let mut rng = Rng(0x2545F4914F6CDD1D);
     for n in [4, 40, 2000] {
-        let instances = mixed_instances(&mut rng, n);
+        let (instances, transforms) = mixed_instances(&mut rng, n);
         let prims: Vec<Primitive> = instances
             .iter()
-            .map(|i| Primitive::new(&i.geometry, &i.transform, i.material as u32).unwrap())
+            .map(|i| {
+                let xf = &transforms[i.transform as usize];
+                Primitive::new(&i.geometry, xf, i.material as u32).unwrap()
+            })
             .collect();
         let scene = Scene {
             materials: (0..instances.len())
                 .map(|i| Material::phong(&format!("m{i}"), Vec3::ONE, Vec3::ONE, Vec3::ONE, 1.0))
                 .collect(),
-            instances,
-            lights: Vec::new(),
-            ambient: Vec3::ZERO,
-            background: Vec3::ZERO,
+            instances: instances.into(),
+            transforms,
+            ..Scene::default()
         };
         let (render, dropped) = RenderScene::compile(&scene);
         assert!(dropped.is_empty());

@@ -114,10 +114,20 @@ fn canonical_text_of_corpus_files_loads_to_the_same_jobs() {
             assert_eq!(a.scene.ambient, b.scene.ambient, "{name}");
             assert_eq!(a.scene.background, b.scene.background, "{name}");
             assert_eq!(a.scene.instances.len(), b.scene.instances.len(), "{name}");
-            for (x, y) in a.scene.instances.iter().zip(&b.scene.instances) {
+            for (x, y) in a.scene.instances.iter().zip(b.scene.instances.iter()) {
                 assert_eq!(
-                    (&x.name, &x.geometry, x.material, x.transform),
-                    (&y.name, &y.geometry, y.material, y.transform),
+                    (
+                        a.scene.instance_name(x),
+                        &x.geometry,
+                        x.material,
+                        a.scene.transform_of(x)
+                    ),
+                    (
+                        b.scene.instance_name(y),
+                        &y.geometry,
+                        y.material,
+                        b.scene.transform_of(y)
+                    ),
                     "{name}"
                 );
             }

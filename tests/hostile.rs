@@ -120,31 +120,52 @@ fn a_file_with_nul_bytes_is_not_a_text_file() {
 
 #[test]
 fn a_doubling_composite_chain_is_refused_from_its_counts() {
-    // 300 chained composites, the top 20 listing their child twice: 2^20 copies of a chain of
-    // 280, in a 10 kB file. Walking it took minutes; counting takes microseconds.
-    let mut text =
-        String::from("define material m 1 0 0 1 0 0 1 0 0 1\ndefine shape sphere s0 0 0 0 1 m\n");
-    for k in 1..=300 {
-        let child = if k == 1 {
-            "s0".to_string()
-        } else {
-            format!("c{}", k - 1)
-        };
-        let twice = if k > 280 {
-            format!(" {child}")
-        } else {
-            String::new()
-        };
-        text.push_str(&format!("define shape composite c{k} {child}{twice}\n"));
-    }
-    text.push_str("define camera cam 60\nrender cam image.png 10 10\n");
+    // 300 chained composites, the top 40 listing their child twice: 2^40 copies of a chain of
+    // 260, in a 10 kB file. Walking it took minutes; counting takes microseconds.
+    let chain = |doubled: usize| {
+        let mut text = String::from(
+            "define material m 1 0 0 1 0 0 1 0 0 1\ndefine shape sphere s0 0 0 0 1 m\n",
+        );
+        for k in 1..=300 {
+            let child = if k == 1 {
+                "s0".to_string()
+            } else {
+                format!("c{}", k - 1)
+            };
+            let twice = if k > 300 - doubled {
+                format!(" {child}")
+            } else {
+                String::new()
+            };
+            text.push_str(&format!("define shape composite c{k} {child}{twice}\n"));
+        }
+        text.push_str("define camera cam 60\nrender cam image.png 10 10\n");
+        text
+    };
     let dir = tempfile::tempdir().unwrap();
-    let path = write(dir.path(), "chain.sdf", text.as_bytes());
+    let path = write(dir.path(), "chain.sdf", chain(40).as_bytes());
     let (ok, stderr, took) = check(&path);
     assert!(!ok);
     assert!(took < QUICK, "{took:?}");
     assert!(
-        stderr.contains("expands to more than 250000 shapes: it would make 1048576"),
+        stderr.contains(
+            "error: the composite tree expands to 1099511627776 shapes, which need about 524288.0 GiB of memory"
+        ),
+        "{stderr}"
+    );
+    assert!(stderr.contains("--max-memory raises the limit"), "{stderr}");
+
+    // 2^20 shapes fit the machine's memory but not a budget of 64 MiB.
+    let path = write(dir.path(), "chain20.sdf", chain(20).as_bytes());
+    let out = anim()
+        .args(["check", "--max-memory", "64M"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("expands to 1048576 shapes, which need about 512.0 MiB of memory, more than the 64.0 MiB allowed (`c300` is the largest part)"),
         "{stderr}"
     );
 

@@ -58,9 +58,7 @@ pub const CHANGES: [Change; 8] = [
 /// `job` with the whole scene, camera and lights mapped by `t`.
 pub fn transform_job(job: &RenderJob, t: &Transform) -> RenderJob {
     let mut out = job.clone();
-    for inst in &mut out.scene.instances {
-        inst.transform = t.then_after(&inst.transform);
-    }
+    out.scene.transform_all(t);
     for light in &mut out.scene.lights {
         light.position = t.point(light.position);
     }

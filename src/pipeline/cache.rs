@@ -189,6 +189,9 @@ mod tests {
             transform_order,
             // The input limit decides whether a file is read at all, never what it renders.
             max_input: _,
+            // The memory budget decides whether a scene is built at all, never what it
+            // renders.
+            max_memory: _,
         } = load.clone();
         let variants: Vec<(RenderSettings, LoadOptions)> = vec![
             (

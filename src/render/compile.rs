@@ -91,8 +91,12 @@ impl RenderScene {
         let mut bounds = Vec::with_capacity(n);
         let mut objects = Vec::new();
         let mut dropped = Vec::new();
-        for inst in &scene.instances {
-            match Primitive::new(&inst.geometry, &inst.transform, inst.material as u32) {
+        for inst in scene.instances.iter() {
+            match Primitive::new(
+                &inst.geometry,
+                scene.transform_of(inst),
+                inst.material as u32,
+            ) {
                 Ok(p) => {
                     bounds.push(p.bounds);
                     material.push(p.material);
@@ -106,8 +110,8 @@ impl RenderScene {
                     }
                 }
                 Err(_) => dropped.push(Dropped {
-                    instance: inst.name.clone(),
-                    loc: inst.loc.clone(),
+                    instance: scene.instance_name(inst),
+                    loc: scene.instance_loc(inst),
                 }),
             }
         }

@@ -162,10 +162,9 @@ fn camera_relative(job: &RenderJob) -> Option<(Scene, Camera)> {
         return None;
     }
     let to_camera = Transform::translate(-eye);
+    // The instances are shared, not copied: only the table of transforms is.
     let mut scene = job.scene.clone();
-    for instance in &mut scene.instances {
-        instance.transform = to_camera.then_after(&instance.transform);
-    }
+    scene.transform_all(&to_camera);
     for light in &mut scene.lights {
         light.position -= eye;
     }

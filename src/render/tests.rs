@@ -2,7 +2,6 @@
 //! expected values derived from the physics rather than from earlier output.
 
 use super::*;
-use crate::math::Transform;
 use crate::scene::{Camera, Geometry, Instance, Light, Material, Scene};
 use glam::{DVec3, Vec3};
 
@@ -11,13 +10,7 @@ fn material(name: &str, ka: f32, kd: [f32; 3], ks: f32, m: f32) -> Material {
 }
 
 fn instance(geometry: Geometry, material: usize) -> Instance {
-    Instance {
-        name: "s".into(),
-        geometry,
-        material,
-        transform: Transform::IDENTITY,
-        loc: None,
-    }
+    Instance::new(geometry, material)
 }
 
 fn sphere(c: [f64; 3], r: f64, material: usize) -> Instance {
@@ -64,7 +57,8 @@ fn base_scene() -> Scene {
                 },
                 1,
             ),
-        ],
+        ]
+        .into(),
         lights: vec![
             Light {
                 name: "a".into(),
@@ -79,6 +73,7 @@ fn base_scene() -> Scene {
         ],
         ambient: Vec3::splat(0.4),
         background: Vec3::new(0.1, 0.2, 0.3),
+        ..Scene::default()
     }
 }
 
@@ -103,7 +98,7 @@ fn glass_of_index_one_is_invisible() {
     glass.ior = 1.0;
     with_glass.materials.push(glass);
     // In front of the ball, and in the path of shadow rays to the floor.
-    with_glass.instances.push(sphere([0.0, 0.0, -5.0], 1.5, 2));
+    with_glass.push_instance(sphere([0.0, 0.0, -5.0], 1.5, 2));
     let seen_through = render(&job(with_glass, cam, 96, 64));
     assert_close(&plain, &seen_through, 1, 96 * 64);
 }
@@ -131,14 +126,16 @@ fn perfect_mirror_shows_the_mirrored_configuration() {
                 },
                 1,
             ),
-        ],
+        ]
+        .into(),
         lights: vec![light_at(10.0)],
         ambient: Vec3::splat(0.3),
         background: Vec3::new(0.3, 0.1, 0.0),
+        ..Scene::default()
     };
     let mirrored = Scene {
         materials: vec![ball],
-        instances: vec![sphere([1.5, 0.5, -46.0], 2.0, 0)],
+        instances: vec![sphere([1.5, 0.5, -46.0], 2.0, 0)].into(),
         lights: vec![light_at(-50.0)],
         ..in_front.clone()
     };
@@ -186,10 +183,12 @@ fn total_internal_reflection_is_not_black() {
                 0,
             ),
             sphere([0.0, -0.5, -14.0], 0.5, 1),
-        ],
+        ]
+        .into(),
         lights: vec![],
         ambient: Vec3::ONE,
         background: Vec3::ZERO,
+        ..Scene::default()
     };
     let angle = 10f64.to_radians();
     let cam = Camera {
@@ -211,7 +210,7 @@ fn no_pixel_is_ever_nan_or_infinite() {
     glass.reflectivity = 0.3;
     glass.ior = 1.5;
     scene.materials.push(glass);
-    scene.instances.push(sphere([-1.0, 0.0, -6.0], 1.0, 2));
+    scene.push_instance(sphere([-1.0, 0.0, -6.0], 1.0, 2));
     // A light exactly on a surface, and a camera inside an object.
     scene.lights.push(Light {
         name: "on".into(),
@@ -269,7 +268,8 @@ fn shadow_through_glass_is_attenuated_per_surface_crossed() {
                 0,
             ),
             sphere([0.0, 5.0, 0.0], 1.0, 1),
-        ],
+        ]
+        .into(),
         lights: vec![Light {
             name: "l".into(),
             position: DVec3::new(0.0, 10.0, 0.0),
@@ -277,6 +277,7 @@ fn shadow_through_glass_is_attenuated_per_surface_crossed() {
         }],
         ambient: Vec3::splat(0.5),
         background: Vec3::ZERO,
+        ..Scene::default()
     };
     let cam = Camera {
         name: "c".into(),
@@ -306,7 +307,7 @@ fn a_world_space_sphere_costs_at_most_100_bytes() {
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
     let n = 20_000;
-    let instances = (0..n)
+    let instances: Vec<Instance> = (0..n)
         .map(|_| {
             let c = [next() * 100.0, next() * 100.0, next() * 100.0];
             sphere(c, 0.1 + next() * 0.4, 0)
@@ -314,10 +315,8 @@ fn a_world_space_sphere_costs_at_most_100_bytes() {
         .collect();
     let scene = Scene {
         materials: vec![material("m", 0.1, [0.5; 3], 0.0, 1.0)],
-        instances,
-        lights: Vec::new(),
-        ambient: Vec3::ZERO,
-        background: Vec3::ZERO,
+        instances: instances.into(),
+        ..Scene::default()
     };
     let (compiled, dropped) = RenderScene::compile(&scene);
     assert!(dropped.is_empty());

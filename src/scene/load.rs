@@ -6,6 +6,8 @@ use crate::diag::{Diagnostic, Severity};
 use crate::limits::MAX_DIAGNOSTICS;
 use crate::sdf::ast::Statement;
 use crate::sdf::{self, finish_diagnostics, LoadOptions};
+use std::borrow::Cow;
+use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;
 
@@ -22,7 +24,23 @@ pub struct Loaded {
 /// Reads and loads a file. `Err` holds every diagnostic (at least one error).
 pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnostic>> {
     let bytes = read_input(path, opts.max_input, "file")?;
-    load_str(&String::from_utf8_lossy(&bytes), path, opts)
+    // A regular file can be read again: its text is freed once parsed, before the scene is
+    // built, and read again only if a diagnostic must quote one of its lines.
+    let rereadable = std::fs::metadata(path).is_ok_and(|m| m.is_file());
+    if !rereadable {
+        return load_str(&String::from_utf8_lossy(&bytes), path, opts);
+    }
+    let length = bytes.len();
+    let parsed = sdf::parse_source(&String::from_utf8_lossy(&bytes), path, opts);
+    drop(bytes);
+    let again = || {
+        read_input(path, opts.max_input, "file")
+            .ok()
+            // A file changed since it was read is not quoted.
+            .filter(|b| b.len() == length)
+            .map(|b| Cow::Owned(String::from_utf8_lossy(&b).into_owned()))
+    };
+    finish_load(parsed, path, opts, again)
 }
 
 /// Reads a whole text file of at most `limit` bytes. Larger files are refused from their
@@ -80,7 +98,7 @@ pub fn build(
     opts: &LoadOptions,
 ) -> Result<Loaded, Vec<Diagnostic>> {
     let (jobs, diagnostics) = build_jobs(statements, path, opts, None);
-    conclude(jobs, finish_diagnostics(diagnostics, opts), path, &[])
+    conclude(jobs, finish_diagnostics(diagnostics, opts), path, || None)
 }
 
 /// Parses and builds a file's text. `Err` holds every diagnostic (warnings too) when at least
@@ -88,39 +106,61 @@ pub fn build(
 /// out.
 pub fn load_str(text: &str, path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnostic>> {
     let parsed = sdf::parse_source(text, path, opts);
+    finish_load(parsed, path, opts, || Some(Cow::Borrowed(text)))
+}
+
+/// Builds the jobs of a parsed file; `text` gives the file's text again for quoting.
+fn finish_load<'t>(
+    parsed: sdf::Parsed,
+    path: &Path,
+    opts: &LoadOptions,
+    text: impl FnOnce() -> Option<Cow<'t, str>>,
+) -> Result<Loaded, Vec<Diagnostic>> {
     let (jobs, built) = build_jobs(&parsed.statements, path, opts, Some(&parsed.omissions));
+    // The statements are no longer needed once the jobs hold the scenes: freed before the
+    // images are made.
+    drop(parsed.statements);
     let mut diagnostics = parsed.diagnostics;
     diagnostics.extend(built);
-    conclude(
-        jobs,
-        finish_diagnostics(diagnostics, opts),
-        path,
-        &parsed.lines,
-    )
+    conclude(jobs, finish_diagnostics(diagnostics, opts), path, text)
 }
 
 /// `Err` with the diagnostics when one is an error. They are capped first, then the kept
-/// ones that lack their source line quote it from `lines`: quoting is done here (not by
-/// `Parsed::quote_source`) so that only the diagnostics shown are quoted, each copying only
-/// the part of its line it shows (a line of a million bad names would otherwise be scanned
-/// once per name).
-fn conclude(
+/// ones that lack their source line quote it from `text()` (the file's text, `None` for
+/// statements made by a program, asked for only when a line is to be quoted): quoting is
+/// done here so that only the diagnostics shown
+/// are quoted, each copying only the part of its line it shows (a line of a million bad names
+/// would otherwise be scanned once per name), in one pass over the text.
+fn conclude<'t>(
     jobs: Vec<RenderJob>,
     diagnostics: Vec<Diagnostic>,
     path: &Path,
-    lines: &[String],
+    text: impl FnOnce() -> Option<Cow<'t, str>>,
 ) -> Result<Loaded, Vec<Diagnostic>> {
     let failed = diagnostics.iter().any(Diagnostic::is_error);
     let mut diagnostics = cap(diagnostics, path);
-    for d in &mut diagnostics {
-        let line = d
-            .loc
-            .as_ref()
-            .and_then(|l| usize::try_from(l.line).ok())
-            .and_then(|n| n.checked_sub(1))
-            .and_then(|i| lines.get(i));
-        if let (None, Some(line)) = (&d.source_line, line) {
-            d.quote(line);
+    let mut wanted: Vec<u32> = diagnostics
+        .iter()
+        .filter(|d| d.source_line.is_none())
+        .filter_map(|d| d.loc.as_ref().map(|l| l.line))
+        .collect();
+    wanted.sort_unstable();
+    wanted.dedup();
+    if let Some(text) = (!wanted.is_empty()).then(text).flatten() {
+        let mut lines: HashMap<u32, &str> = HashMap::with_capacity(wanted.len());
+        let mut next = wanted.iter().peekable();
+        for (i, raw) in sdf::raw_lines(&text).enumerate() {
+            let Some(&&want) = next.peek() else { break };
+            if u32::try_from(i + 1) == Ok(want) {
+                lines.insert(want, raw);
+                next.next();
+            }
+        }
+        for d in &mut diagnostics {
+            let line = d.loc.as_ref().and_then(|l| lines.get(&l.line));
+            if let (None, Some(line)) = (&d.source_line, line) {
+                d.quote(line);
+            }
         }
     }
     if failed {

@@ -15,7 +15,8 @@ pub use load::{build, load_file, load_str, read_input, Loaded};
 use crate::diag::Loc;
 use crate::math::Transform;
 use glam::{DVec3, Vec3};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -50,17 +51,107 @@ impl Material {
 }
 
 /// One leaf of the composite tree placed in the world. A shape listed in two composites
-/// yields two instances.
+/// yields two instances. Kept small, as a scene may hold millions: its world transform, name
+/// and source location are looked up in its [`Scene`] ([`Scene::transform_of`],
+/// [`Scene::instance_name`], [`Scene::instance_loc`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Instance {
-    /// Path through the composite tree, e.g. `root/table/leg1`.
-    pub name: String,
     pub geometry: Geometry,
     /// Index into `Scene::materials`.
     pub material: usize,
-    /// The accumulated world transform (parents' transforms included).
-    pub transform: Transform,
-    pub loc: Option<Loc>,
+    /// Index into `Scene::transforms`: the accumulated world transform (parents' transforms
+    /// included). Instances under no transform share slot 0, so they cost nothing for it.
+    pub transform: u32,
+    /// The object it is drawn from, in `Scene::names` ([`NO_NAME`] for none).
+    pub object: u32,
+    /// The composite it is listed in, as a path node of `Scene::names` ([`NO_NAME`] at the
+    /// top of the tree).
+    pub parent: u32,
+}
+
+/// No name or path node: an instance made by a program, or one at the top of the tree.
+pub const NO_NAME: u32 = u32::MAX;
+
+impl Instance {
+    /// An instance with no name, placed by transform slot 0 (the identity unless the whole
+    /// scene was moved): for scenes made by programs.
+    pub fn new(geometry: Geometry, material: usize) -> Self {
+        Instance {
+            geometry,
+            material,
+            transform: 0,
+            object: NO_NAME,
+            parent: NO_NAME,
+        }
+    }
+}
+
+/// The names of a scene's objects and where they are defined, and the composite paths its
+/// instances are listed under: what diagnostics name an instance by (`root/table/leg1`),
+/// built only when one is needed. Shared by the jobs of a file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Names {
+    /// Every object name, one after the other.
+    text: String,
+    objects: Vec<ObjectName>,
+    files: Vec<Arc<Path>>,
+    paths: Vec<PathNode>,
+}
+
+/// An object's name (ending at `end` in `Names::text`) and its definition's location.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ObjectName {
+    end: u32,
+    file: u32,
+    line: u32,
+    col: u32,
+}
+
+/// A composite as listed on one path through the tree.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct PathNode {
+    parent: u32,
+    object: u32,
+}
+
+impl Names {
+    /// Records an object's name and location; its id.
+    pub fn add_object(&mut self, name: &str, loc: &Loc) -> u32 {
+        let file = match self.files.iter().rposition(|f| Arc::ptr_eq(f, &loc.file)) {
+            Some(i) => i,
+            None => {
+                self.files.push(loc.file.clone());
+                self.files.len() - 1
+            }
+        };
+        self.text.push_str(name);
+        self.objects.push(ObjectName {
+            end: u32::try_from(self.text.len()).unwrap_or(u32::MAX),
+            file: file as u32,
+            line: loc.line,
+            col: loc.col,
+        });
+        (self.objects.len() - 1) as u32
+    }
+
+    /// Records composite `object` listed under path node `parent`; the new path node's id.
+    pub fn add_path(&mut self, parent: u32, object: u32) -> u32 {
+        self.paths.push(PathNode { parent, object });
+        (self.paths.len() - 1) as u32
+    }
+
+    fn object_name(&self, id: u32) -> &str {
+        let i = id as usize;
+        let Some(o) = self.objects.get(i) else {
+            return "";
+        };
+        let start = if i == 0 {
+            0
+        } else {
+            self.objects[i - 1].end as usize
+        };
+        self.text.get(start..o.end as usize).unwrap_or("")
+    }
 }
 
 /// A point light, already in world space. Intensity is brightness · colour.
@@ -99,10 +190,66 @@ impl Camera {
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Scene {
     pub materials: Vec<Material>,
-    pub instances: Vec<Instance>,
+    /// Shared by the jobs of a file: they differ only in their transforms.
+    pub instances: Arc<Vec<Instance>>,
+    /// World transforms of the instances, by `Instance::transform`; an empty table holds the
+    /// identity in slot 0.
+    pub transforms: Vec<Transform>,
+    pub names: Arc<Names>,
     pub lights: Vec<Light>,
     pub ambient: Vec3,
     pub background: Vec3,
+}
+
+impl Scene {
+    /// The world transform of `instance`.
+    pub fn transform_of(&self, instance: &Instance) -> &Transform {
+        self.transforms
+            .get(instance.transform as usize)
+            .unwrap_or(&Transform::IDENTITY)
+    }
+
+    /// Moves every instance by `t` (applied after its own transform), without copying them.
+    pub fn transform_all(&mut self, t: &Transform) {
+        if self.transforms.is_empty() {
+            self.transforms.push(Transform::IDENTITY);
+        }
+        for m in &mut self.transforms {
+            *m = t.then_after(m);
+        }
+    }
+
+    /// Adds an instance.
+    pub fn push_instance(&mut self, instance: Instance) {
+        Arc::make_mut(&mut self.instances).push(instance);
+    }
+
+    /// The path of `instance` through the composite tree, e.g. `root/table/leg1`.
+    pub fn instance_name(&self, instance: &Instance) -> String {
+        let names = &self.names;
+        let mut parts = vec![names.object_name(instance.object)];
+        let mut node = instance.parent;
+        // A path is at most as long as composites nest; the bound guards a malformed table.
+        while let Some(p) = names.paths.get(node as usize) {
+            if parts.len() > crate::limits::MAX_NESTING + 1 {
+                break;
+            }
+            parts.push(names.object_name(p.object));
+            node = p.parent;
+        }
+        parts.reverse();
+        parts.join("/")
+    }
+
+    /// Where the object `instance` is drawn from is defined.
+    pub fn instance_loc(&self, instance: &Instance) -> Option<Loc> {
+        let o = self.names.objects.get(instance.object as usize)?;
+        Some(Loc {
+            file: self.names.files.get(o.file as usize)?.clone(),
+            line: o.line,
+            col: o.col,
+        })
+    }
 }
 
 /// One image to make: the scene as it stands at a `render` statement.

@@ -10,7 +10,7 @@
 
 use super::{load_file, Camera, Instance, Material, RenderJob, Scene};
 use crate::diag::{Diagnostic, Loc, Severity};
-use crate::math::{reflect, spawn_ray, Ray};
+use crate::math::{reflect, spawn_ray, Ray, Transform};
 use crate::sdf::LoadOptions;
 use crate::shape::{AaBox, Cone, Cylinder, Geometry, Plane, Shape, Sphere, Triangle};
 use glam::{DVec3, Vec3, Vec3A};
@@ -52,6 +52,7 @@ pub struct Blank {
 /// A shape placed in the world, ready to intersect.
 struct Placed<'s> {
     instance: &'s Instance,
+    transform: &'s Transform,
     shape: Shape,
     material: &'s Material,
     /// Closed shapes have an inside a camera can be in.
@@ -121,6 +122,7 @@ impl<'s> Probe<'s> {
                 );
                 Some(Placed {
                     instance,
+                    transform: scene.transform_of(instance),
                     shape,
                     material,
                     closed,
@@ -137,7 +139,7 @@ impl<'s> Probe<'s> {
             if invisible(p.material) {
                 continue;
             }
-            let xf = &p.instance.transform;
+            let xf = p.transform;
             let origin = xf.object_from_world.transform_point3(ray.origin.as_dvec3());
             let dir = xf.object_from_world.transform_vector3(ray.dir.as_dvec3());
             let local = Ray::new(v(origin), v(dir));
@@ -266,12 +268,18 @@ pub fn blank_image(job: &RenderJob) -> Option<Blank> {
         return blank("the scene has no shapes at all: the image is only the background".into());
     }
     let rays = primary_rays(&job.camera, job.width, job.height)?;
-    let probe = Probe::new(scene);
-    if probe.placed.len().saturating_mul(rays.len()) > PROBE_BUDGET {
+    // Counted before the shapes are placed, so that a huge scene costs no memory here.
+    let placeable = scene
+        .instances
+        .iter()
+        .filter(|i| scene.materials.get(i.material).is_some() && shape_of(&i.geometry).is_some())
+        .count();
+    if placeable.saturating_mul(rays.len()) > PROBE_BUDGET {
         // Scenes this big are generated, and their images are rarely empty: the probe
         // stays cheap rather than exhaustive (the reasons above still apply).
         return None;
     }
+    let probe = Probe::new(scene);
     let mut seen = Vec::with_capacity(rays.len());
     for ray in &rays {
         seen.push(probe.trace(ray, 0));
@@ -287,7 +295,7 @@ pub fn blank_image(job: &RenderJob) -> Option<Blank> {
         .collect();
     let hits_any_geometry = rays.iter().any(|ray| {
         probe.placed.iter().any(|p| {
-            let xf = &p.instance.transform;
+            let xf = p.transform;
             let o = xf.object_from_world.transform_point3(ray.origin.as_dvec3());
             let d = xf.object_from_world.transform_vector3(ray.dir.as_dvec3());
             p.shape
@@ -309,10 +317,7 @@ pub fn blank_image(job: &RenderJob) -> Option<Blank> {
             if !b.min.is_finite() || !b.max.is_finite() {
                 return false;
             }
-            let center = p
-                .instance
-                .transform
-                .point(((b.min + b.max) * 0.5).as_dvec3());
+            let center = p.transform.point(((b.min + b.max) * 0.5).as_dvec3());
             (center - eye).dot(dir) < 0.0
         });
         return blank(if behind {
@@ -330,7 +335,9 @@ pub fn blank_image(job: &RenderJob) -> Option<Blank> {
     if seen.iter().all(|(_, back)| *back == Some(true)) {
         let name = probe
             .nearest(&rays[rays.len() / 2], f32::INFINITY)
-            .map_or(String::new(), |h| format!(" `{}`", h.placed.instance.name));
+            .map_or(String::new(), |h| {
+                format!(" `{}`", scene.instance_name(h.placed.instance))
+            });
         return blank(format!(
             "the camera is inside an object{name}: every ray meets its inside, which no light reaches"
         ));

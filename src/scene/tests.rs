@@ -33,6 +33,14 @@ fn errors(text: &str) -> Vec<Diagnostic> {
     }
 }
 
+fn instance_names(scene: &crate::scene::Scene) -> Vec<String> {
+    scene
+        .instances
+        .iter()
+        .map(|i| scene.instance_name(i))
+        .collect()
+}
+
 fn close(a: DVec3, b: DVec3) -> bool {
     a.abs_diff_eq(b, 1e-9)
 }
@@ -47,7 +55,8 @@ fn world_of(ops: &str, order: TransformOrder) -> crate::math::Transform {
         ..LoadOptions::default()
     };
     let loaded = load_with(&text, &opts);
-    loaded.jobs[0].scene.instances[0].transform
+    let scene = &loaded.jobs[0].scene;
+    *scene.transform_of(&scene.instances[0])
 }
 
 #[test]
@@ -120,24 +129,20 @@ fn a_composite_transform_moves_every_child_alike() {
         .then_after(&crate::math::Transform::rotate(90.0, DVec3::Z).unwrap());
     let a = &scene.instances[0];
     let b = &scene.instances[1];
-    assert_eq!(a.name, "root/a");
+    assert_eq!(scene.instance_name(a), "root/a");
+    let (a, b) = (scene.transform_of(a), scene.transform_of(b));
     // a: parent · own, where own moves it up by 5 first.
     let expected_a = root.then_after(&crate::math::Transform::translate(DVec3::new(
         0.0, 5.0, 0.0,
     )));
     assert!(a
-        .transform
         .world_from_object
         .abs_diff_eq(expected_a.world_from_object, 1e-12));
     assert!(b
-        .transform
         .world_from_object
         .abs_diff_eq(root.world_from_object, 1e-12));
     // (1, 0, 0) of b: rotated to (0, 1, 0), then moved to (10, 1, 0).
-    assert!(close(
-        b.transform.point(DVec3::X),
-        DVec3::new(10.0, 1.0, 0.0)
-    ));
+    assert!(close(b.point(DVec3::X), DVec3::new(10.0, 1.0, 0.0)));
 }
 
 #[test]
@@ -150,14 +155,18 @@ fn a_shape_in_two_composites_is_drawn_twice() {
          define camera c 60\nrender c out.png 10 10\n"
     );
     let scene = &load(&text).jobs[0].scene;
-    let names: Vec<&str> = scene.instances.iter().map(|i| i.name.as_str()).collect();
+    let names: Vec<String> = scene
+        .instances
+        .iter()
+        .map(|i| scene.instance_name(i))
+        .collect();
     assert_eq!(names, ["both/left/ball", "both/right/ball"]);
     assert!(close(
-        scene.instances[0].transform.point(DVec3::ZERO),
+        scene.transform_of(&scene.instances[0]).point(DVec3::ZERO),
         DVec3::new(-5.0, 0.0, 0.0)
     ));
     assert!(close(
-        scene.instances[1].transform.point(DVec3::ZERO),
+        scene.transform_of(&scene.instances[1]).point(DVec3::ZERO),
         DVec3::new(5.0, 0.0, 0.0)
     ));
 }
@@ -169,12 +178,7 @@ fn root_rule() {
         "{MATERIAL}define shape sphere a 0 0 0 1 m\ndefine shape sphere b 0 0 0 1 m\n\
          define shape composite root a\ndefine camera c 60\nrender c o.png 1 1\n"
     );
-    let names: Vec<String> = load(&with_root).jobs[0]
-        .scene
-        .instances
-        .iter()
-        .map(|i| i.name.clone())
-        .collect();
+    let names = instance_names(&load(&with_root).jobs[0].scene);
     assert_eq!(names, ["root/a"]);
     // Without it: every shape no composite contains, and uncontained composites.
     let without = format!(
@@ -182,12 +186,7 @@ fn root_rule() {
          define shape sphere c 0 0 0 1 m\ndefine shape composite g a\n\
          define camera cam 60\nrender cam o.png 1 1\n"
     );
-    let names: Vec<String> = load(&without).jobs[0]
-        .scene
-        .instances
-        .iter()
-        .map(|i| i.name.clone())
-        .collect();
+    let names = instance_names(&load(&without).jobs[0].scene);
     assert_eq!(names, ["b", "c", "g/a"]);
 }
 
@@ -199,7 +198,8 @@ fn one_render_line_sees_every_transform_wherever_it_stands() {
     );
     let loaded = load(&text);
     assert!(loaded.diagnostics.is_empty(), "{:?}", loaded.diagnostics);
-    let t = loaded.jobs[0].scene.instances[0].transform;
+    let scene = &loaded.jobs[0].scene;
+    let t = *scene.transform_of(&scene.instances[0]);
     assert!(close(t.point(DVec3::ZERO), DVec3::X));
 }
 
@@ -214,7 +214,12 @@ fn several_render_lines_see_the_transforms_before_them() {
     let xs: Vec<f64> = loaded
         .jobs
         .iter()
-        .map(|j| j.scene.instances[0].transform.point(DVec3::ZERO).x)
+        .map(|j| {
+            j.scene
+                .transform_of(&j.scene.instances[0])
+                .point(DVec3::ZERO)
+                .x
+        })
         .collect();
     // Every job sees the sphere (definitions are global), moved as far as its line allows.
     assert_eq!(xs, [0.0, 1.0, 2.0]);
@@ -226,6 +231,52 @@ fn several_render_lines_see_the_transforms_before_them() {
     assert!(close(loaded.jobs[2].camera.eye, DVec3::new(0.0, 0.0, 5.0)));
     assert!(close(loaded.jobs[1].camera.eye, DVec3::ZERO));
     assert_eq!(loaded.jobs[2].samples, Some(4));
+}
+
+#[test]
+fn the_jobs_of_a_file_share_their_instances_and_unmoved_ones_share_one_transform() {
+    let text = format!(
+        "{MATERIAL}define shape sphere a 0 0 0 1 m
+define shape sphere b 0 0 0 1 m
+         define shape sphere s 0 0 0 1 m
+define shape composite g s b
+         define camera c 60
+render c f0.png 1 1
+transform s translate 1 0 0
+         render c f1.png 1 1
+transform g translate 0 2 0
+render c f2.png 1 1
+"
+    );
+    let loaded = load(&text);
+    let [j0, j1, j2] = &loaded.jobs[..] else {
+        panic!("{:?}", loaded.jobs.len())
+    };
+    assert!(std::sync::Arc::ptr_eq(
+        &j0.scene.instances,
+        &j1.scene.instances
+    ));
+    assert!(std::sync::Arc::ptr_eq(
+        &j0.scene.instances,
+        &j2.scene.instances
+    ));
+    // a: slot 0; g: its own slot; s in g: another; b in g: g's.
+    assert_eq!(j0.scene.transforms.len(), 3);
+    let slot = |name: &str| {
+        let i = j2
+            .scene
+            .instances
+            .iter()
+            .find(|i| j2.scene.instance_name(i) == name)
+            .unwrap_or_else(|| panic!("{name}"));
+        (i.transform, j2.scene.transform_of(i).point(DVec3::ZERO))
+    };
+    assert_eq!(slot("a"), (0, DVec3::ZERO));
+    assert_eq!(slot("g/b").1, DVec3::new(0.0, 2.0, 0.0));
+    assert_eq!(slot("g/s").1, DVec3::new(1.0, 2.0, 0.0));
+    assert_ne!(slot("g/b").0, slot("g/s").0);
+    let loc = j2.scene.instance_loc(&j2.scene.instances[0]).unwrap();
+    assert_eq!((loc.line, loc.col), (2, 1));
 }
 
 #[test]
@@ -412,12 +463,7 @@ fn degenerate_shapes_are_dropped_and_their_transforms_ignored() {
          define camera c 60\nrender c o.png 1 1\n"
     );
     let loaded = load(&text);
-    let names: Vec<&str> = loaded.jobs[0]
-        .scene
-        .instances
-        .iter()
-        .map(|i| i.name.as_str())
-        .collect();
+    let names = instance_names(&loaded.jobs[0].scene);
     assert_eq!(names, ["g/ok"]);
     assert_eq!(
         loaded
@@ -496,12 +542,45 @@ fn composite_cycles_and_explosions_are_errors_not_hangs() {
         ));
     }
     text.push_str("define camera c 60\nrender c o.png 1 1\n");
-    let ds = errors(&text);
-    assert!(
-        ds.iter()
-            .any(|d| d.message.contains("expands to more than")),
-        "{ds:?}"
+    // 2^25 shapes: refused from its counts under a budget of 1 GiB, on any machine.
+    let opts = LoadOptions {
+        max_memory: 1 << 30,
+        ..LoadOptions::default()
+    };
+    let ds = load_str(&text, Path::new("scene.sdf"), &opts).unwrap_err();
+    let want = format!(
+        "the composite tree expands to 33554432 shapes, which need about {} of memory, more than the 1.0 GiB allowed (`s25` is the largest part)",
+        crate::util::human_bytes(crate::limits::scene_memory(1 << 25))
     );
+    assert!(ds.iter().any(|d| d.message == want), "{ds:?}");
+}
+
+#[test]
+fn a_flat_scene_is_refused_only_beyond_the_memory_budget() {
+    let mut text = format!("{MATERIAL}define camera c 60\nrender c o.png 1 1\n");
+    for i in 0..1000 {
+        text.push_str(&format!("define shape sphere s{i} {i} 0 -5 0.5 m\n"));
+    }
+    let fits = LoadOptions {
+        max_memory: crate::limits::scene_memory(1000),
+        ..LoadOptions::default()
+    };
+    let loaded = load_str(&text, Path::new("scene.sdf"), &fits).unwrap();
+    assert_eq!(loaded.jobs[0].scene.instances.len(), 1000);
+    let tight = LoadOptions {
+        max_memory: crate::limits::scene_memory(999),
+        ..LoadOptions::default()
+    };
+    let ds = load_str(&text, Path::new("scene.sdf"), &tight).unwrap_err();
+    let want = format!(
+        "the scene's 1000 shapes need about {} of memory, more than the {} allowed",
+        crate::util::human_bytes(crate::limits::scene_memory(1000)),
+        crate::util::human_bytes(crate::limits::scene_memory(999))
+    );
+    assert_eq!(ds.len(), 1, "{ds:?}");
+    assert_eq!(ds[0].message, want);
+    // Located at the first shape, the largest part of a flat scene.
+    assert_eq!(ds[0].loc.as_ref().map(|l| l.line), Some(4));
 }
 
 #[test]
@@ -539,7 +618,14 @@ fn canonical_text_reads_back_to_the_same_jobs() {
             j.scene
                 .instances
                 .iter()
-                .map(|i| (i.name.clone(), i.geometry.clone(), i.material, i.transform))
+                .map(|i| {
+                    (
+                        j.scene.instance_name(i),
+                        i.geometry.clone(),
+                        i.material,
+                        *j.scene.transform_of(i),
+                    )
+                })
                 .collect()
         };
         assert_eq!(strip(a), strip(b));
@@ -639,9 +725,10 @@ mod fuzz {
                 if let Ok(loaded) = result {
                     for job in &loaded.jobs {
                         prop_assert!(job.camera.eye.is_finite() && job.camera.dir.is_finite());
-                        for i in &job.scene.instances {
-                            prop_assert!(i.transform.world_from_object.is_finite());
-                            prop_assert!(i.transform.object_from_world.is_finite());
+                        for i in job.scene.instances.iter() {
+                            let t = job.scene.transform_of(i);
+                            prop_assert!(t.world_from_object.is_finite());
+                            prop_assert!(t.object_from_world.is_finite());
                         }
                     }
                 }
@@ -777,7 +864,8 @@ fn a_name_after_the_material_is_the_shapes_name() {
     let l = load(&format!(
         "{MATERIAL}define shape sphere 0 0 -5 1 m ball\ndefine camera eye 60\nrender eye out.png 8 8\n"
     ));
-    assert_eq!(l.jobs[0].scene.instances[0].name, "ball");
+    let scene = &l.jobs[0].scene;
+    assert_eq!(scene.instance_name(&scene.instances[0]), "ball");
 }
 
 #[test]

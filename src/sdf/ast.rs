@@ -37,10 +37,11 @@ impl Statement {
     }
 }
 
-/// A token as written: where it starts and how many characters it covers.
-#[derive(Clone, Debug, PartialEq)]
+/// A token of a statement's line as written: the column (in characters, from 1) where it
+/// starts and how many characters it covers. Its file and line are the statement's.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Span {
-    pub loc: Loc,
+    pub col: u32,
     pub width: u32,
 }
 

@@ -40,7 +40,9 @@ impl Line<'_> {
 
 /// Splits a whole file into lines and tokenizes each. LF, CRLF and a lone CR (old Mac files)
 /// all end a line; the final line ending is optional. A byte-order mark at the start of the
-/// file is ignored.
+/// file is ignored. The reader goes through a file with [`each_line`] instead, which keeps no
+/// more than one line's tokens.
+#[cfg(test)]
 pub fn lines(text: &str) -> Vec<Line<'_>> {
     raw_lines(text)
         .enumerate()
@@ -50,6 +52,29 @@ pub fn lines(text: &str) -> Vec<Line<'_>> {
             tokens: tokenize(raw),
         })
         .collect()
+}
+
+/// Calls `f` with every line of `text` (as [`lines`] splits them), tokenized into one buffer
+/// that is reused from line to line: reading a file of a million lines allocates no token
+/// list per line, and never holds more than one.
+pub fn each_line<'t>(text: &'t str, mut f: impl FnMut(&Line<'t>)) {
+    let mut tokens = Vec::new();
+    for (i, raw) in raw_lines(text).enumerate() {
+        tokenize_into(raw, &mut tokens);
+        let line = Line {
+            number: line_number(i),
+            text: raw,
+            tokens,
+        };
+        f(&line);
+        tokens = line.tokens;
+    }
+}
+
+/// The text of line `number` (from 1), without its line ending.
+pub fn line_text(text: &str, number: u32) -> Option<&str> {
+    let index = usize::try_from(number).ok()?.checked_sub(1)?;
+    raw_lines(text).nth(index)
 }
 
 /// The lines of a file without their line endings, without tokenizing them.
@@ -106,6 +131,56 @@ pub fn overlong_lines(text: &str) -> Vec<(u32, usize)> {
 /// The tokens of one line, comments removed.
 pub fn tokenize(line: &str) -> Vec<Token<'_>> {
     let mut tokens = Vec::new();
+    tokenize_into(line, &mut tokens);
+    tokens
+}
+
+/// The tokens of one line, comments removed, into `tokens` (cleared first).
+pub fn tokenize_into<'t>(line: &'t str, tokens: &mut Vec<Token<'t>>) {
+    tokens.clear();
+    if line.is_ascii() {
+        tokenize_ascii(line, tokens);
+    } else {
+        tokenize_chars(line, tokens);
+    }
+    // A line starting with `//` is a comment as a whole (`//define shape ...` included).
+    if tokens.first().is_some_and(|t| t.text.starts_with("//")) {
+        tokens.clear();
+    }
+}
+
+/// [`tokenize_into`] for a line of ASCII, where a character is a byte: the common case, read
+/// without decoding characters.
+fn tokenize_ascii<'t>(line: &'t str, tokens: &mut Vec<Token<'t>>) {
+    let bytes = line.as_bytes();
+    let code = bytes.iter().position(|&b| b == b'#').unwrap_or(bytes.len());
+    let mut i = 0;
+    while i < code {
+        // The whitespace of ASCII as `char::is_whitespace` knows it.
+        while i < code && matches!(bytes[i], b' ' | b'\t' | b'\n' | 0x0b | 0x0c | b'\r') {
+            i += 1;
+        }
+        if i == code {
+            break;
+        }
+        let start = i;
+        while i < code && !matches!(bytes[i], b' ' | b'\t' | b'\n' | 0x0b | 0x0c | b'\r') {
+            i += 1;
+        }
+        if tokens.len() >= crate::limits::MAX_TOKENS_PER_LINE {
+            // The rest is not kept (see `overlong_lines`, which reports the line).
+            return;
+        }
+        tokens.push(Token {
+            text: &line[start..i],
+            col: u32::try_from(start + 1).unwrap_or(u32::MAX),
+            width: u32::try_from(i - start).unwrap_or(u32::MAX),
+        });
+    }
+}
+
+/// [`tokenize_into`] for any line: columns and widths count characters.
+fn tokenize_chars<'t>(line: &'t str, tokens: &mut Vec<Token<'t>>) {
     let mut start: Option<(usize, u32)> = None;
     let mut col: u32 = 0;
     let mut end_byte = line.len();
@@ -120,7 +195,7 @@ pub fn tokenize(line: &str) -> Vec<Token<'_>> {
                 tokens.push(make_token(line, s, i, c));
                 if tokens.len() >= crate::limits::MAX_TOKENS_PER_LINE {
                     // The rest is not kept (see `overlong_lines`, which reports the line).
-                    return tokens;
+                    return;
                 }
             }
         } else if start.is_none() {
@@ -130,11 +205,6 @@ pub fn tokenize(line: &str) -> Vec<Token<'_>> {
     if let Some((s, c)) = start {
         tokens.push(make_token(line, s, end_byte, c));
     }
-    // A line starting with `//` is a comment as a whole (`//define shape ...` included).
-    if tokens.first().is_some_and(|t| t.text.starts_with("//")) {
-        tokens.clear();
-    }
-    tokens
 }
 
 fn make_token(line: &str, start: usize, end: usize, col: u32) -> Token<'_> {
@@ -319,6 +389,41 @@ mod tests {
         assert!(tokenize("// define shape").is_empty());
         assert!(tokenize("   //define shape").is_empty());
         assert_eq!(tokenize("a#b").len(), 1);
+    }
+
+    #[test]
+    fn ascii_and_character_tokenizers_agree() {
+        for line in [
+            "define shape sphere s 0 0 -5 1 red",
+            "  a\tb\x0bc\x0cd  # e f",
+            "x#y",
+            "",
+            "   ",
+            "// comment",
+            "#",
+            "a  b ",
+        ] {
+            let mut ascii = Vec::new();
+            tokenize_ascii(line, &mut ascii);
+            let mut chars = Vec::new();
+            tokenize_chars(line, &mut chars);
+            assert_eq!(ascii, chars, "{line:?}");
+        }
+    }
+
+    #[test]
+    fn each_line_sees_what_lines_splits() {
+        let text = "\u{feff}a b\r\nc\r\n\r\nd # x\rjklö 1";
+        let mut seen = Vec::new();
+        each_line(text, |l| seen.push((l.number, l.text, l.tokens.clone())));
+        let expected: Vec<_> = lines(text)
+            .into_iter()
+            .map(|l| (l.number, l.text, l.tokens))
+            .collect();
+        assert_eq!(seen, expected);
+        assert_eq!(line_text(text, 4), Some("d # x"));
+        assert_eq!(line_text(text, 9), None);
+        assert_eq!(line_text(text, 0), None);
     }
 
     #[test]

@@ -10,6 +10,7 @@ mod lexer;
 mod parse;
 pub mod repair;
 
+pub use lexer::raw_lines;
 pub use parse::{default_output, Omissions, Parsed};
 
 use crate::diag::{Diagnostic, Loc, Severity};
@@ -75,6 +76,9 @@ pub struct LoadOptions {
     pub transform_order: TransformOrder,
     /// Largest input file read, in bytes (`--max-input`); larger files are refused unread.
     pub max_input: u64,
+    /// Memory the scene may take, in bytes (`--max-memory`): a scene whose shapes would need
+    /// more (`limits::scene_memory`) is refused before it is built.
+    pub max_memory: u64,
 }
 
 impl Default for LoadOptions {
@@ -86,6 +90,7 @@ impl Default for LoadOptions {
             material_fields: MaterialLayout::standard(),
             transform_order: TransformOrder::World,
             max_input: crate::limits::DEFAULT_MAX_INPUT,
+            max_memory: crate::limits::default_memory_budget(),
         }
     }
 }

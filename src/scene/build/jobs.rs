@@ -1,19 +1,21 @@
 //! One render job per render statement: the camera it names and the scene as it stands
 //! there, with the composite tree flattened into instances.
 
-use super::definitions::{Definitions, ObjectKind};
+use super::definitions::{Definitions, Object, ObjectKind};
 use super::transforms::{finite_transform, Snapshot, Space};
 use super::{At, Builder};
 use crate::diag::Diagnostic;
 use crate::diag::Severity;
+use crate::limits::MAX_WALK;
 use crate::limits::{self, DEFAULT_IMAGE_SIZE, MAX_NESTING};
-use crate::limits::{MAX_INSTANCES, MAX_TOTAL_INSTANCES, MAX_WALK};
 use crate::math::Transform;
-use crate::scene::{Camera, Geometry, Instance, Light, RenderJob, Scene};
+use crate::scene::{Camera, Geometry, Instance, Light, Names, RenderJob, Scene, NO_NAME};
 use crate::sdf::ast::{CameraDef, NameRef, Statement, StatementKind};
 use crate::sdf::default_output;
+use crate::util::human_bytes;
 use std::collections::HashSet;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 impl Builder<'_> {
     // ----- jobs --------------------------------------------------------------------------
@@ -24,13 +26,29 @@ impl Builder<'_> {
         d: &Definitions<'s>,
     ) -> Vec<RenderJob> {
         let snapshots = self.snapshots(statements, d);
-        // The composite tree is the same for every job; only the transforms differ.
+        // The composite tree is the same for every job; only the transforms differ. It is
+        // flattened once, into instances every job shares: each place where an object that
+        // some transform statement moves is listed gets its own transform slot, the rest share
+        // their parent's, and each job fills the slots from its own transforms.
+        let mut moved = vec![false; d.objects.len()];
+        for (_, snapshot) in &snapshots {
+            for (space, name) in snapshot.keys() {
+                if let (Space::Object, Some(&i)) = (space, d.object_index.get(name)) {
+                    moved[i] = true;
+                }
+            }
+        }
         let roots = roots(d);
-        let expansion = expansion(d, &roots);
-        let tree = Tree {
-            roots: &roots,
-            expansion: &expansion,
+        let shapes = {
+            let expansion = expansion(d, &roots, &moved);
+            let tree = Tree {
+                roots: &roots,
+                expansion: &expansion,
+            };
+            self.expansion_fits(d, &tree, snapshots.len() as u64)
         };
+        // The counts are freed before the instances are made.
+        let flat = self.flatten_tree(d, &roots, shapes, &moved);
         let mut jobs = Vec::new();
         for (render, snapshot) in &snapshots {
             let job = match render {
@@ -42,7 +60,7 @@ impl Builder<'_> {
                         continue;
                     };
                     RenderJob {
-                        scene: self.scene(d, &tree, snapshot),
+                        scene: self.scene(d, &flat, snapshot),
                         camera,
                         output: PathBuf::from(&r.output),
                         width: r.width,
@@ -74,7 +92,7 @@ impl Builder<'_> {
                     w.severity = Severity::Warning;
                     self.diagnostics.push(w);
                     RenderJob {
-                        scene: self.scene(d, &tree, snapshot),
+                        scene: self.scene(d, &flat, snapshot),
                         camera,
                         output: PathBuf::from(output),
                         width: DEFAULT_IMAGE_SIZE.0,
@@ -118,22 +136,33 @@ impl Builder<'_> {
         }
     }
 
-    pub(super) fn scene(&mut self, d: &Definitions, tree: &Tree, snapshot: &Snapshot) -> Scene {
-        let mut instances = Vec::new();
-        if self.expansion_fits(d, tree) {
-            let mut stack = Vec::new();
-            for &root in tree.roots {
-                let name = d.objects[root].name;
-                self.flatten(
-                    d,
-                    snapshot,
-                    name,
-                    &Transform::IDENTITY,
-                    "",
-                    &mut stack,
-                    &mut instances,
+    /// The scene of one job: the shared instances, placed by this job's transforms.
+    fn scene(&mut self, d: &Definitions, flat: &Flat, snapshot: &Snapshot) -> Scene {
+        let mut transforms = Vec::with_capacity(flat.slots.len() + 1);
+        transforms.push(Transform::IDENTITY);
+        for &(parent, i) in &flat.slots {
+            let object = &d.objects[i];
+            let own = snapshot
+                .get(&(Space::Object, object.name))
+                .copied()
+                .unwrap_or_default();
+            let world = transforms[parent as usize].then_after(&own);
+            if finite_transform(&world) {
+                transforms.push(world);
+                continue;
+            }
+            if self.reported_composites.insert(object.name.to_string()) {
+                self.error(
+                    At::Name(object.statement),
+                    format!(
+                        "the transforms above `{}` multiply out beyond floating-point range",
+                        object.name
+                    ),
+                    Some("use scale factors nearer to 1".to_string()),
                 );
             }
+            // The file is refused; the slot keeps a usable value meanwhile.
+            transforms.push(Transform::IDENTITY);
         }
         let lights = d
             .lights
@@ -152,79 +181,89 @@ impl Builder<'_> {
             .collect();
         Scene {
             materials: d.materials.clone(),
-            instances,
+            instances: flat.instances.clone(),
+            transforms,
+            names: flat.names.clone(),
             lights,
             ambient: d.ambient,
             background: d.background,
         }
     }
 
-    /// Appends the instances below object `name`, placed by `parent` (its parent's world
-    /// transform). `stack` holds the composites being expanded, to stop at cycles.
+    /// The composite tree below `roots` flattened into instances: `shapes` of them, or none
+    /// when the tree does not fit the memory budget (reported).
+    fn flatten_tree(
+        &mut self,
+        d: &Definitions,
+        roots: &[usize],
+        shapes: Option<u64>,
+        moved: &[bool],
+    ) -> Flat {
+        let mut flat = Flatten {
+            instances: Vec::new(),
+            slots: Vec::new(),
+            names: Names::default(),
+            name_ids: vec![NO_NAME; d.objects.len()],
+        };
+        if let Some(shapes) = shapes {
+            flat.instances
+                .reserve_exact(usize::try_from(shapes).unwrap_or(0));
+            let mut stack = Vec::new();
+            for &root in roots {
+                self.flatten(d, moved, root, 0, NO_NAME, &mut stack, &mut flat);
+            }
+        }
+        flat.instances.shrink_to_fit();
+        Flat {
+            instances: Arc::new(flat.instances),
+            slots: flat.slots,
+            names: Arc::new(flat.names),
+        }
+    }
+
+    /// Appends the instances below object `i`, listed in transform slot `slot` under path
+    /// node `path`. `stack` holds the composites being expanded, to stop at cycles.
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn flatten<'s>(
+    fn flatten<'s>(
         &mut self,
         d: &Definitions<'s>,
-        snapshot: &Snapshot,
-        name: &'s str,
-        parent: &Transform,
-        prefix: &str,
+        moved: &[bool],
+        i: usize,
+        slot: u32,
+        path: u32,
         stack: &mut Vec<&'s str>,
-        out: &mut Vec<Instance>,
+        out: &mut Flatten,
     ) {
-        let Some(&i) = d.object_index.get(name) else {
-            return;
-        };
         if self.too_many_reported {
             return; // the scene is refused anyway; do not walk the rest of a huge tree
         }
         let object = &d.objects[i];
-        let own = snapshot
-            .get(&(Space::Object, name))
-            .copied()
-            .unwrap_or_default();
-        let world = parent.then_after(&own);
-        if !finite_transform(&world) {
-            if self.reported_composites.insert(name.to_string()) {
-                self.error(
-                    At::Name(object.statement),
-                    format!(
-                        "the transforms above `{name}` multiply out beyond floating-point range"
-                    ),
-                    Some("use scale factors nearer to 1".to_string()),
-                );
-            }
-            return;
-        }
-        let path = if prefix.is_empty() {
-            name.to_string()
+        let name = object.name;
+        let slot = if moved[i] {
+            out.slots.push((slot, i));
+            out.slots.len() as u32
         } else {
-            format!("{prefix}/{name}")
+            slot
         };
         match &object.kind {
             ObjectKind::Shape { geometry, material } => {
                 let Some(material) = *material else {
                     return;
                 };
-                if out.len() >= MAX_INSTANCES || self.total_instances >= MAX_TOTAL_INSTANCES {
-                    if !self.too_many_reported {
-                        self.too_many_reported = true;
-                        let (message, help) = if out.len() >= MAX_INSTANCES {
-                            (
-                                format!("the composite tree expands to more than {MAX_INSTANCES} shapes"),
-                                "a composite listing another twice, level after level, doubles the scene each time",
-                            )
-                        } else {
-                            (
-                                format!("the file's render statements together need more than {MAX_TOTAL_INSTANCES} shapes"),
-                                "write one file per frame (as `anim generate` does) instead of many render lines",
-                            )
-                        };
-                        self.error(At::Name(object.statement), message, Some(help.to_string()));
-                    }
+                if limits::scene_memory(out.instances.len() as u64 + 1) > self.opts.max_memory {
+                    // Counted before flattening, the tree fits; only a cycle (reported when
+                    // it is met) can make the walk go on past the count.
+                    self.too_many_reported = true;
+                    self.error(
+                        At::Name(object.statement),
+                        format!(
+                            "the composite tree expands to more shapes than the {} allowed can hold",
+                            human_bytes(self.opts.max_memory)
+                        ),
+                        Some(format!("{DOUBLING}; {RAISE}")),
+                    );
                     return;
                 }
-                self.total_instances += 1;
                 // The parser makes radii positive; statements made by a program may not.
                 let mut geometry = (*geometry).clone();
                 if let Geometry::Sphere { radius, .. }
@@ -233,12 +272,13 @@ impl Builder<'_> {
                 {
                     *radius = limits::fixed_radius(*radius);
                 }
-                out.push(Instance {
-                    name: path,
+                let object = out.name_id(i, object);
+                out.instances.push(Instance {
                     geometry,
                     material,
-                    transform: world,
-                    loc: Some(object.statement.loc.clone()),
+                    transform: slot,
+                    object,
+                    parent: path,
                 });
             }
             ObjectKind::Composite { children } => {
@@ -264,13 +304,45 @@ impl Builder<'_> {
                     }
                     return;
                 }
+                let id = out.name_id(i, object);
+                let node = out.names.add_path(path, id);
                 stack.push(name);
                 for &child in children {
-                    self.flatten(d, snapshot, child, &world, &path, stack, out);
+                    if let Some(&c) = d.object_index.get(child) {
+                        self.flatten(d, moved, c, slot, node, stack, out);
+                    }
                 }
                 stack.pop();
             }
         }
+    }
+}
+
+/// The composite tree flattened, as the jobs of a file share it.
+struct Flat {
+    instances: Arc<Vec<Instance>>,
+    /// Transform slot `k` (from 1; slot 0 is the top of the tree) is `slots[k - 1]`: the slot
+    /// it is listed in, and the object whose own transform it adds.
+    slots: Vec<(u32, usize)>,
+    names: Arc<Names>,
+}
+
+/// A [`Flat`] being made.
+struct Flatten {
+    instances: Vec<Instance>,
+    slots: Vec<(u32, usize)>,
+    names: Names,
+    /// Object index → its id in `names`, once recorded.
+    name_ids: Vec<u32>,
+}
+
+impl Flatten {
+    /// The id in `names` of object `i`, recorded the first time it is asked for.
+    fn name_id(&mut self, i: usize, object: &Object) -> u32 {
+        if self.name_ids[i] == NO_NAME {
+            self.name_ids[i] = self.names.add_object(object.name, &object.statement.loc);
+        }
+        self.name_ids[i]
     }
 }
 
@@ -288,6 +360,8 @@ pub(super) struct Expansion {
     /// Objects visited on the way, shapes and composites (composites holding nothing cost
     /// walking time too).
     nodes: u64,
+    /// Transform slots made on the way (visits of objects a transform statement moves).
+    slots: u64,
 }
 
 /// The roots of the composite tree, in definition order: the composite `root` if there is
@@ -322,7 +396,7 @@ fn roots(d: &Definitions) -> Vec<usize> {
 /// twice doubles at every level, and must be refused from its counts, not by walking it.
 /// Counts saturate; a child that closes a cycle counts nothing (`flatten` reports the cycle).
 /// The walk is iterative, as a chain of composites can be longer than the stack is deep.
-fn expansion(d: &Definitions, roots: &[usize]) -> Vec<Expansion> {
+fn expansion(d: &Definitions, roots: &[usize], moved: &[bool]) -> Vec<Expansion> {
     const NEW: u8 = 0;
     const OPEN: u8 = 1;
     const DONE: u8 = 2;
@@ -344,6 +418,7 @@ fn expansion(d: &Definitions, roots: &[usize]) -> Vec<Expansion> {
                     memo[i] = Expansion {
                         shapes: u64::from(material.is_some()),
                         nodes: 1,
+                        slots: u64::from(moved[i]),
                     };
                     state[i] = DONE;
                     stack.pop();
@@ -364,11 +439,13 @@ fn expansion(d: &Definitions, roots: &[usize]) -> Vec<Expansion> {
             let mut total = Expansion {
                 shapes: 0,
                 nodes: 1,
+                slots: u64::from(moved[i]),
             };
             for c in children.iter().filter_map(|c| child_index(c)) {
                 if state[c] == DONE {
                     total.shapes = total.shapes.saturating_add(memo[c].shapes);
                     total.nodes = total.nodes.saturating_add(memo[c].nodes);
+                    total.slots = total.slots.saturating_add(memo[c].slots);
                 }
             }
             memo[i] = total;
@@ -380,28 +457,32 @@ fn expansion(d: &Definitions, roots: &[usize]) -> Vec<Expansion> {
 }
 
 impl Builder<'_> {
-    /// Whether the scene of one job can be flattened: its tree expands to at most
-    /// [`MAX_INSTANCES`] shapes (and [`MAX_WALK`] objects), and the file's jobs together to at
-    /// most [`MAX_TOTAL_INSTANCES`]. Otherwise reports why, once per file.
-    fn expansion_fits(&mut self, d: &Definitions, tree: &Tree) -> bool {
+    /// The shapes the tree expands to, when they fit in the memory budget (`--max-memory`)
+    /// together with the transforms of the file's `jobs` jobs, and the tree has at most
+    /// [`MAX_WALK`] objects that make no shape. Otherwise reports why, once per file, with
+    /// the memory the scene would need.
+    fn expansion_fits(&mut self, d: &Definitions, tree: &Tree, jobs: u64) -> Option<u64> {
         if self.too_many_reported {
-            return false; // the scene is refused anyway
+            return None; // the scene is refused anyway
         }
         let mut shapes: u64 = 0;
         let mut nodes: u64 = 0;
+        let mut slots: u64 = 0;
         let mut largest: Option<(u64, usize)> = None;
         for &root in tree.roots {
             let e = tree.expansion[root];
             shapes = shapes.saturating_add(e.shapes);
             nodes = nodes.saturating_add(e.nodes);
+            slots = slots.saturating_add(e.slots);
             if largest.is_none_or(|(n, _)| e.nodes > n) {
                 largest = Some((e.nodes, root));
             }
         }
         let Some((_, largest)) = largest else {
-            return true;
+            return Some(0);
         };
         let object = &d.objects[largest];
+        let composite = matches!(object.kind, ObjectKind::Composite { .. });
         let count = |n: u64| {
             if n == u64::MAX {
                 "more than 10^19".to_string()
@@ -409,29 +490,52 @@ impl Builder<'_> {
                 n.to_string()
             }
         };
-        let problem = if shapes > MAX_INSTANCES as u64 {
-            Some((
-                format!(
-                    "the composite tree expands to more than {MAX_INSTANCES} shapes: it would make {} (`{}` is the largest part)",
-                    count(shapes),
-                    object.name
-                ),
-                "a composite listing another twice, level after level, doubles the scene each time",
-            ))
-        } else if nodes > MAX_WALK {
+        let budget = self.opts.max_memory;
+        let needed = limits::scene_memory(shapes);
+        // Each job holds its own transform for every slot.
+        let transform_bytes = std::mem::size_of::<Transform>() as u64;
+        let all_jobs =
+            needed.saturating_add(jobs.saturating_mul(slots).saturating_mul(transform_bytes));
+        let problem = if needed > budget {
+            Some(if composite {
+                (
+                    format!(
+                        "the composite tree expands to {} shapes, which need about {} of memory, more than the {} allowed (`{}` is the largest part)",
+                        count(shapes),
+                        human_bytes(needed),
+                        human_bytes(budget),
+                        object.name
+                    ),
+                    format!("{DOUBLING}; {RAISE}"),
+                )
+            } else {
+                (
+                    format!(
+                        "the scene's {} shapes need about {} of memory, more than the {} allowed",
+                        count(shapes),
+                        human_bytes(needed),
+                        human_bytes(budget)
+                    ),
+                    RAISE.to_string(),
+                )
+            })
+        } else if nodes.saturating_sub(shapes) > MAX_WALK {
             Some((
                 format!(
                     "the composite tree expands to {} composites and shapes, more than the {MAX_WALK} that are walked (`{}` is the largest part)",
                     count(nodes),
                     object.name
                 ),
-                "a composite listing another twice, level after level, doubles the scene each time",
+                DOUBLING.to_string(),
             ))
-        } else if (self.total_instances as u64).saturating_add(shapes) > MAX_TOTAL_INSTANCES as u64
-        {
+        } else if all_jobs > budget {
             Some((
-                format!("the file's render statements together need more than {MAX_TOTAL_INSTANCES} shapes"),
-                "write one file per frame (as `anim generate` does) instead of many render lines",
+                format!(
+                    "the file's render statements together need about {} of memory for their shapes and transforms, more than the {} allowed",
+                    human_bytes(all_jobs),
+                    human_bytes(budget)
+                ),
+                format!("write one file per frame (as `anim generate` does) instead of many render lines; {RAISE}"),
             ))
         } else {
             None
@@ -439,13 +543,20 @@ impl Builder<'_> {
         match problem {
             Some((message, help)) => {
                 self.too_many_reported = true;
-                self.error(At::Name(object.statement), message, Some(help.to_string()));
-                false
+                self.error(At::Name(object.statement), message, Some(help));
+                None
             }
-            None => true,
+            None => Some(shapes),
         }
     }
 }
+
+/// Why a small file can expand to a huge scene.
+const DOUBLING: &str =
+    "a composite listing another twice, level after level, doubles the scene each time";
+
+/// How to allow a bigger scene.
+const RAISE: &str = "--max-memory raises the limit";
 
 /// A camera definition with its transform applied: the eye as a point, dir and up as vectors.
 pub(super) fn place_camera(c: &CameraDef, snapshot: &Snapshot) -> Camera {

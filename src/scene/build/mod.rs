@@ -43,7 +43,6 @@ pub(super) fn build_jobs(
         too_many_reported: false,
 
         suggestion_budget: SUGGESTION_BUDGET,
-        total_instances: 0,
     };
     let defs = b.definitions(statements);
     b.check_cycles(&defs);
@@ -78,8 +77,6 @@ struct Builder<'a> {
 
     /// Name comparisons left for "did you mean" suggestions.
     suggestion_budget: usize,
-    /// Instances made so far, over all jobs.
-    total_instances: usize,
 }
 
 impl<'a> Builder<'a> {
@@ -90,12 +87,16 @@ impl<'a> Builder<'a> {
     fn place(&self, at: At) -> (Loc, u32) {
         match at {
             At::Ref(r) => (r.loc.clone(), r.name.chars().count() as u32),
-            At::Name(stmt) if self.from_reader => {
-                match stmt.spans.as_ref().and_then(|s| s.name.as_ref()) {
-                    Some(name) => (name.loc.clone(), name.width),
-                    None => self.place(At::Statement(stmt)),
-                }
-            }
+            At::Name(stmt) if self.from_reader => match stmt.spans.as_ref().and_then(|s| s.name) {
+                Some(name) => (
+                    Loc {
+                        col: name.col,
+                        ..stmt.loc.clone()
+                    },
+                    name.width,
+                ),
+                None => self.place(At::Statement(stmt)),
+            },
             At::Name(stmt) | At::Statement(stmt) => (
                 stmt.loc.clone(),
                 stmt.spans.as_ref().map_or(1, |s| s.first_width),

@@ -56,29 +56,11 @@ const SHAPE_KINDS: [&str; 7] = [
     "composite",
 ];
 
-/// The statements of a file, the problems met, what the reader left out, and the lines as
-/// written (for quoting them in diagnostics found later).
+/// The statements of a file, the problems met, and what the reader left out.
 pub struct Parsed {
     pub statements: Vec<Statement>,
     pub diagnostics: Vec<Diagnostic>,
     pub omissions: Omissions,
-    pub lines: Vec<String>,
-}
-
-impl Parsed {
-    /// Quotes the source line of every diagnostic located in this file that lacks it.
-    pub fn quote_source(&self, diagnostics: &mut [Diagnostic]) {
-        for d in diagnostics {
-            let Some(loc) = &d.loc else { continue };
-            let line = usize::try_from(loc.line)
-                .ok()
-                .and_then(|n| n.checked_sub(1))
-                .and_then(|i| self.lines.get(i));
-            if let (None, Some(line)) = (&d.source_line, line) {
-                d.source_line = Some(line.clone());
-            }
-        }
-    }
 }
 
 /// What the reader left out of the statements that building must still account for: its
@@ -122,7 +104,6 @@ struct Anchor {
 }
 
 pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
-    let lines = lexer::lines(text);
     let mut p = Parser {
         file: Arc::from(path),
         path,
@@ -136,26 +117,25 @@ pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
         variants_noted: HashSet::new(),
         render_lines: 0,
         cameras_rejected: false,
-        layout: material_layout(&lines, opts),
+        layout: material_layout(text, opts),
         render_errors: Vec::new(),
         camera_sizes: HashMap::new(),
     };
-    for line in &lines {
-        p.line(line);
-    }
+    // Line by line, one line's tokens at a time: the file is never held as a list of lines.
+    lexer::each_line(text, |line| p.line(line));
+    let commented = commented_definitions(text);
     p.resolve_renders();
-    p.resolve_camera_role(&lines);
+    p.resolve_camera_role(text);
     p.prune_skipped_references();
-    p.drop_transforms_of_commented_definitions(&lines);
+    p.drop_transforms_of_commented_definitions(text, &commented);
     Parsed {
         statements: p.statements,
         diagnostics: p.diagnostics,
-        lines: lines.iter().map(|l| l.text.to_string()).collect(),
         omissions: Omissions {
             skipped: p.skipped,
             render_lines: p.render_lines,
             cameras_rejected: p.cameras_rejected,
-            commented: commented_definitions(&lines)
+            commented: commented
                 .into_iter()
                 .map(|(name, line)| (name.to_string(), line))
                 .collect(),
@@ -194,27 +174,31 @@ struct Parser<'a> {
 /// The layout of the numbers after the colours of the file's materials: the one named by
 /// `--material-fields`, or with `auto` the most plausible one for every
 /// material line of the file (`docs/scene-language.md §3.1`).
-fn material_layout(lines: &[Line], opts: &LoadOptions) -> layout::Layout {
+fn material_layout(text: &str, opts: &LoadOptions) -> layout::Layout {
     if let Some(fields) = opts.material_fields.explicit() {
         return layout::Layout::explicit(fields);
     }
-    let extras: Vec<Vec<f64>> = lines
-        .iter()
-        .filter(|l| {
-            l.tokens.first().is_some_and(|t| t.text == "define")
-                && l.tokens.get(1).is_some_and(|t| t.text == "material")
-        })
-        .filter_map(|l| {
-            // Lines with a malformed number are reported when read; they do not vote.
-            let nums: Option<Vec<f64>> = l
-                .tokens
-                .iter()
-                .skip(3)
-                .map(|t| lenient_number(t.text))
-                .collect();
-            nums.filter(|n| n.len() >= 10).map(|n| n[9..].to_vec())
-        })
-        .collect();
+    let mut extras: Vec<Vec<f64>> = Vec::new();
+    let mut tokens = Vec::new();
+    for raw in lexer::raw_lines(text) {
+        // Only lines naming a material can be material lines; the rest are not tokenized.
+        if !raw.contains("material") {
+            continue;
+        }
+        lexer::tokenize_into(raw, &mut tokens);
+        let is_material = tokens.first().is_some_and(|t| t.text == "define")
+            && tokens.get(1).is_some_and(|t| t.text == "material");
+        if !is_material {
+            continue;
+        }
+        // Lines with a malformed number are reported when read; they do not vote.
+        let nums: Option<Vec<f64>> = tokens
+            .iter()
+            .skip(3)
+            .map(|t| lenient_number(t.text))
+            .collect();
+        extras.extend(nums.filter(|n| n.len() >= 10).map(|n| n[9..].to_vec()));
+    }
     layout::infer(&extras).unwrap_or_else(layout::default_layout)
 }
 
@@ -329,14 +313,7 @@ impl Parser<'_> {
     /// known (a duplicate, a cycle) point at it.
     fn emit_named(&mut self, line: &Line, name_at: usize, kind: StatementKind) {
         let (col, width) = Self::place(line, At::Tok(name_at));
-        let name = Span {
-            loc: Loc {
-                file: self.file.clone(),
-                line: line.number,
-                col,
-            },
-            width,
-        };
+        let name = Span { col, width };
         self.push(line, kind, Some(name));
     }
 

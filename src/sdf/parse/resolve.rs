@@ -6,7 +6,7 @@ use super::Parser;
 use crate::diag::{Diagnostic, Loc, Severity};
 use crate::limits;
 use crate::sdf::ast::{CameraDef, NameRef, Statement, StatementKind};
-use crate::sdf::lexer::{self, Line};
+use crate::sdf::lexer;
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
@@ -44,8 +44,11 @@ impl Parser<'_> {
     /// Drops (with one warning per name) the transforms of names that are defined only in a
     /// commented-out line: a definition disabled while its transforms were left in, which
     /// leaves them nothing to move (as for a composite's commented-out child).
-    pub(super) fn drop_transforms_of_commented_definitions(&mut self, lines: &[Line]) {
-        let commented = commented_definitions(lines);
+    pub(super) fn drop_transforms_of_commented_definitions(
+        &mut self,
+        text: &str,
+        commented: &HashMap<&str, u32>,
+    ) {
         if commented.is_empty() {
             return;
         }
@@ -71,13 +74,19 @@ impl Parser<'_> {
                 }
             }
         }
+        if dropped.is_empty() {
+            return;
+        }
+        // The lines, to quote: only when there is something to report.
+        let lines: Vec<&str> = lexer::raw_lines(text).collect();
         let mut warned = HashSet::new();
         let mut notes = Vec::new();
         for &(_, target, comment_line) in &dropped {
             if warned.insert(target.name.as_str()) {
                 let text = lines
                     .get((target.loc.line as usize).saturating_sub(1))
-                    .map_or("", |l| l.text);
+                    .copied()
+                    .unwrap_or("");
                 let d = Diagnostic::new(
                     Severity::Warning,
                     target.loc.clone(),
@@ -298,7 +307,7 @@ impl Parser<'_> {
 
     /// `transform camera ...` in a file with exactly one camera, none of whose objects is
     /// named `camera`: the word names the camera's role, and there is only one to mean.
-    pub(super) fn resolve_camera_role(&mut self, lines: &[Line]) {
+    pub(super) fn resolve_camera_role(&mut self, text: &str) {
         let [only] = self.camera_names.as_slice() else {
             return;
         };
@@ -326,9 +335,7 @@ impl Parser<'_> {
             }
         }
         if let Some(loc) = first {
-            let text = lines
-                .get((loc.line as usize).saturating_sub(1))
-                .map_or(String::new(), |l| l.text.to_string());
+            let text = lexer::line_text(text, loc.line).unwrap_or("");
             let d = Diagnostic::new(
                 Severity::Warning,
                 loc,
@@ -345,10 +352,10 @@ impl Parser<'_> {
 
 /// Names defined in commented-out lines (`# define shape box b ...`, `//define light l ...`)
 /// → the line, for explaining references to them.
-pub(crate) fn commented_definitions<'t>(lines: &[Line<'t>]) -> HashMap<&'t str, u32> {
+pub(crate) fn commented_definitions(text: &str) -> HashMap<&str, u32> {
     let mut index = HashMap::new();
-    for line in lines {
-        let body = line.text.trim_start();
+    for (i, raw) in lexer::raw_lines(text).enumerate() {
+        let body = raw.trim_start();
         let Some(body) = body.strip_prefix("//").or_else(|| body.strip_prefix('#')) else {
             continue;
         };
@@ -356,7 +363,9 @@ pub(crate) fn commented_definitions<'t>(lines: &[Line<'t>]) -> HashMap<&'t str, 
         if tokens.first().is_some_and(|t| t.text == "define") {
             // `define shape <kind> <name>` or `define <kind> <name>`.
             for t in tokens.iter().skip(2).take(2) {
-                index.entry(t.text).or_insert(line.number);
+                index
+                    .entry(t.text)
+                    .or_insert(u32::try_from(i + 1).unwrap_or(u32::MAX));
             }
         }
     }

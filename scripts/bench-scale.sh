@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# Scale: flat files of 10^3..10^6 random spheres, loaded (`anim check`) and rendered
+# (`anim render --spp 1`, 640×360), whole process. Prints CPU seconds, peak RSS, bytes of
+# peak RSS per sphere and lines read per second (by `anim check`, whose time is the reader
+# and the scene builder).
+#
+# Usage: scripts/bench-scale.sh [ANIM_BINARY] [COUNTS...]
+# Default binary: target/release/anim; default counts: 1000 10000 100000 1000000.
+set -euo pipefail
+
+bin=${1:-target/release/anim}
+shift || true
+counts=("$@")
+if [ ${#counts[@]} -eq 0 ]; then
+    counts=(1000 10000 100000 1000000)
+fi
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+
+gen() { # count file
+    python3 - "$1" "$2" <<'PY'
+import random, sys
+n, path = int(sys.argv[1]), sys.argv[2]
+rng = random.Random(8)
+# Spheres spread over a cube whose side grows with the count, so the view stays as full.
+side = max(10.0, n ** (1 / 3) * 2.0)
+with open(path, "w") as f:
+    f.write("define material red 0.2 0 0 0.8 0.1 0.1 0.5 0.5 0.5 20\n")
+    f.write("define material blue 0 0 0.2 0.1 0.1 0.8 0.5 0.5 0.5 20\n")
+    f.write("define light sun %g %g %g 1 1 1 1\n" % (side, side * 2, side * 2))
+    f.write("ambient 0.2 0.2 0.2\n")
+    f.write("define camera eye 60 0 0 %g 0 0 -1 0 1 0\n" % (side * 1.2))
+    f.write("render eye out.png 640 360\n")
+    for i in range(n):
+        x, y, z = (rng.uniform(-side / 2, side / 2) for _ in range(3))
+        f.write("define shape sphere s%d %.4f %.4f %.4f %.4f %s\n"
+                % (i, x, y, z, rng.uniform(0.2, 0.6), "red" if i % 2 else "blue"))
+PY
+}
+
+measure() { # label count command...
+    local label=$1 n=$2
+    shift 2
+    /usr/bin/time -f '%U %S %M' -o "$dir/time" "$@" >/dev/null 2>"$dir/err" || {
+        echo "$label failed:" >&2
+        tail -5 "$dir/err" >&2
+        return 1
+    }
+    read -r user sys kb <"$dir/time"
+    awk -v l="$label" -v n="$n" -v u="$user" -v s="$sys" -v kb="$kb" -v lines="$((n + 6))" \
+        'BEGIN { cpu = u + s; rate = "";
+                 if (l == "check") rate = sprintf("  %5.2f M lines/s", lines / (cpu > 0 ? cpu : 1e-9) / 1e6);
+                 printf "%-7s %9d spheres  %7.2f CPU s  %8.1f MiB peak  %6.0f B/sphere%s\n",
+                 l, n, cpu, kb / 1024, kb * 1024 / n, rate }'
+}
+
+for n in "${counts[@]}"; do
+    f="$dir/spheres-$n.sdf"
+    gen "$n" "$f"
+    measure check "$n" "$bin" check -q "$f"
+    measure render "$n" "$bin" render -q --spp 1 --out "$dir" "$f"
+done
