@@ -5,7 +5,8 @@
 //! Memory per triangle, as rendered: one index triple (12 bytes), its share of the vertex
 //! positions and normals (about half a vertex per triangle in a closed mesh, 12 bytes each)
 //! and its share of the 4-wide hierarchy (a 128-byte node per few leaves plus the leaf index
-//! lists). BENCHMARKS.md records what a million-triangle mesh costs a whole render.
+//! lists); `Mesh::bytes` adds it up. BENCHMARKS.md records what a million-triangle mesh
+//! costs a whole render.
 
 mod obj;
 
@@ -99,6 +100,13 @@ impl Mesh {
     /// Whether the mesh is shaded with its vertex normals.
     pub fn is_smooth(&self) -> bool {
         !self.normals.is_empty()
+    }
+
+    /// Bytes the mesh holds for rendering: its arrays and its hierarchy.
+    pub fn bytes(&self) -> usize {
+        (self.positions.len() + self.normals.len()) * size_of::<Vec3>()
+            + self.triangles.len() * size_of::<[u32; 3]>()
+            + self.bvh.bytes()
     }
 
     pub fn bounds(&self) -> Aabb {

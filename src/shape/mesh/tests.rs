@@ -93,3 +93,98 @@ fn mesh_files_compare_by_name() {
     let copy = a.clone();
     assert!(Arc::ptr_eq(copy.mesh().unwrap(), a.mesh().unwrap()));
 }
+
+/// A closed torus of `2·nu·nv` triangles over `nu·nv` shared vertices.
+fn torus(nu: u32, nv: u32, smooth: bool) -> Mesh {
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    for i in 0..nu {
+        let a = std::f32::consts::TAU * i as f32 / nu as f32;
+        for j in 0..nv {
+            let b = std::f32::consts::TAU * j as f32 / nv as f32;
+            let n = Vec3::new(a.cos() * b.cos(), b.sin(), a.sin() * b.cos());
+            positions.push(Vec3::new(a.cos(), 0.0, a.sin()) + n * 0.35);
+            normals.push(n);
+        }
+    }
+    let mut triangles = Vec::new();
+    for i in 0..nu {
+        for j in 0..nv {
+            let p = i * nv + j;
+            let q = (i + 1) % nu * nv + j;
+            let r = (i + 1) % nu * nv + (j + 1) % nv;
+            let s = i * nv + (j + 1) % nv;
+            triangles.push([p, s, r]);
+            triangles.push([p, r, q]);
+        }
+    }
+    Mesh::new(
+        positions,
+        if smooth { normals } else { Vec::new() },
+        triangles,
+    )
+    .unwrap()
+}
+
+#[test]
+fn a_mesh_costs_at_most_100_bytes_per_triangle() {
+    for smooth in [false, true] {
+        let m = torus(400, 125, smooth);
+        let per_triangle = m.bytes() as f64 / m.triangle_count() as f64;
+        assert!(per_triangle <= 100.0, "{per_triangle} B/triangle");
+    }
+}
+
+mod watertight {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Whether every triangle of `mesh` holding all of `corners` faces `origin` (seen from the
+    /// front, not edge-on): a ray from there through the shared corners crosses the surface.
+    fn faces_towards(mesh: &Mesh, corners: &[u32], origin: Vec3A) -> bool {
+        (0..mesh.triangle_count() as u32)
+            .filter(|&t| {
+                corners
+                    .iter()
+                    .all(|c| mesh.triangles[t as usize].contains(c))
+            })
+            .all(|t| {
+                let [a, b, c] = mesh.vertices(t);
+                let n = (b - a).cross(c - a).normalize();
+                n.dot((origin - a).normalize()) > 0.05
+            })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(512))]
+
+        /// Rays aimed exactly at a shared vertex, or at a point of a shared edge, of a closed
+        /// mesh from outside where the faces there are seen from the front, always hit it.
+        #[test]
+        fn rays_at_shared_edges_and_vertices_never_slip_through(
+            i in 0u32..24, j in 0u32..9, edge in 0usize..3,
+            s in prop_oneof![Just(0.0f32), Just(1.0f32), 0.0f32..1.0],
+            theta in 0.0f32..std::f32::consts::TAU, phi in -1.5f32..1.5, dist in 2.5f32..40.0,
+        ) {
+            let mesh = torus(24, 9, false);
+            let [a, b, c] = mesh.triangles[(2 * (i * 9 + j)) as usize];
+            let corner = |k: u32| Vec3A::from(mesh.positions[k as usize]);
+            let (p, q) = [(a, b), (b, c), (c, a)][edge];
+            let (target, shared) = if s == 0.0 {
+                (corner(p), vec![p])
+            } else if s == 1.0 {
+                (corner(q), vec![q])
+            } else {
+                (corner(p).lerp(corner(q), s), vec![p, q])
+            };
+            let origin =
+                Vec3A::new(theta.cos() * phi.cos(), phi.sin(), theta.sin() * phi.cos()) * dist;
+            prop_assume!(faces_towards(&mesh, &shared, origin));
+            let ray = Ray::new(origin, target - origin);
+            prop_assert!(
+                mesh.intersect(&ray, f32::INFINITY).is_some(),
+                "slipped through at {target:?}"
+            );
+        }
+    }
+}
