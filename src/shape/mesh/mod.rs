@@ -51,7 +51,7 @@ impl fmt::Display for MeshError {
 
 impl Mesh {
     /// Builds the mesh and its hierarchy. `normals` is used only when it gives one finite
-    /// normal per position; otherwise the mesh is shaded flat.
+    /// normal per position (each made unit length); otherwise the mesh is shaded flat.
     pub fn new(
         positions: Vec<Vec3>,
         normals: Vec<Vec3>,
@@ -68,7 +68,8 @@ impl Mesh {
             return Err(MeshError::BadIndex);
         }
         let normals = if normals.len() == n && normals.iter().all(|v| v.is_finite()) {
-            normals
+            // Files need not write unit normals; interpolation weighs them alike.
+            normals.into_iter().map(Vec3::normalize_or_zero).collect()
         } else {
             Vec::new()
         };

@@ -42,8 +42,8 @@ fn smooth_normals_are_interpolated() {
             f32::INFINITY,
         )
         .unwrap();
-    // Barycentric weights (0.25, 0.5, 0.25).
-    let expected = Vec3A::new(0.5, 0.0, 1.0);
+    // Barycentric weights (0.25, 0.5, 0.25) of the unit normals.
+    let expected = Vec3A::Z * 0.5 + Vec3A::new(1.0, 0.0, 1.0).normalize() * 0.5;
     assert!((h.normal - expected).length() < 1e-6, "{:?}", h.normal);
 }
 
