@@ -20,9 +20,14 @@ use std::sync::Arc;
 /// location and a message that follows the file's name ("… holds no triangles").
 pub fn load(path: &Path) -> Result<Mesh, Box<Diagnostic>> {
     let open = || {
-        File::open(path)
-            .map(BufReader::new)
-            .map_err(|e| Box::new(Diagnostic::file_error(path, format!("cannot be read: {e}"))))
+        let cannot =
+            |e: String| Box::new(Diagnostic::file_error(path, format!("cannot be read: {e}")));
+        let file = File::open(path).map_err(|e| cannot(e.to_string()))?;
+        // A device or pipe could feed a line without end (`/dev/zero`).
+        if !file.metadata().is_ok_and(|m| m.is_file()) {
+            return Err(cannot("it is not a regular file".to_string()));
+        }
+        Ok(BufReader::new(file))
     };
     let scan = scan(open()?).map_err(|problem| Box::new(problem.diagnostic(path)))?;
     if scan.triangles == 0 {
@@ -157,9 +162,10 @@ impl Scan {
     }
 }
 
-/// Whitespace-separated words of a line with their byte offsets.
+/// Whitespace-separated words of a line with their byte offsets (Unicode whitespace, as
+/// `tobj` splits them).
 fn words(line: &str) -> impl Iterator<Item = (usize, &str)> {
-    line.split_ascii_whitespace()
+    line.split_whitespace()
         .map(move |w| (w.as_ptr() as usize - line.as_ptr() as usize, w))
 }
 
@@ -271,7 +277,7 @@ fn scan_line(s: &mut Scan, line: &str, line_no: u64) -> Result<(), LineProblem> 
                         end,
                         format!(
                             "a vertex takes x y z and then a weight w or an r g b colour; \
-                             found {n} more numbers"
+                             found {n} more words"
                         ),
                     ));
                 }
@@ -462,6 +468,23 @@ mod tests {
         let (line, start, msg) = problem("v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n");
         assert_eq!((line, start), (5, 10));
         assert!(msg.contains("normal 2"), "{msg}");
+    }
+
+    #[test]
+    fn folders_and_devices_are_refused_before_reading() {
+        let dir = std::env::temp_dir();
+        let mut paths = vec![dir.as_path()];
+        // A device never ends its first line: it must not be read at all.
+        if Path::new("/dev/zero").exists() {
+            paths.push(Path::new("/dev/zero"));
+        }
+        for p in paths {
+            let d = load(p).unwrap_err();
+            assert!(
+                d.loc.is_none() && d.message.contains("cannot be read"),
+                "{d:?}"
+            );
+        }
     }
 
     #[test]
