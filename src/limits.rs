@@ -132,6 +132,10 @@ pub const MAX_TOKENS_PER_LINE: usize = 1 << 20;
 /// and small enough that reading one whole cannot exhaust an ordinary machine.
 pub const DEFAULT_MAX_INPUT: u64 = 1 << 30;
 
+/// Most triangles one OBJ mesh may hold (`define shape obj`): at the renderer's 100 bytes or
+/// less per triangle, about 5 GB; triangle indices also stay far inside the `u32` range.
+pub const MAX_MESH_TRIANGLES: usize = 50_000_000;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -40,6 +40,15 @@ fn manifest_lines(label: &str, scene: &Path) -> String {
     let name = scene.file_name().unwrap();
     let copy = dir.join(name);
     std::fs::copy(scene, &copy).unwrap();
+    // Meshes a scene reads (`define shape obj`) sit beside it.
+    for entry in std::fs::read_dir(scene.parent().unwrap())
+        .unwrap()
+        .flatten()
+    {
+        if entry.path().extension().is_some_and(|e| e == "obj") {
+            std::fs::copy(entry.path(), dir.join(entry.file_name())).unwrap();
+        }
+    }
     let output = anim()
         .arg("render")
         .arg(&copy)

@@ -5,7 +5,7 @@
 //! The layers, top to bottom (a module may import only modules of lower layers):
 //!
 //! ```text
-//! cli → app → {pipeline, anim, bench} → render → scene → sdf → {accel, shape} → math
+//! cli → app → {pipeline, anim, bench} → render → scene → sdf → shape → accel → math
 //!     → limits → {diag, util}
 //! ```
 
@@ -19,7 +19,8 @@ const LAYERS: &[&[&str]] = &[
     &["render"],
     &["scene"],
     &["sdf"],
-    &["accel", "shape"],
+    &["shape"],
+    &["accel"],
     &["math"],
     &["limits"],
     &["diag", "util"],

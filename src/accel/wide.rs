@@ -131,6 +131,11 @@ impl Bvh {
         self.nodes.len()
     }
 
+    /// Bytes the hierarchy holds (nodes and leaf lists, not counting spare capacity).
+    pub fn bytes(&self) -> usize {
+        self.nodes.len() * size_of::<Node>() + self.prims.len() * size_of::<u32>()
+    }
+
     /// Makes the wide node for the binary subtree at `root` and, depth first, its children;
     /// returns its index.
     fn collapse(&mut self, bin: &BinaryBvh, root: usize) -> u32 {

@@ -185,6 +185,10 @@ impl Bounds {
             Geometry::Triangle { vertices } => Bounds::around(vertices, 0.0),
             Geometry::Cylinder { p1, p2, radius } => Bounds::around(&[*p1, *p2], *radius),
             Geometry::Cone { base, tip, radius } => Bounds::around(&[*base, *tip], *radius),
+            Geometry::Mesh(m) => m.mesh().map_or(Bounds::point(DVec3::ZERO), |m| {
+                let b = m.bounds();
+                Bounds::around(&[b.min.as_dvec3(), b.max.as_dvec3()], 0.0)
+            }),
         }
     }
 

@@ -92,6 +92,8 @@ impl Primitive {
                 Geometry::Plane { .. } | Geometry::Triangle { .. } => {
                     Some(make_shape(geometry, xf)?)
                 }
+                // One mesh is shared by all its instances: each keeps its own matrix.
+                Geometry::Mesh(_) => None,
             }
         };
         let (shape, object) = match baked {
@@ -208,6 +210,8 @@ fn make_shape(geometry: &Geometry, xf: &Transform) -> Result<Shape, Degenerate> 
             let s = similarity_scale(xf.linear()).ok_or(Degenerate)?;
             Cone::new(p(*base), p(*tip), (radius * s) as f32).map(Shape::Cone)
         }
+        Geometry::Mesh(m) if xf.is_identity() => m.mesh().cloned().map(Shape::Mesh),
+        Geometry::Mesh(_) => None,
     };
     shape.ok_or(Degenerate)
 }

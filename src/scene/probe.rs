@@ -89,6 +89,7 @@ fn shape_of(g: &Geometry) -> Option<Shape> {
         Geometry::Cone { base, tip, radius } => {
             Cone::new(v(base), v(tip), radius as f32).map(Shape::Cone)
         }
+        Geometry::Mesh(ref m) => m.mesh().cloned().map(Shape::Mesh),
     }
 }
 
@@ -118,7 +119,7 @@ impl<'s> Probe<'s> {
                 let shape = shape_of(&instance.geometry)?;
                 let closed = !matches!(
                     instance.geometry,
-                    Geometry::Plane { .. } | Geometry::Triangle { .. }
+                    Geometry::Plane { .. } | Geometry::Triangle { .. } | Geometry::Mesh(_)
                 );
                 Some(Placed {
                     instance,

@@ -219,6 +219,7 @@ impl fmt::Display for StatementKind {
                     Geometry::Cone { base, tip, radius } => {
                         format!("cone {name} {} {} {}", v3(*base), v3(*tip), Num(*radius))
                     }
+                    Geometry::Mesh(m) => format!("obj {name} {}", m.file),
                 };
                 write!(f, "define shape {body} {}", material.name)
             }

@@ -2,6 +2,7 @@
 //! say whether one can be drawn at all. The reader and the scene builder both judge
 //! degeneracy here, so a shape cannot be accepted by one and refused by the other.
 
+use super::mesh::MeshFile;
 use glam::DVec3;
 
 /// A primitive as written in its own (object) space.
@@ -35,6 +36,8 @@ pub enum Geometry {
         tip: DVec3,
         radius: f64,
     },
+    /// Triangles of an OBJ file (`define shape obj`), loaded by the scene builder.
+    Mesh(MeshFile),
 }
 
 /// Why a shape cannot be drawn, if it cannot (it is then dropped with a warning).
@@ -67,6 +70,7 @@ pub fn degeneracy(g: &Geometry) -> Option<&'static str> {
             }
         }
         Geometry::Plane { normal, .. } if is_zero(normal) => Some("has a zero normal"),
+        Geometry::Mesh(ref m) if m.mesh().is_none() => Some("has no mesh loaded"),
         _ => None,
     }
 }

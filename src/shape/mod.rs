@@ -13,6 +13,7 @@ mod aabox;
 mod cone;
 mod cylinder;
 pub mod geometry;
+pub mod mesh;
 mod plane;
 mod sphere;
 mod triangle;
@@ -21,12 +22,14 @@ pub use aabox::AaBox;
 pub use cone::Cone;
 pub use cylinder::Cylinder;
 pub use geometry::{degeneracy, Geometry};
+pub use mesh::{Mesh, MeshFile};
 pub use plane::Plane;
 pub use sphere::{Sphere, SphereRay};
 pub use triangle::Triangle;
 
 use crate::math::{Aabb, Ray};
 use glam::Vec3A;
+use std::sync::Arc;
 
 /// A hit in the shape's own space.
 #[derive(Clone, Copy, Debug)]
@@ -44,6 +47,8 @@ pub enum Shape {
     Triangle(Triangle),
     Cylinder(Cylinder),
     Cone(Cone),
+    /// Shared by every instance of the mesh.
+    Mesh(Arc<Mesh>),
 }
 
 impl Shape {
@@ -56,6 +61,7 @@ impl Shape {
             Shape::Triangle(s) => s.intersect(ray, t_max),
             Shape::Cylinder(s) => s.intersect(ray, t_max),
             Shape::Cone(s) => s.intersect(ray, t_max),
+            Shape::Mesh(s) => s.intersect(ray, t_max),
         }
     }
 
@@ -70,6 +76,7 @@ impl Shape {
             Shape::Triangle(s) => s.bounds(),
             Shape::Cylinder(s) => s.bounds(),
             Shape::Cone(s) => s.bounds(),
+            Shape::Mesh(s) => s.bounds(),
         }
     }
 }

@@ -57,6 +57,42 @@ impl Triangle {
     /// Two-sided; the normal is the geometric one whatever side the ray comes from.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
+        let h = RaySpace::new(ray)?.hit(self.v0, self.v1, self.v2, t_max)?;
+        Some(ShapeHit {
+            t: h.t,
+            point: h.point,
+            normal: self.normal,
+        })
+    }
+}
+
+/// A hit of [`RaySpace::hit`]: the distance, the barycentric weights of the three vertices
+/// and the point they give.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleHit {
+    pub t: f32,
+    pub barycentric: [f32; 3],
+    pub point: Vec3A,
+}
+
+/// The ray's half of the watertight test: the axis permutation and shear that make the ray
+/// run along +z. It depends on the ray alone, so a mesh computes it once per ray and tests
+/// every candidate triangle against it.
+#[derive(Clone, Copy, Debug)]
+pub struct RaySpace {
+    origin: Vec3A,
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    sx: f32,
+    sy: f32,
+    sz: f32,
+}
+
+impl RaySpace {
+    /// `None` for a zero (or unusable) direction: no line to intersect with.
+    #[inline]
+    pub fn new(ray: &Ray) -> Option<RaySpace> {
         let d = ray.dir;
         // Permute so that the largest |component| of the direction is z (kz); this keeps the
         // shear factors Sx, Sy within [-1, 1].
@@ -69,25 +105,36 @@ impl Triangle {
             2
         };
         if d[kz] == 0.0 || !d[kz].is_finite() {
-            // Zero (or unusable) direction: no line to intersect with.
             return None;
         }
         let kx = if kz == 2 { 0 } else { kz + 1 };
         let ky = if kx == 2 { 0 } else { kx + 1 };
-        let sx = -d[kx] / d[kz];
-        let sy = -d[ky] / d[kz];
-        let sz = 1.0 / d[kz];
+        Some(RaySpace {
+            origin: ray.origin,
+            kx,
+            ky,
+            kz,
+            sx: -d[kx] / d[kz],
+            sy: -d[ky] / d[kz],
+            sz: 1.0 / d[kz],
+        })
+    }
 
+    /// The hit of the triangle `v0 v1 v2` with `0 < t < t_max`, from either side.
+    #[inline]
+    pub fn hit(&self, v0: Vec3A, v1: Vec3A, v2: Vec3A, t_max: f32) -> Option<TriangleHit> {
+        let (kx, ky, kz) = (self.kx, self.ky, self.kz);
+        let (sx, sy, sz) = (self.sx, self.sy, self.sz);
         // Ray-space vertices. The x and y shear is applied per vertex, so a vertex shared by
         // two triangles gets bit-identical ray-space coordinates in both.
         let to_ray_space = |v: Vec3A| {
-            let p = v - ray.origin;
+            let p = v - self.origin;
             let (x, y, z) = (p[kx], p[ky], p[kz]);
             (x + sx * z, y + sy * z, z)
         };
-        let (x0, y0, z0) = to_ray_space(self.v0);
-        let (x1, y1, z1) = to_ray_space(self.v1);
-        let (x2, y2, z2) = to_ray_space(self.v2);
+        let (x0, y0, z0) = to_ray_space(v0);
+        let (x1, y1, z1) = to_ray_space(v1);
+        let (x2, y2, z2) = to_ray_space(v2);
 
         // Edge functions. Rounding is monotonic, so `a·b − c·d` in f32 either has the exact
         // sign or is 0, and swapping the edge's vertices negates it exactly.
@@ -150,14 +197,14 @@ impl Triangle {
         // The point as a barycentric combination of the vertices: its error is a few ulps of
         // the vertex magnitudes, independent of how far the ray travelled (o + t·d is not).
         let (b0, b1, b2) = (e0 * inv_det, e1 * inv_det, e2 * inv_det);
-        let point = self.v0 * b0 + self.v1 * b1 + self.v2 * b2;
+        let point = v0 * b0 + v1 * b1 + v2 * b2;
         if !point.is_finite() {
             return None;
         }
-        Some(ShapeHit {
+        Some(TriangleHit {
             t,
+            barycentric: [b0, b1, b2],
             point,
-            normal: self.normal,
         })
     }
 }

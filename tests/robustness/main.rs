@@ -238,7 +238,9 @@ fn interior_point(obj: &Object, rng: &mut Rng) -> DVec3 {
             let disc = rng.in_ball().truncate() * (0.45 * radius);
             base + (tip - base) * rng.range(0.05, 0.5) + u * disc.x + v * disc.y
         }
-        Geometry::Plane { .. } | Geometry::Triangle { .. } => unreachable!("not closed"),
+        Geometry::Plane { .. } | Geometry::Triangle { .. } | Geometry::Mesh(_) => {
+            unreachable!("not closed (or not made here)")
+        }
     }
 }
 
@@ -253,6 +255,7 @@ fn centre(obj: &Object) -> DVec3 {
         } => (a + b + c) / 3.0,
         Geometry::Cylinder { p1, p2, .. } => (p1 + p2) * 0.5,
         Geometry::Cone { base, tip, .. } => (base + tip) * 0.5,
+        Geometry::Mesh(_) => unreachable!("the generated scenes hold no meshes"),
     }
 }
 
@@ -421,7 +424,9 @@ fn reference_hit(g: &Geometry, o: DVec3, d: DVec3) -> Option<(f64, DVec3)> {
                 }
             }
         }
-        Geometry::Plane { .. } | Geometry::Triangle { .. } => unreachable!("not closed"),
+        Geometry::Plane { .. } | Geometry::Triangle { .. } | Geometry::Mesh(_) => {
+            unreachable!("not closed (or not made here)")
+        }
     }
     best
 }

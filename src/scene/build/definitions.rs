@@ -8,10 +8,12 @@ use crate::sdf::ast::{
     CameraDef, LightDef, MaterialDef, NameRef, Statement, StatementKind, TransformOp,
 };
 use crate::sdf::repair;
-use crate::shape::degeneracy;
 use crate::shape::geometry::{is_zero, parallel};
+use crate::shape::{degeneracy, MeshFile};
 use glam::{DVec3, Vec3};
 use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
 
 /// A shape or composite.
 pub(super) struct Object<'s> {
@@ -83,6 +85,9 @@ impl Builder<'_> {
                     }
                 }
                 StatementKind::Shape { name, geometry, .. } => {
+                    if let Geometry::Mesh(m) = geometry {
+                        self.load_mesh(m, stmt);
+                    }
                     if let Some(reason) = degeneracy(geometry) {
                         if !self.from_reader {
                             self.warn(
@@ -224,6 +229,23 @@ impl Builder<'_> {
         d.objects.push(object);
     }
 
+    /// Reads a mesh's OBJ file, relative to the scene file. Problems inside it point at the
+    /// OBJ file's own lines; a file that cannot be read at all, at the statement.
+    fn load_mesh(&mut self, m: &MeshFile, stmt: &Statement) {
+        if m.mesh().is_some() {
+            return;
+        }
+        let dir = self.path.parent().unwrap_or(Path::new(""));
+        match crate::shape::mesh::load(&dir.join(&m.file)) {
+            Ok(mesh) => m.set(Arc::new(mesh)),
+            Err(d) if d.loc.is_none() => {
+                let message = format!("mesh file `{}` {}", m.file, d.message);
+                self.error(At::Statement(stmt), message, None);
+            }
+            Err(d) => self.diagnostics.push(*d),
+        }
+    }
+
     pub(super) fn duplicate(&mut self, stmt: &Statement, name: &str, what: &str) {
         self.warn(
             At::Name(stmt),
@@ -310,6 +332,7 @@ pub(super) fn finite_statement(kind: &StatementKind) -> bool {
             Geometry::Triangle { vertices } => vertices.iter().all(v),
             Geometry::Cylinder { p1, p2, radius } => v(p1) && v(p2) && radius.is_finite(),
             Geometry::Cone { base, tip, radius } => v(base) && v(tip) && radius.is_finite(),
+            Geometry::Mesh(_) => true,
         },
         StatementKind::Light(l) => v(&l.position) && c(&l.color) && l.brightness.is_finite(),
         StatementKind::Ambient(rgb)

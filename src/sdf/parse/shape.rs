@@ -1,12 +1,12 @@
 //! `define shape`: the geometric primitives and composites.
 
-use super::{At, PResult, Parser, SHAPE_KINDS};
+use super::{At, Fail, PResult, Parser, SHAPE_KINDS};
 use crate::diag::suggest;
 use crate::limits;
 use crate::sdf::ast::StatementKind;
 use crate::sdf::lexer::{looks_numeric, Line};
 use crate::shape::geometry::degeneracy;
-use crate::shape::Geometry;
+use crate::shape::{Geometry, MeshFile};
 use glam::DVec3;
 
 const FORM_SPHERE: &str = "define shape sphere <name> [center] <radius> <material>";
@@ -15,6 +15,7 @@ const FORM_TRIANGLE: &str = "define shape triangle <name> [v1] [v2] [v3] <materi
 const FORM_CYLINDER: &str = "define shape cylinder <name> [p1] [p2] <radius> <material>";
 const FORM_CONE: &str = "define shape cone <name> [base] [tip] <radius> <material>";
 const FORM_PLANE: &str = "define shape plane <name> [point] [normal] <material>";
+const FORM_OBJ: &str = "define shape obj <name> <file.obj> <material>";
 const FORM_COMPOSITE: &str = "define shape composite <name> <child> ...";
 
 impl Parser<'_> {
@@ -38,13 +39,9 @@ impl Parser<'_> {
                 }
             }
             "obj" => {
-                self.warn(
-                    line,
-                    At::Tok(kind_at),
-                    "mesh files (`define shape obj`) are not supported; shape skipped",
-                    None,
-                );
-                self.skip_name(line, name_at);
+                if self.mesh(line, kind_at).is_err() {
+                    self.skip_name(line, name_at);
+                }
             }
             k if SHAPE_KINDS.contains(&k) => {
                 if let Some(reordered) = name_after_material(line, kind_at) {
@@ -83,6 +80,39 @@ impl Parser<'_> {
                 self.skip_name(line, name_at);
             }
         }
+    }
+
+    /// `define shape obj <name> <file.obj> <material>`; the file is read by the scene builder.
+    fn mesh(&mut self, line: &Line, kind_at: usize) -> PResult<()> {
+        let args = line.tokens.len() - kind_at - 1;
+        if args < 3 {
+            // Other renderers write `define shape obj <file>`, with no name or material.
+            self.warn(
+                line,
+                At::Tok(kind_at),
+                "a mesh needs a name, an OBJ file and a material; shape skipped",
+                Some(format!(
+                    "write `{FORM_OBJ}`; the short form `define shape obj <file>` is not supported"
+                )),
+            );
+            return Err(Fail);
+        }
+        if args > 3 {
+            let last = line.tokens.len() - 1;
+            return Err(self.error(
+                line,
+                At::Span(kind_at + 4, last),
+                format!("a mesh takes a name, an OBJ file and a material; found {args} words"),
+                Some(FORM_OBJ.to_string()),
+            ));
+        }
+        let kind = StatementKind::Shape {
+            name: line.tokens[kind_at + 1].text.to_string(),
+            geometry: Geometry::Mesh(MeshFile::new(line.tokens[kind_at + 2].text)),
+            material: self.name_ref(line, kind_at + 3),
+        };
+        self.emit_named(line, kind_at + 1, kind);
+        Ok(())
     }
 
     fn geometric_shape(&mut self, line: &Line, kind_at: usize) -> PResult<()> {

@@ -1,0 +1,495 @@
+//! Reading a mesh from a Wavefront OBJ file with the `tobj` crate.
+//!
+//! `tobj` reports what went wrong but not where, so a light pass over the text comes first:
+//! it checks every line `tobj` would read (numbers of `v`, `vt` and `vn` lines, the indices
+//! of `f` and `l` lines, `usemtl` names) by the same rules, and points at the file's own line
+//! and column. Only a file that passes reaches `tobj`, whose model is turned into the mesh's
+//! compact arrays and dropped before the hierarchy is built (the peak holds one copy).
+
+use super::{Mesh, MeshError};
+use crate::diag::{Diagnostic, Loc, Severity};
+use crate::limits::MAX_MESH_TRIANGLES;
+use glam::Vec3;
+use std::fs::File;
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::sync::Arc;
+
+/// Loads the mesh of an OBJ file. A problem on a line points at the OBJ file's own line and
+/// column; a problem with the whole file (it cannot be read, it holds no triangles) has no
+/// location and a message that follows the file's name ("… holds no triangles").
+pub fn load(path: &Path) -> Result<Mesh, Box<Diagnostic>> {
+    let open = || {
+        let cannot =
+            |e: String| Box::new(Diagnostic::file_error(path, format!("cannot be read: {e}")));
+        let file = File::open(path).map_err(|e| cannot(e.to_string()))?;
+        // A device or pipe could feed a line without end (`/dev/zero`).
+        if !file.metadata().is_ok_and(|m| m.is_file()) {
+            return Err(cannot("it is not a regular file".to_string()));
+        }
+        Ok(BufReader::new(file))
+    };
+    let scan = scan(open()?).map_err(|problem| Box::new(problem.diagnostic(path)))?;
+    if scan.triangles == 0 {
+        return Err(Box::new(Diagnostic::file_error(
+            path,
+            MeshError::NoTriangles.to_string(),
+        )));
+    }
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    // Materials are the scene file's business: `mtllib` lines are not followed.
+    let (models, _) = tobj::load_obj_buf(&mut open()?, &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| {
+        Box::new(Diagnostic::file_error(
+            path,
+            format!("cannot be read as OBJ: {e}"),
+        ))
+    })?;
+
+    let mut positions: Vec<Vec3> = Vec::with_capacity(scan.vertices_hint());
+    let mut normals: Vec<Vec3> = Vec::new();
+    let mut triangles: Vec<[u32; 3]> = Vec::with_capacity(scan.triangles);
+    let mut smooth = true;
+    for model in models {
+        // Each model is dropped as soon as it is copied.
+        let m = model.mesh;
+        let base = positions.len() as u32;
+        let vec3s = |v: &[f32]| {
+            v.chunks_exact(3)
+                .map(|c| Vec3::new(c[0], c[1], c[2]))
+                .collect::<Vec<_>>()
+        };
+        smooth &= m.normals.len() == m.positions.len();
+        if smooth {
+            normals.extend(vec3s(&m.normals));
+        }
+        positions.extend(vec3s(&m.positions));
+        triangles.extend(
+            m.indices
+                .chunks_exact(3)
+                .map(|t| [t[0] + base, t[1] + base, t[2] + base]),
+        );
+    }
+    if !smooth {
+        normals = Vec::new();
+    }
+    positions.shrink_to_fit();
+    normals.shrink_to_fit();
+    Mesh::new(positions, normals, triangles)
+        .map_err(|e| Box::new(Diagnostic::file_error(path, e.to_string())))
+}
+
+/// A problem found on one line: byte range of the culprit and the message.
+#[derive(Debug)]
+struct Problem {
+    line: u64,
+    start: usize,
+    end: usize,
+    message: String,
+    /// The line's text, when the pass still had it (problems found at the end of the file
+    /// read it again).
+    text: Option<String>,
+}
+
+impl Problem {
+    fn diagnostic(self, path: &Path) -> Diagnostic {
+        let text = self.text.or_else(|| nth_line(path, self.line));
+        let text = text.unwrap_or_default();
+        let start = self.start.min(text.len());
+        let col = text[..start].chars().count() + 1;
+        let width = text
+            .get(start..self.end.min(text.len()))
+            .map_or(1, |t| t.chars().count());
+        let loc = Loc {
+            file: Arc::from(path),
+            line: u32::try_from(self.line).unwrap_or(u32::MAX),
+            col: u32::try_from(col).unwrap_or(u32::MAX),
+        };
+        Diagnostic::new(Severity::Error, loc, self.message)
+            .with_source(&text, u32::try_from(width).unwrap_or(u32::MAX))
+    }
+}
+
+/// The text of line `n` (from 1), read again for a problem found after the line had passed.
+fn nth_line(path: &Path, n: u64) -> Option<String> {
+    let mut reader = BufReader::new(File::open(path).ok()?);
+    let mut buf = Vec::new();
+    for _ in 0..n {
+        buf.clear();
+        if reader.read_until(b'\n', &mut buf).ok()? == 0 {
+            return None;
+        }
+    }
+    Some(String::from_utf8_lossy(trim_line_end(&buf)).into_owned())
+}
+
+fn trim_line_end(buf: &[u8]) -> &[u8] {
+    let buf = buf.strip_suffix(b"\n").unwrap_or(buf);
+    buf.strip_suffix(b"\r").unwrap_or(buf)
+}
+
+/// Indexed element kinds of a face vertex `v/vt/vn`.
+const KINDS: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+
+/// The largest index a face names of one kind, and where.
+#[derive(Clone, Copy, Debug, Default)]
+struct Farthest {
+    index: u64,
+    line: u64,
+    start: usize,
+    end: usize,
+}
+
+/// What the pass counted.
+#[derive(Debug, Default)]
+struct Scan {
+    /// Positions, texture coordinates and normals defined.
+    counts: [u64; 3],
+    triangles: usize,
+    farthest: [Farthest; 3],
+}
+
+impl Scan {
+    fn vertices_hint(&self) -> usize {
+        usize::try_from(self.counts[0]).unwrap_or(0)
+    }
+}
+
+/// Whitespace-separated words of a line with their byte offsets (Unicode whitespace, as
+/// `tobj` splits them).
+fn words(line: &str) -> impl Iterator<Item = (usize, &str)> {
+    line.split_whitespace()
+        .map(move |w| (w.as_ptr() as usize - line.as_ptr() as usize, w))
+}
+
+fn scan(mut reader: impl BufRead) -> Result<Scan, Problem> {
+    let mut s = Scan::default();
+    let mut buf = Vec::new();
+    let mut line_no = 0u64;
+    loop {
+        buf.clear();
+        let read = reader.read_until(b'\n', &mut buf).map_err(|e| Problem {
+            line: line_no + 1,
+            start: 0,
+            end: 0,
+            message: format!("cannot be read: {e}"),
+            text: Some(String::new()),
+        })?;
+        if read == 0 {
+            break;
+        }
+        line_no += 1;
+        let bytes = trim_line_end(&buf);
+        let Ok(line) = std::str::from_utf8(bytes) else {
+            let good = std::str::from_utf8(bytes).map_or_else(|e| e.valid_up_to(), |_| 0);
+            return Err(Problem {
+                line: line_no,
+                start: good,
+                end: good + 1,
+                message: "not UTF-8 text (an OBJ file is text)".to_string(),
+                text: Some(String::from_utf8_lossy(bytes).into_owned()),
+            });
+        };
+        let at = |start: usize, end: usize, message: String| Problem {
+            line: line_no,
+            start,
+            end,
+            message,
+            text: Some(line.to_string()),
+        };
+        scan_line(&mut s, line, line_no)
+            .map_err(|(start, end, message)| at(start, end, message))?;
+    }
+    for (kind, far) in s.farthest.iter().enumerate() {
+        // Indices of texture coordinates or normals a file does not define at all are
+        // ignored, as by `tobj`; vertices must exist.
+        let defined = s.counts[kind];
+        if far.index > defined && (kind == 0 || defined > 0) {
+            return Err(Problem {
+                line: far.line,
+                start: far.start,
+                end: far.end,
+                message: format!(
+                    "face refers to {} {} but the file defines {defined}",
+                    KINDS[kind], far.index
+                ),
+                text: None,
+            });
+        }
+    }
+    Ok(s)
+}
+
+type LineProblem = (usize, usize, String);
+
+/// Checks one line as `tobj` reads it, counting what it defines.
+fn scan_line(s: &mut Scan, line: &str, line_no: u64) -> Result<(), LineProblem> {
+    let mut ws = words(line);
+    let Some((_, keyword)) = ws.next() else {
+        return Ok(());
+    };
+    let end = line.len();
+    let number = |w: Option<(usize, &str)>, what: &str| -> Result<f32, LineProblem> {
+        match w {
+            None => Err((end, end, format!("expected {what}, found end of line"))),
+            Some((at, text)) => text.parse::<f32>().map_err(|_| {
+                (
+                    at,
+                    at + text.len(),
+                    format!("expected {what}, found '{text}'"),
+                )
+            }),
+        }
+    };
+    match keyword {
+        "v" => {
+            let mut xyz = [0.0f32; 3];
+            let mut spans = [(0usize, 0usize); 3];
+            for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+                let w = ws.next();
+                xyz[i] = number(w, &format!("the vertex's {axis} coordinate (a number)"))?;
+                spans[i] = w.map_or((end, end), |(a, t)| (a, a + t.len()));
+            }
+            let rest: Vec<(usize, &str)> = ws.collect();
+            match rest.len() {
+                0 | 3 => {}
+                1 => {
+                    let w = number(Some(rest[0]), "the vertex's weight w (a number)")?;
+                    let (a, t) = rest[0];
+                    if w == 0.0 {
+                        return Err((a, a + t.len(), "vertex weight w is 0".to_string()));
+                    }
+                    for c in &mut xyz {
+                        *c /= w;
+                    }
+                }
+                n => {
+                    let (a, _) = rest[0];
+                    return Err((
+                        a,
+                        end,
+                        format!(
+                            "a vertex takes x y z and then a weight w or an r g b colour; \
+                             found {n} more words"
+                        ),
+                    ));
+                }
+            }
+            if let Some(i) = xyz.iter().position(|c| !c.is_finite()) {
+                let (a, b) = spans[i];
+                return Err((a, b, "vertex coordinate is not a finite number".to_string()));
+            }
+            s.counts[0] += 1;
+        }
+        "vt" => {
+            for what in ["the texture coordinate u", "the texture coordinate v"] {
+                number(ws.next(), &format!("{what} (a number)"))?;
+            }
+            s.counts[1] += 1;
+        }
+        "vn" => {
+            for axis in ["x", "y", "z"] {
+                let w = ws.next();
+                let v = number(w, &format!("the normal's {axis} component (a number)"))?;
+                if !v.is_finite() {
+                    let (a, t) = w.unwrap_or((end, ""));
+                    return Err((a, a + t.len(), "normal is not a finite number".to_string()));
+                }
+            }
+            s.counts[2] += 1;
+        }
+        "f" | "l" => {
+            let mut corners = 0usize;
+            for (at, word) in ws {
+                face_vertex(s, at, word, line_no)?;
+                corners += 1;
+            }
+            if corners >= 3 {
+                s.triangles += corners - 2;
+                if s.triangles > MAX_MESH_TRIANGLES {
+                    return Err((
+                        0,
+                        end,
+                        format!("a mesh may hold at most {MAX_MESH_TRIANGLES} triangles"),
+                    ));
+                }
+            }
+        }
+        "usemtl" if ws.next().is_none() => {
+            return Err((
+                end,
+                end,
+                "expected a material name, found end of line".into(),
+            ));
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+/// Checks one `v`, `v/vt`, `v//vn` or `v/vt/vn` word of a face. Relative (negative) indices
+/// count back from the elements defined so far; positive ones must exist by the end of the
+/// file, so the largest is kept for that check.
+fn face_vertex(s: &mut Scan, at: usize, word: &str, line_no: u64) -> Result<(), LineProblem> {
+    let whole = (at, at + word.len());
+    let parts: Vec<&str> = word.split('/').collect();
+    if parts.len() > 3 {
+        return Err((
+            whole.0,
+            whole.1,
+            format!("expected a face vertex v, v/vt, v//vn or v/vt/vn, found '{word}'"),
+        ));
+    }
+    let mut offset = at;
+    for (kind, part) in parts.iter().enumerate() {
+        let span = (offset, offset + part.len());
+        offset += part.len() + 1;
+        if part.is_empty() {
+            if kind == 0 {
+                return Err((
+                    whole.0,
+                    whole.1,
+                    format!("face vertex '{word}' gives no vertex index"),
+                ));
+            }
+            continue;
+        }
+        let index: i64 = part.parse().map_err(|_| {
+            (
+                span.0,
+                span.1,
+                format!(
+                    "expected a {} index (a whole number), found '{part}'",
+                    KINDS[kind]
+                ),
+            )
+        })?;
+        let defined = s.counts[kind];
+        if index == 0 {
+            return Err((
+                span.0,
+                span.1,
+                format!("{} index 0: OBJ indices count from 1", KINDS[kind]),
+            ));
+        }
+        if index < 0 {
+            if index.unsigned_abs() > defined && (kind == 0 || defined > 0) {
+                return Err((
+                    span.0,
+                    span.1,
+                    format!(
+                        "relative {} index {index} reaches before the first one ({defined} defined so far)",
+                        KINDS[kind]
+                    ),
+                ));
+            }
+        } else if index as u64 > s.farthest[kind].index {
+            s.farthest[kind] = Farthest {
+                index: index as u64,
+                line: line_no,
+                start: span.0,
+                end: span.1,
+            };
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scan_str(text: &str) -> Result<Scan, Problem> {
+        scan(text.as_bytes())
+    }
+
+    fn problem(text: &str) -> (u64, usize, String) {
+        let p = scan_str(text).unwrap_err();
+        (p.line, p.start, p.message)
+    }
+
+    #[test]
+    fn counts_triangles_after_fan_triangulation() {
+        let s =
+            scan_str("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2 3\nl 1 2\n").unwrap();
+        assert_eq!(s.counts, [4, 0, 0]);
+        assert_eq!(s.triangles, 3);
+    }
+
+    #[test]
+    fn relative_and_slashed_indices_are_accepted() {
+        let s = scan_str("v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0 1\nf -3//1 -2//1 -1//-1\n").unwrap();
+        assert_eq!(s.triangles, 1);
+    }
+
+    #[test]
+    fn problems_point_at_the_culprit() {
+        let (line, start, msg) = problem("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 4\n");
+        assert_eq!((line, start), (4, 6), "{msg}");
+        assert!(msg.contains("vertex 4 but the file defines 3"), "{msg}");
+        let (line, start, msg) = problem("v 0 0 0\nv 1 nan 0\n");
+        assert_eq!((line, start), (2, 4));
+        assert!(msg.contains("not a finite number"));
+        let (line, start, msg) = problem("v 0 0 0\nv 1 0x 0\n");
+        assert_eq!((line, start), (2, 4));
+        assert!(msg.contains("found '0x'"), "{msg}");
+        let (line, start, msg) = problem("v 0 0\n");
+        assert_eq!((line, start), (1, 5));
+        assert!(msg.contains("end of line"), "{msg}");
+        let (line, start, msg) = problem("v 0 0 0\nf 1 0 1\n");
+        assert_eq!((line, start), (2, 4));
+        assert!(msg.contains("count from 1"));
+        let (line, start, _) = problem("v 0 0 0\nf 1 -2 1\n");
+        assert_eq!((line, start), (2, 4));
+        let (line, start, msg) = problem("v 0 0 0\nf 1/2/3/4 1 1\n");
+        assert_eq!((line, start), (2, 2));
+        assert!(msg.contains("v/vt/vn"));
+        let (line, start, _) = problem("v 0 0 0 1 1\n");
+        assert_eq!((line, start), (1, 8));
+        let (line, _, msg) = problem("v 0 0 0 0\n");
+        assert_eq!(line, 1);
+        assert!(msg.contains("weight"));
+        let (line, start, _) = problem("usemtl\n");
+        assert_eq!((line, start), (1, 6));
+    }
+
+    #[test]
+    fn unused_kinds_of_index_are_ignored_as_tobj_ignores_them() {
+        // No `vt` lines at all: the texture indices are never looked at.
+        assert!(scan_str("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1/7 2/7 3/7\n").is_ok());
+        // Some normals defined: an index past them is an error.
+        let (line, start, msg) = problem("v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n");
+        assert_eq!((line, start), (5, 10));
+        assert!(msg.contains("normal 2"), "{msg}");
+    }
+
+    #[test]
+    fn folders_and_devices_are_refused_before_reading() {
+        let dir = std::env::temp_dir();
+        let mut paths = vec![dir.as_path()];
+        // A device never ends its first line: it must not be read at all.
+        if Path::new("/dev/zero").exists() {
+            paths.push(Path::new("/dev/zero"));
+        }
+        for p in paths {
+            let d = load(p).unwrap_err();
+            assert!(
+                d.loc.is_none() && d.message.contains("cannot be read"),
+                "{d:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn not_utf8_is_located() {
+        let p = scan(&b"v 0 0 0\nv \xff 0 0\n"[..]).unwrap_err();
+        assert_eq!((p.line, p.start), (2, 2));
+    }
+}
