@@ -131,22 +131,31 @@ impl Cone {
             (side_normal + DVec3::Z).normalize(),
         );
         let apex = (DVec3::ZERO, DVec3::new(0.0, 0.0, -1.0));
-        let (local, normal) = match part {
+        let ((local, normal), on_edge) = match part {
             Part::Side => {
                 // Foot of the perpendicular from (ρ, z) onto the generator ρ = k·z in the
                 // half-plane of the hit, kept between apex and base.
                 let s = ((k * rho + p.z) / (1.0 + k2)).clamp(0.0, h);
                 if s >= h - band {
-                    rim
+                    (rim, true)
                 } else if s <= band || radial.is_none() {
-                    apex
+                    (apex, true)
                 } else {
-                    (DVec3::new(cx * k * s, cy * k * s, s), side_normal)
+                    ((DVec3::new(cx * k * s, cy * k * s, s), side_normal), false)
                 }
             }
-            Part::Cap { .. } if rho >= r - band => rim,
-            Part::Cap { z, sign } => (DVec3::new(p.x, p.y, z), DVec3::new(0.0, 0.0, sign)),
+            Part::Cap { .. } if rho >= r - band => (rim, true),
+            Part::Cap { z, sign } => ((DVec3::new(p.x, p.y, z), DVec3::new(0.0, 0.0, sign)), false),
         };
+        // A ray that has just left this edge and is snapped back onto it (see
+        // `AxisFrame::left_edge`).
+        let origin = o - d * l.t_shift;
+        let inside = origin.x * origin.x + origin.y * origin.y < k2 * origin.z * origin.z
+            && origin.z > 0.0
+            && origin.z < h;
+        if on_edge && inside && AxisFrame::left_edge(origin, local, band) {
+            return None;
+        }
         self.frame.shape_hit(t, local, normal)
     }
 }

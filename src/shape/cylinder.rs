@@ -122,6 +122,23 @@ impl AxisFrame {
         (2.0 * offset + rounding).min(0.25 * smallest)
     }
 
+    /// Whether a ray whose local origin is `origin`, inside the solid, has just left the edge
+    /// point `edge` (a rim point, or the cone's apex) that its hit was snapped to: the origin
+    /// lies within [`LEFT_EDGE_BANDS`] bands of it. (The origin of a ray spawned from a surface
+    /// that touches the edge from outside, a floor under a post, is outside the solid.)
+    ///
+    /// Why: an edge point carries one normal, halfway between its faces', and `spawn_origin`
+    /// sides a ray by that normal alone. A ray leaving an edge into the solid by that normal
+    /// but out of it through one face (which exact arithmetic would see leave at once and meet
+    /// nothing) starts just inside, crosses that face within a few offsets and is snapped
+    /// back onto the edge, where the halfway normal calls the exit an entry: a re-hit of the
+    /// surface it left. Such a hit is dropped. A ray that really goes into the solid from the
+    /// edge is unaffected: its first crossing is the exit through the far side, farther away
+    /// than this unless it leaves through a chord thinner than a few offsets.
+    pub fn left_edge(origin: DVec3, edge: DVec3, band: f64) -> bool {
+        (origin - edge).length() <= LEFT_EDGE_BANDS * band
+    }
+
     /// World-space box around the disc of `radius` centred at local height `z`, perpendicular
     /// to the axis: along world axis i the disc reaches `radius·√(1 − w_i²)`.
     pub fn disc_bounds(&self, z: f64, radius: f64) -> (DVec3, DVec3) {
@@ -131,6 +148,11 @@ impl AxisFrame {
         (c - e, c + e)
     }
 }
+
+/// How many edge bands around an edge a ray's origin may lie and still count as having left
+/// that edge (see `AxisFrame::left_edge`): the offset moves it about half a band, and the
+/// matrix path of a non-uniformly scaled shape stretches that by its anisotropy.
+const LEFT_EDGE_BANDS: f64 = 8.0;
 
 /// Rounds an f64 box outwards to a conservative f32 box: a pad of 1e-6 of the box's extent
 /// and of its coordinates' magnitude covers the f64 arithmetic and the rounding to f32
@@ -304,17 +326,26 @@ impl Cylinder {
                 DVec3::new(cx, cy, sign) * std::f64::consts::FRAC_1_SQRT_2,
             )
         };
-        let (local, normal) = match part {
-            Part::Side if p.z <= band => rim(0.0, -1.0),
-            Part::Side if p.z >= h - band => rim(h, 1.0),
+        let ((local, normal), on_edge) = match part {
+            Part::Side if p.z <= band => (rim(0.0, -1.0), true),
+            Part::Side if p.z >= h - band => (rim(h, 1.0), true),
             // Project radially onto the side; keep the height inside the cylinder.
             Part::Side => (
-                DVec3::new(cx * r, cy * r, p.z.clamp(0.0, h)),
-                DVec3::new(cx, cy, 0.0),
+                (
+                    DVec3::new(cx * r, cy * r, p.z.clamp(0.0, h)),
+                    DVec3::new(cx, cy, 0.0),
+                ),
+                false,
             ),
-            Part::Cap { z, sign } if rho >= r - band => rim(z, sign),
-            Part::Cap { z, sign } => (DVec3::new(p.x, p.y, z), DVec3::new(0.0, 0.0, sign)),
+            Part::Cap { z, sign } if rho >= r - band => (rim(z, sign), true),
+            Part::Cap { z, sign } => ((DVec3::new(p.x, p.y, z), DVec3::new(0.0, 0.0, sign)), false),
         };
+        let origin = o - d * l.t_shift;
+        let inside =
+            origin.x * origin.x + origin.y * origin.y < r2 && origin.z > 0.0 && origin.z < h;
+        if on_edge && inside && AxisFrame::left_edge(origin, local, band) {
+            return None;
+        }
         self.frame.shape_hit(t, local, normal)
     }
 }
