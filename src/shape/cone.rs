@@ -131,31 +131,33 @@ impl Cone {
             (side_normal + DVec3::Z).normalize(),
         );
         let apex = (DVec3::ZERO, DVec3::new(0.0, 0.0, -1.0));
-        let ((local, normal), on_edge) = match part {
+        let (local, normal) = match part {
             Part::Side => {
                 // Foot of the perpendicular from (ρ, z) onto the generator ρ = k·z in the
                 // half-plane of the hit, kept between apex and base.
                 let s = ((k * rho + p.z) / (1.0 + k2)).clamp(0.0, h);
                 if s >= h - band {
-                    (rim, true)
+                    rim
                 } else if s <= band || radial.is_none() {
-                    (apex, true)
+                    apex
                 } else {
-                    ((DVec3::new(cx * k * s, cy * k * s, s), side_normal), false)
+                    (DVec3::new(cx * k * s, cy * k * s, s), side_normal)
                 }
             }
-            Part::Cap { .. } if rho >= r - band => (rim, true),
-            Part::Cap { z, sign } => ((DVec3::new(p.x, p.y, z), DVec3::new(0.0, 0.0, sign)), false),
+            Part::Cap { .. } if rho >= r - band => rim,
+            Part::Cap { z, sign } => (DVec3::new(p.x, p.y, z), DVec3::new(0.0, 0.0, sign)),
         };
-        // A ray that has just left this edge and is snapped back onto it (see
-        // `AxisFrame::left_edge`).
+        // A hit snapped onto the rim or the apex keeps the edge's normal only while it tells
+        // the crossing right: see `AxisFrame::crossing_normal`.
         let origin = o - d * l.t_shift;
         let inside = origin.x * origin.x + origin.y * origin.y < k2 * origin.z * origin.z
             && origin.z > 0.0
             && origin.z < h;
-        if on_edge && inside && AxisFrame::left_edge(origin, local, band) {
-            return None;
-        }
+        let face = match part {
+            Part::Side => side_normal,
+            Part::Cap { sign, .. } => DVec3::new(0.0, 0.0, sign),
+        };
+        let normal = AxisFrame::crossing_normal(normal, face, d, inside);
         self.frame.shape_hit(t, local, normal)
     }
 }
@@ -438,5 +440,38 @@ mod tests {
         assert!(Cone::new(o, Vec3A::Y, -2.0).is_none());
         assert!(Cone::new(o, Vec3A::new(f32::NAN, 1.0, 0.0), 1.0).is_none());
         assert!(Cone::new(o, Vec3A::Y, f32::INFINITY).is_none());
+    }
+
+    #[test]
+    fn a_ray_leaving_the_apex_outside_the_cone_does_not_meet_it_again() {
+        use crate::math::spawn_ray;
+        let c = unit();
+        let h = c
+            .intersect(
+                &Ray::new(Vec3A::new(0.0, 5.0, 0.0), -Vec3A::Y),
+                f32::INFINITY,
+            )
+            .unwrap();
+        assert!(close(h.point, Vec3A::new(0.0, 2.0, 0.0)));
+        // Below the apex's supporting plane (into the solid by its normal +y) but outside the
+        // cone's half-angle of atan(1/2): it leaves at once.
+        for dir in [
+            Vec3A::new(1.0, -0.2, 0.0),
+            Vec3A::new(-0.3, -0.1, 0.9),
+            Vec3A::new(0.7, -0.3, -0.7),
+        ] {
+            let dir = dir.normalize();
+            assert!(h.normal.dot(dir) < 0.0);
+            let again = c.intersect(&spawn_ray(h.point, h.normal, dir), f32::INFINITY);
+            // It may cross the face it leaves through a few offsets on (its origin is inside),
+            // but as an exit, never as an entry of the surface it left.
+            assert!(
+                again.is_none_or(|e| e.normal.dot(dir) > 0.0),
+                "{dir:?}: {again:?}"
+            );
+        }
+        // Down the axis it goes through the solid to the base.
+        let down = c.intersect(&spawn_ray(h.point, h.normal, -Vec3A::Y), f32::INFINITY);
+        assert!(down.is_some_and(|e| (e.t - 2.0).abs() < 1e-4), "{down:?}");
     }
 }
