@@ -86,6 +86,8 @@ fn stress_writes_its_table() {
             "--tiny",
             "--scene",
             "assignment",
+            "--scene",
+            "anisotropic",
             "--out",
         ])
         .arg(dir.path())
@@ -100,11 +102,21 @@ fn stress_writes_its_table() {
     let rows: Vec<&str> = csv.lines().collect();
     assert_eq!(
         rows[0],
-        "scene,change,pct_within_1lsb,nonfinite_pixels,dropped_shapes,cpu_s"
+        "scene,change,pct_within_1lsb,nonfinite_pixels,dropped_shapes,cpu_s,spawned_rays,rehits"
     );
-    // The unchanged render and eight changes.
-    assert_eq!(rows.len(), 1 + 9);
+    // Per scene (the file's and the built-in one of every primitive scaled non-uniformly),
+    // the unchanged render and eight changes.
+    assert_eq!(rows.len(), 1 + 2 * 9);
     assert!(rows[1].starts_with("assignment,none,100.0000,0,"));
+    assert!(rows[10].starts_with("anisotropic,none,100.0000,0,"));
+    for row in &rows[1..] {
+        // The change's label has commas of its own ("translate 1e3 (x, y, z)"): count from
+        // the end.
+        let cols: Vec<&str> = row.rsplit(',').collect();
+        let spawned: u64 = cols[1].parse().unwrap();
+        // Every row spawns rays, and none of them meets the surface it left.
+        assert!(spawned > 0 && cols[0] == "0", "{row}");
+    }
     // A change to centimetres loses nothing in f32.
     let cm = rows.iter().find(|r| r.contains("scale 1e-2")).unwrap();
     let pct: f64 = cm.split(',').nth(2).unwrap().parse().unwrap();

@@ -12,6 +12,7 @@
 pub mod metrics;
 mod plot;
 pub mod pov;
+pub mod rehit;
 mod report;
 pub mod stress;
 

@@ -9,8 +9,9 @@
 //! positions and the camera's eye, direction and up are mapped. The renderer then compiles it
 //! to f32 as it does any scene, so every numerical path of a real file is exercised.
 
+use super::rehit::{self, RehitCount, KINDS};
 use super::report::write_text;
-use super::{load_scenes, render_measured, BenchConfig};
+use super::{load_scenes, render_measured, BenchConfig, BenchScene};
 use crate::math::Transform;
 use crate::render::RenderSettings;
 use crate::scene::RenderJob;
@@ -79,6 +80,15 @@ pub struct StressRow {
     /// Shapes left out because they became degenerate in f32.
     pub dropped: usize,
     pub cpu_s: f64,
+    /// Rays spawned from surface hits and those that re-hit their own surface (`rehit`).
+    pub spawned: u64,
+    pub rehits: u64,
+}
+
+impl StressRow {
+    pub fn rehits_per_million(&self) -> f64 {
+        1e6 * self.rehits as f64 / self.spawned.max(1) as f64
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -87,6 +97,8 @@ pub struct StressReport {
     pub height: u32,
     pub spp: u32,
     pub rows: Vec<StressRow>,
+    /// Spawned rays and re-hits per primitive kind over every row.
+    pub kinds: RehitCount,
 }
 
 /// Samples per pixel of the stress renders: one ray through each pixel centre, so a pixel
@@ -107,8 +119,53 @@ fn within_1lsb(a: &[u8], b: &[u8]) -> f64 {
     100.0 * close as f64 / pixels.max(1) as f64
 }
 
+/// Name of the built-in scene of every primitive kind scaled non-uniformly.
+pub const ANISOTROPIC: &str = "anisotropic";
+const ANISOTROPIC_SDF: &str = include_str!("anisotropic.sdf");
+
+fn anisotropic_scene() -> Result<BenchScene, String> {
+    let file = PathBuf::from("anisotropic.sdf (built in)");
+    let job = crate::scene::load_str(ANISOTROPIC_SDF, &file, &crate::sdf::LoadOptions::default())
+        .map_err(|d| format!("the built-in stress scene does not load: {d:?}"))?
+        .jobs
+        .remove(0);
+    Ok(BenchScene {
+        name: ANISOTROPIC.into(),
+        file,
+        bytes: ANISOTROPIC_SDF.as_bytes().to_vec(),
+        job,
+    })
+}
+
+/// The bench scenes plus the built-in anisotropic one (all, or those named in `only`).
+fn stress_scenes(config: &BenchConfig) -> Result<Vec<BenchScene>, String> {
+    let from_files: Vec<String> = config
+        .only
+        .iter()
+        .filter(|n| n.as_str() != ANISOTROPIC)
+        .cloned()
+        .collect();
+    let mut scenes = if config.only.is_empty() || !from_files.is_empty() {
+        load_scenes(&config.scenes_dir, &from_files)?
+    } else {
+        Vec::new()
+    };
+    if config.only.is_empty() || config.only.iter().any(|n| n == ANISOTROPIC) {
+        scenes.push(anisotropic_scene()?);
+    }
+    Ok(scenes)
+}
+
+/// Re-hits of `job` rendered as the renderer renders it: camera-relative.
+fn count_rehits(job: &RenderJob, settings: &RenderSettings) -> Result<RehitCount, String> {
+    let (width, height, _) = settings.resolve(job);
+    let relative = transform_job(job, &Transform::translate(-job.camera.eye));
+    rehit::count(&relative, width, height, settings.max_depth)
+}
+
 pub fn run(config: &BenchConfig, progress: &mut dyn FnMut(&str)) -> Result<StressReport, String> {
-    let scenes = load_scenes(&config.scenes_dir, &config.only)?;
+    let scenes = stress_scenes(config)?;
+    let mut kinds = RehitCount::default();
     let settings = RenderSettings {
         spp: Some(STRESS_SPP),
         width: Some(config.width),
@@ -119,6 +176,8 @@ pub fn run(config: &BenchConfig, progress: &mut dyn FnMut(&str)) -> Result<Stres
     let mut rows = Vec::new();
     for scene in &scenes {
         let base = render_measured(&scene.job, &settings)?;
+        let base_rehits = count_rehits(&scene.job, &settings)?;
+        kinds.add(&base_rehits);
         rows.push(StressRow {
             scene: scene.name.clone(),
             change: "none".into(),
@@ -126,10 +185,14 @@ pub fn run(config: &BenchConfig, progress: &mut dyn FnMut(&str)) -> Result<Stres
             nonfinite: nonfinite(&base.hdr),
             dropped: base.dropped,
             cpu_s: base.cpu_s,
+            spawned: base_rehits.spawned(),
+            rehits: base_rehits.rehits(),
         });
         for change in CHANGES {
             let job = transform_job(&scene.job, &change.transform());
             let t = render_measured(&job, &settings)?;
+            let rehits = count_rehits(&job, &settings)?;
+            kinds.add(&rehits);
             let row = StressRow {
                 scene: scene.name.clone(),
                 change: change.label(),
@@ -137,10 +200,12 @@ pub fn run(config: &BenchConfig, progress: &mut dyn FnMut(&str)) -> Result<Stres
                 nonfinite: nonfinite(&t.hdr),
                 dropped: t.dropped,
                 cpu_s: t.cpu_s,
+                spawned: rehits.spawned(),
+                rehits: rehits.rehits(),
             };
             progress(&format!(
-                "{}: {} — {:.2} % within 1 LSB, {} non-finite, {} dropped",
-                row.scene, row.change, row.pct_within_1lsb, row.nonfinite, row.dropped
+                "{}: {} — {:.2} % within 1 LSB, {} non-finite, {} dropped, {} re-hits in {} spawned rays",
+                row.scene, row.change, row.pct_within_1lsb, row.nonfinite, row.dropped, row.rehits, row.spawned
             ));
             rows.push(row);
         }
@@ -150,18 +215,27 @@ pub fn run(config: &BenchConfig, progress: &mut dyn FnMut(&str)) -> Result<Stres
         height: config.height,
         spp: STRESS_SPP,
         rows,
+        kinds,
     })
 }
 
-pub const CSV_HEADER: &str = "scene,change,pct_within_1lsb,nonfinite_pixels,dropped_shapes,cpu_s";
+pub const CSV_HEADER: &str =
+    "scene,change,pct_within_1lsb,nonfinite_pixels,dropped_shapes,cpu_s,spawned_rays,rehits";
 
 pub fn csv(report: &StressReport) -> String {
     let mut out = format!("{CSV_HEADER}\n");
     for r in &report.rows {
         let _ = writeln!(
             out,
-            "{},{},{:.4},{},{},{:.6}",
-            r.scene, r.change, r.pct_within_1lsb, r.nonfinite, r.dropped, r.cpu_s
+            "{},{},{:.4},{},{},{:.6},{},{}",
+            r.scene,
+            r.change,
+            r.pct_within_1lsb,
+            r.nonfinite,
+            r.dropped,
+            r.cpu_s,
+            r.spawned,
+            r.rehits
         );
     }
     out
@@ -169,15 +243,26 @@ pub fn csv(report: &StressReport) -> String {
 
 pub fn markdown(report: &StressReport) -> String {
     let mut out = format!(
-        "# anim bench --stress: the whole scene scaled and moved\n\n{}×{}, {} spp. Each render is compared with the unchanged scene's (8-bit, after tone mapping). Non-finite: pixels of the HDR buffer with a NaN or infinite channel. Dropped: shapes degenerate in f32 once transformed, left out.\n\n| scene | change | % within 1 LSB | non-finite | dropped | CPU s |\n|---|---|---:|---:|---:|---:|\n",
+        "# anim bench --stress: the whole scene scaled and moved\n\n{}×{}, {} spp. Each render is compared with the unchanged scene's (8-bit, after tone mapping). Non-finite: pixels of the HDR buffer with a NaN or infinite channel. Dropped: shapes degenerate in f32 once transformed, left out. Spawned: rays leaving a surface hit of a walk over the pixel centres (shadow, mirror, refracted and two random directions per hit, to the depth limit); re-hits: those meeting the primitive they left where exact arithmetic cannot (again, after leaving a flat or convex shape outwards; entering it, after leaving inwards), per million spawned.\n\n| scene | change | % within 1 LSB | non-finite | dropped | spawned | re-hits per M | CPU s |\n|---|---|---:|---:|---:|---:|---:|---:|\n",
         report.width, report.height, report.spp
     );
     for r in &report.rows {
         let _ = writeln!(
             out,
-            "| {} | {} | {:.2} | {} | {} | {:.3} |",
-            r.scene, r.change, r.pct_within_1lsb, r.nonfinite, r.dropped, r.cpu_s
+            "| {} | {} | {:.2} | {} | {} | {} | {:.2} | {:.3} |",
+            r.scene,
+            r.change,
+            r.pct_within_1lsb,
+            r.nonfinite,
+            r.dropped,
+            r.spawned,
+            r.rehits_per_million(),
+            r.cpu_s
         );
+    }
+    out.push_str("\nSpawned rays and re-hits per primitive kind, all rows together:\n\n| primitive | spawned | re-hits |\n|---|---:|---:|\n");
+    for (name, (spawned, rehits)) in KINDS.iter().zip(report.kinds.by_kind.iter()) {
+        let _ = writeln!(out, "| {name} | {spawned} | {rehits} |");
     }
     out
 }

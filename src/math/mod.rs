@@ -41,8 +41,15 @@ impl Ray {
 /// surface 2 % of its radius from the contact point (`contact_shadows_reach_the_resting_sphere`),
 /// so contact shadows stay closed. Hence left as it is.
 const ORIGIN_ERROR_SCALE: f32 = 1.0 / 4096.0 * (1.0 / 32.0);
-/// Floor for points near the origin, where a relative bound would collapse to nothing.
-const ORIGIN_ERROR_FLOOR: f32 = 1.0 / 65536.0 / 1024.0;
+/// Floor for points at the origin itself, where a relative bound would be exactly zero.
+/// Rendering is camera-relative (the eye at the origin), so `|p|` is about the distance from
+/// the eye and the relative bound is right for every visible point; a fixed floor of any
+/// size in world units would break scale invariance (`anim bench --stress`): the earlier
+/// 2⁻²⁶ outweighed the relative bound in a scene scaled by 1e-4, so contact shadows and
+/// acute cone rims saw an offset 3× too long (99.88 % of pixels within 1 LSB, and re-hits at
+/// the rims of non-uniformly scaled cones). 2⁻¹⁰⁰ stays far above f32's smallest normal
+/// number and below any coordinate a scene can hold.
+const ORIGIN_ERROR_FLOOR: f32 = 7.888_609e-31;
 
 /// Origin for a ray leaving surface point `p` with geometric normal `n` in direction `dir`:
 /// pushed to the side of the surface that `dir` points into. The only place in the renderer

@@ -5,7 +5,7 @@ use super::primitive::{Primitive, SurfaceHit};
 use crate::accel::Bvh;
 use crate::math::Ray;
 use crate::scene::{Material, Scene};
-use crate::shape::{ShapeHit, Sphere, SphereRay};
+use crate::shape::{Shape, ShapeHit, Sphere, SphereRay};
 use glam::{Vec3A, Vec4};
 
 #[derive(Clone, Debug)]
@@ -190,6 +190,15 @@ impl RenderScene {
     #[inline(always)]
     pub fn material_of(&self, i: u32) -> u32 {
         self.material[i as usize]
+    }
+
+    /// The object-space shape of primitive `i`, or `None` for a packed world-space sphere
+    /// (for tools that report by kind of shape).
+    pub fn object_shape(&self, i: u32) -> Option<&Shape> {
+        match self.kind[i as usize] {
+            SPHERE => None,
+            k => Some(&self.objects[k as usize].shape),
+        }
     }
 
     #[inline]

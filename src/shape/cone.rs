@@ -147,6 +147,17 @@ impl Cone {
             Part::Cap { .. } if rho >= r - band => rim,
             Part::Cap { z, sign } => (DVec3::new(p.x, p.y, z), DVec3::new(0.0, 0.0, sign)),
         };
+        // A hit snapped onto the rim or the apex keeps the edge's normal only while it tells
+        // the crossing right: see `AxisFrame::crossing_normal`.
+        let origin = o - d * l.t_shift;
+        let inside = origin.x * origin.x + origin.y * origin.y < k2 * origin.z * origin.z
+            && origin.z > 0.0
+            && origin.z < h;
+        let face = match part {
+            Part::Side => side_normal,
+            Part::Cap { sign, .. } => DVec3::new(0.0, 0.0, sign),
+        };
+        let normal = AxisFrame::crossing_normal(normal, face, d, inside);
         self.frame.shape_hit(t, local, normal)
     }
 }
@@ -429,5 +440,38 @@ mod tests {
         assert!(Cone::new(o, Vec3A::Y, -2.0).is_none());
         assert!(Cone::new(o, Vec3A::new(f32::NAN, 1.0, 0.0), 1.0).is_none());
         assert!(Cone::new(o, Vec3A::Y, f32::INFINITY).is_none());
+    }
+
+    #[test]
+    fn a_ray_leaving_the_apex_outside_the_cone_does_not_meet_it_again() {
+        use crate::math::spawn_ray;
+        let c = unit();
+        let h = c
+            .intersect(
+                &Ray::new(Vec3A::new(0.0, 5.0, 0.0), -Vec3A::Y),
+                f32::INFINITY,
+            )
+            .unwrap();
+        assert!(close(h.point, Vec3A::new(0.0, 2.0, 0.0)));
+        // Below the apex's supporting plane (into the solid by its normal +y) but outside the
+        // cone's half-angle of atan(1/2): it leaves at once.
+        for dir in [
+            Vec3A::new(1.0, -0.2, 0.0),
+            Vec3A::new(-0.3, -0.1, 0.9),
+            Vec3A::new(0.7, -0.3, -0.7),
+        ] {
+            let dir = dir.normalize();
+            assert!(h.normal.dot(dir) < 0.0);
+            let again = c.intersect(&spawn_ray(h.point, h.normal, dir), f32::INFINITY);
+            // It may cross the face it leaves through a few offsets on (its origin is inside),
+            // but as an exit, never as an entry of the surface it left.
+            assert!(
+                again.is_none_or(|e| e.normal.dot(dir) > 0.0),
+                "{dir:?}: {again:?}"
+            );
+        }
+        // Down the axis it goes through the solid to the base.
+        let down = c.intersect(&spawn_ray(h.point, h.normal, -Vec3A::Y), f32::INFINITY);
+        assert!(down.is_some_and(|e| (e.t - 2.0).abs() < 1e-4), "{down:?}");
     }
 }

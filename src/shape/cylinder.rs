@@ -122,6 +122,26 @@ impl AxisFrame {
         (2.0 * offset + rounding).min(0.25 * smallest)
     }
 
+    /// The normal to report for a hit whose normal is `normal` (the halfway normal of an edge
+    /// it was snapped onto, or a face's own), on the face whose outward normal is `face`, by a
+    /// ray of local direction `d` whose origin is `inside` the solid or not.
+    ///
+    /// Why: the sign of `normal · d` is how the renderer tells an exit from an entry. A ray
+    /// leaving an edge into the solid by the halfway normal but out of it through one face
+    /// (exact arithmetic sees it leave at once) starts just inside and crosses that face a few
+    /// offsets on; snapped back onto the edge, the halfway normal called that exit an entry,
+    /// a re-hit of the surface it left (`anim bench --stress` counts them). A ray from inside
+    /// exits and one from outside enters; when the halfway normal says otherwise, the face's
+    /// own normal (which the crossing agrees with) is reported.
+    pub fn crossing_normal(normal: DVec3, face: DVec3, d: DVec3, inside: bool) -> DVec3 {
+        let exits = normal.dot(d) > 0.0;
+        if exits != inside && (face.dot(d) > 0.0) == inside {
+            face
+        } else {
+            normal
+        }
+    }
+
     /// World-space box around the disc of `radius` centred at local height `z`, perpendicular
     /// to the axis: along world axis i the disc reaches `radius·√(1 − w_i²)`.
     pub fn disc_bounds(&self, z: f64, radius: f64) -> (DVec3, DVec3) {
@@ -315,6 +335,16 @@ impl Cylinder {
             Part::Cap { z, sign } if rho >= r - band => rim(z, sign),
             Part::Cap { z, sign } => (DVec3::new(p.x, p.y, z), DVec3::new(0.0, 0.0, sign)),
         };
+        // A hit snapped onto a rim keeps the halfway normal only while it tells the crossing
+        // right: see `AxisFrame::crossing_normal`.
+        let origin = o - d * l.t_shift;
+        let inside =
+            origin.x * origin.x + origin.y * origin.y < r2 && origin.z > 0.0 && origin.z < h;
+        let face = match part {
+            Part::Side => DVec3::new(cx, cy, 0.0),
+            Part::Cap { sign, .. } => DVec3::new(0.0, 0.0, sign),
+        };
+        let normal = AxisFrame::crossing_normal(normal, face, d, inside);
         self.frame.shape_hit(t, local, normal)
     }
 }
@@ -498,5 +528,43 @@ mod tests {
         let far = Vec3A::splat(1.0e6);
         assert!(Cylinder::new(far, far + Vec3A::X * 0.25, 1.0).is_none());
         assert!(Cylinder::new(far, far + Vec3A::X, 1.0).is_some());
+    }
+
+    #[test]
+    fn a_ray_leaving_the_rim_through_the_side_does_not_meet_it_again() {
+        use crate::math::spawn_ray;
+        let c = unit();
+        let h = c
+            .intersect(
+                &Ray::new(Vec3A::new(3.0, 4.0, 0.0), Vec3A::new(-1.0, -1.0, 0.0)),
+                f32::INFINITY,
+            )
+            .unwrap();
+        // Into the solid by the halfway normal (1, 1, 0)/√2, but out through the side (x > 0
+        // component): it leaves at once. Snapped back onto the rim, its crossing of the
+        // side a few offsets on used to carry the halfway normal and so read as an entry.
+        for dir in [
+            Vec3A::new(0.3, -0.9, 0.3),
+            Vec3A::new(0.05, -1.0, 0.6),
+            Vec3A::new(0.01, -0.2, -1.0),
+        ] {
+            let dir = dir.normalize();
+            assert!(h.normal.dot(dir) < 0.0);
+            let again = c.intersect(&spawn_ray(h.point, h.normal, dir), f32::INFINITY);
+            // It may cross the face it leaves through a few offsets on (its origin is inside),
+            // but as an exit, never as an entry of the surface it left.
+            assert!(
+                again.is_none_or(|e| e.normal.dot(dir) > 0.0),
+                "{dir:?}: {again:?}"
+            );
+        }
+        // A ray arriving at the rim from outside still hits it, as an entry.
+        let floor = Ray::new(
+            Vec3A::new(1.0 + 1e-3, 1e-6, 0.0),
+            Vec3A::new(-1.0, 0.5, 0.0).normalize(),
+        );
+        assert!(c
+            .intersect(&floor, f32::INFINITY)
+            .is_some_and(|e| e.normal.dot(floor.dir) < 0.0));
     }
 }
