@@ -7,6 +7,8 @@ mod build;
 mod load;
 pub mod probe;
 #[cfg(test)]
+mod scale_tests;
+#[cfg(test)]
 mod tests;
 
 pub use crate::shape::Geometry;
