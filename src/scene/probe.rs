@@ -2,15 +2,16 @@
 //! (32×18 primary rays for a 16:9 image, one shadow ray per light, a few mirror bounces) tells whether the
 //! image would be all background or all black, and why.
 //!
-//! The probe lives in `scene` and uses only `shape` and `math` (the layering forbids
+//! The probe lives in `scene` and uses only `shape`, `accel` and `math` (the layering forbids
 //! `render` here), so it rebuilds the pinhole camera of `render::camera` (the same formula:
 //! horizontal field of view, image plane at `(w/2)/tan(fov/2)` pixels) and intersects the
-//! instances one by one. It only has to be right about "nothing at all would show", so it
+//! instances through its own hierarchy of their world bounds. It only has to be right about "nothing at all would show", so it
 //! shades with Phong terms but without refraction.
 
 use super::{load_file, Camera, Instance, Material, RenderJob, Scene};
+use crate::accel::Bvh;
 use crate::diag::{Diagnostic, Loc, Severity};
-use crate::math::{reflect, spawn_ray, Ray, Transform};
+use crate::math::{reflect, spawn_ray, Aabb, Ray, Transform};
 use crate::sdf::LoadOptions;
 use crate::shape::{AaBox, Cone, Cylinder, Geometry, Plane, Shape, Sphere, Triangle};
 use glam::{DVec3, Vec3, Vec3A};
@@ -22,8 +23,10 @@ use std::sync::Arc;
 /// below one real sample per pixel.
 pub const PROBE_WIDTH: u32 = 32;
 
-/// Ray–shape tests the probe may spend on primary rays (each also costs shadow rays): it
-/// tests every shape for every ray, so a huge scene would cost more than its render.
+/// Shapes × primary rays beyond which the probe is skipped (about 35 000 shapes at 16:9). The
+/// rays are cheap through the probe's hierarchy, but placing every shape (a copy of each, and
+/// its bounds) is not: for a huge generated scene it would cost memory and time the render
+/// needs, and the "nothing at all would show" question stays cheap to get wrong there.
 const PROBE_BUDGET: usize = 20_000_000;
 
 /// Mirror and see-through bounces the probe follows.
@@ -107,6 +110,27 @@ fn perfect_mirror(m: &Material) -> bool {
 struct Probe<'s> {
     scene: &'s Scene,
     placed: Vec<Placed<'s>>,
+    /// Over the placed shapes with finite bounds: without it every probe ray tests every
+    /// shape, which on a scene of 10k spheres cost more than rendering it.
+    bvh: Bvh,
+    /// Placed shapes without finite bounds (planes), tested on every ray.
+    unbounded: Vec<u32>,
+}
+
+/// World bounds of a placed shape (infinite for planes), widened by a relative margin so
+/// that the f32 rounding of the object-space intersection never falls outside them.
+fn world_bounds(shape: &Shape, xf: &Transform) -> Aabb {
+    let local = shape.bounds();
+    if !local.is_finite() {
+        return local;
+    }
+    let b = Aabb::from_points(
+        local
+            .corners()
+            .map(|c| v(xf.world_from_object.transform_point3(c.as_dvec3()))),
+    );
+    let margin = (b.extent() + b.min.abs().max(b.max.abs())) * 1e-5;
+    Aabb::new(b.min - margin, b.max + margin)
 }
 
 impl<'s> Probe<'s> {
@@ -129,39 +153,63 @@ impl<'s> Probe<'s> {
                     closed,
                 })
             })
+            .collect::<Vec<_>>();
+        let bounds: Vec<Aabb> = placed
+            .iter()
+            .map(|p| world_bounds(&p.shape, p.transform))
             .collect();
-        Probe { scene, placed }
+        let (bounded, unbounded): (Vec<u32>, Vec<u32>) =
+            (0..placed.len() as u32).partition(|&i| bounds[i as usize].is_finite());
+        let bvh = Bvh::build(&bounds, bounded);
+        Probe {
+            scene,
+            placed,
+            bvh,
+            unbounded,
+        }
+    }
+
+    /// The hit of placed shape `i` if it draws something and is met before `t_max`.
+    fn hit_of(&self, i: u32, ray: &Ray, t_max: f32) -> Option<Hit<'_, 's>> {
+        let p = &self.placed[i as usize];
+        if invisible(p.material) {
+            return None;
+        }
+        let xf = p.transform;
+        let origin = xf.object_from_world.transform_point3(ray.origin.as_dvec3());
+        let dir = xf.object_from_world.transform_vector3(ray.dir.as_dvec3());
+        let h = p.shape.intersect(&Ray::new(v(origin), v(dir)), t_max)?;
+        let n = (xf.normal_matrix() * h.normal.as_dvec3()).normalize_or_zero();
+        let mut normal = v(n);
+        let back_face = normal.dot(ray.dir) > 0.0;
+        if back_face {
+            normal = -normal;
+        }
+        Some(Hit {
+            placed: p,
+            t: h.t,
+            point: ray.at(h.t),
+            normal,
+            back_face,
+        })
     }
 
     /// The nearest hit with a shape that draws something.
     fn nearest(&self, ray: &Ray, t_max: f32) -> Option<Hit<'_, 's>> {
         let mut best: Option<Hit> = None;
-        for p in &self.placed {
-            if invisible(p.material) {
-                continue;
-            }
-            let xf = p.transform;
-            let origin = xf.object_from_world.transform_point3(ray.origin.as_dvec3());
-            let dir = xf.object_from_world.transform_vector3(ray.dir.as_dvec3());
-            let local = Ray::new(v(origin), v(dir));
+        for &i in &self.unbounded {
             let limit = best.as_ref().map_or(t_max, |b| b.t);
-            let Some(h) = p.shape.intersect(&local, limit) else {
-                continue;
-            };
-            let n = (xf.normal_matrix() * h.normal.as_dvec3()).normalize_or_zero();
-            let mut normal = v(n);
-            let back_face = normal.dot(ray.dir) > 0.0;
-            if back_face {
-                normal = -normal;
+            if let Some(h) = self.hit_of(i, ray, limit) {
+                best = Some(h);
             }
-            best = Some(Hit {
-                placed: p,
-                t: h.t,
-                point: ray.at(h.t),
-                normal,
-                back_face,
-            });
         }
+        let limit = best.as_ref().map_or(t_max, |b| b.t);
+        self.bvh.closest(ray, limit, |i, t_max| {
+            let h = self.hit_of(i, ray, t_max)?;
+            let t = h.t;
+            best = Some(h);
+            Some(t)
+        });
         best
     }
 
@@ -459,6 +507,21 @@ mod tests {
     fn no_lights_and_no_ambient() {
         let text = format!("{MAT}define shape sphere s 0 0 -5 1 red\n{CAM}");
         assert!(probe(&text).unwrap().contains("no lights and no ambient"));
+    }
+
+    #[test]
+    fn one_small_sphere_among_many_behind_the_camera_is_seen() {
+        // Through the hierarchy: 2000 shapes behind the eye, one in front near the image's
+        // corner; the probe must find that one, and say "behind" once it is moved back too.
+        let mut text = format!("{MAT}define light l 0 5 0 1 1 1 1\n");
+        for k in 0..2000 {
+            let (x, y) = ((k % 50) as f64 - 25.0, (k / 50) as f64 - 20.0);
+            text += &format!("define shape sphere b{k} {x} {y} 10 0.3 red\n");
+        }
+        let front = |z: f64| format!("define shape sphere f -2.5 1.2 {z} 0.4 red\n");
+        assert_eq!(probe(&format!("{text}{}{CAM}", front(-6.0))), None);
+        let reason = probe(&format!("{text}{}{CAM}", front(6.0))).unwrap();
+        assert!(reason.contains("behind"), "{reason}");
     }
 
     #[test]
