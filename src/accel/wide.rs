@@ -8,6 +8,7 @@
 
 use super::binary::{BinaryBvh, MAX_DEPTH, PARALLEL_MIN};
 use crate::math::{Aabb, Ray, SLAB_WIDEN};
+use arrayvec::ArrayVec;
 use glam::Vec4;
 
 const WIDTH: usize = 4;
@@ -277,12 +278,11 @@ impl Bvh {
             | usize::from(ray.dir.z < 0.0) << 2;
         // Entries carry their box's entry distance: one that lies beyond a hit found since it
         // was pushed is dropped without touching its node.
-        let mut stack = [(0u32, 0.0f32); STACK_SIZE];
-        stack[0] = (0, f32::NEG_INFINITY);
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let (reference, enter) = stack[top];
+        // Not zero-filled: clearing a whole fixed-size stack per ray cost about 5 % of the
+        // render time (perf, 10k-sphere grid).
+        let mut stack: ArrayVec<(u32, f32), STACK_SIZE> = ArrayVec::new();
+        stack.push((0, f32::NEG_INFINITY));
+        while let Some((reference, enter)) = stack.pop() {
             if enter > t_max {
                 continue;
             }
@@ -301,8 +301,7 @@ impl Bvh {
             for k in (0..node.len).rev() {
                 let slot = usize::from((order >> (2 * k)) & 3);
                 if mask & (1 << slot) != 0 {
-                    stack[top] = (node.child[slot], enter[slot]);
-                    top += 1;
+                    stack.push((node.child[slot], enter[slot]));
                 }
             }
         }
@@ -348,11 +347,9 @@ impl Bvh {
         let octant = usize::from(ray.dir.x < 0.0)
             | usize::from(ray.dir.y < 0.0) << 1
             | usize::from(ray.dir.z < 0.0) << 2;
-        let mut stack = [0u32; STACK_SIZE];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let reference = stack[top];
+        let mut stack: ArrayVec<u32, STACK_SIZE> = ArrayVec::new();
+        stack.push(0);
+        while let Some(reference) = stack.pop() {
             if reference & LEAF != 0 {
                 if occludes(self.leaf(reference)) {
                     return true;
@@ -372,8 +369,7 @@ impl Bvh {
                     usize::from(k)
                 };
                 if mask & (1 << slot) != 0 {
-                    stack[top] = node.child[slot];
-                    top += 1;
+                    stack.push(node.child[slot]);
                 }
             }
         }
