@@ -6,19 +6,6 @@ mod common;
 use common::*;
 use std::path::Path;
 
-type V = [f64; 3];
-
-fn sub(a: V, b: V) -> V {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: V, b: V) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn unit(a: V) -> V {
-    let l = dot(a, a).sqrt();
-    [a[0] / l, a[1] / l, a[2] / l]
-}
-
 /// `Ka·I_a + I·(Kd·max(N·L,0) + Ks·max(R·V,0)^m)` for the material and the one unshadowed
 /// light of [`HEAD`] (docs/shading.md §2).
 fn phong(p: V, n: V, v: V) -> [u8; 3] {

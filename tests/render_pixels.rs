@@ -4,19 +4,6 @@
 mod common;
 use common::*;
 
-type V = [f64; 3];
-
-fn sub(a: V, b: V) -> V {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: V, b: V) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn unit(a: V) -> V {
-    let l = dot(a, a).sqrt();
-    [a[0] / l, a[1] / l, a[2] / l]
-}
-
 const SPHERE_SCENE: &str = "\
 define material m 0.1 0.2 0.3 0.5 0.4 0.3 0.3 0.3 0.3 10
 define material floor 0.2 0.3 0.44 0.6 0.6 0.6 0 0 0 1

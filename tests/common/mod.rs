@@ -144,3 +144,19 @@ pub fn files_below(dir: &Path, out: &mut Vec<PathBuf>) {
         }
     }
 }
+
+/// A vector in f64, for expected values worked out from the formulas of docs/shading.md.
+pub type V = [f64; 3];
+
+pub fn sub(a: V, b: V) -> V {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub fn dot(a: V, b: V) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+pub fn unit(a: V) -> V {
+    let l = dot(a, a).sqrt();
+    [a[0] / l, a[1] / l, a[2] / l]
+}
