@@ -69,6 +69,27 @@ fn random_ray(rng: &mut Rng, i: usize) -> Ray {
     Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(dir.as_vec3()))
 }
 
+/// Every third ray is bounded, so that the `t_max` paths are exercised too.
+fn t_limit_of(i: usize) -> f32 {
+    if i.is_multiple_of(3) {
+        40.0
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// The nearest hit by testing every primitive in order (the first of equal distances wins).
+fn brute_closest(prims: &[Primitive], ray: &Ray, t_limit: f32) -> Option<(usize, f32)> {
+    let mut best: Option<(usize, f32)> = None;
+    for (k, p) in prims.iter().enumerate() {
+        let t_max = best.map_or(t_limit, |(_, t)| t);
+        if let Some(h) = p.hit(ray, t_max) {
+            best = Some((k, h.t));
+        }
+    }
+    best
+}
+
 #[test]
 fn wide_bvh_equals_brute_force_on_random_scenes() {
     let mut rng = Rng(0x853C49E6748FEA9B);
@@ -79,18 +100,8 @@ fn wide_bvh_equals_brute_force_on_random_scenes() {
         let mut hits = 0;
         for i in 0..4000 {
             let ray = random_ray(&mut rng, i);
-            let t_limit = if i.is_multiple_of(3) {
-                40.0
-            } else {
-                f32::INFINITY
-            };
-            let mut brute: Option<(u32, f32)> = None;
-            for (k, p) in prims.iter().enumerate() {
-                let t_max = brute.map_or(t_limit, |(_, t)| t);
-                if let Some(h) = p.hit(&ray, t_max) {
-                    brute = Some((k as u32, h.t));
-                }
-            }
+            let t_limit = t_limit_of(i);
+            let brute = brute_closest(&prims, &ray, t_limit).map(|(k, t)| (k as u32, t));
             let mut found: Option<(u32, f32)> = None;
             let t = bvh.closest(&ray, t_limit, |k, t_max| {
                 let h = prims[k as usize].hit(&ray, t_max)?;
@@ -218,18 +229,8 @@ fn render_scene_equals_brute_force_on_mixed_scenes() {
         let mut hits = 0;
         for i in 0..4000 {
             let ray = random_ray(&mut rng, i);
-            let t_limit = if i.is_multiple_of(3) {
-                40.0
-            } else {
-                f32::INFINITY
-            };
-            let mut brute: Option<(usize, f32)> = None;
-            for (k, p) in prims.iter().enumerate() {
-                let t_max = brute.map_or(t_limit, |(_, t)| t);
-                if let Some(h) = p.hit(&ray, t_max) {
-                    brute = Some((k, h.t));
-                }
-            }
+            let t_limit = t_limit_of(i);
+            let brute = brute_closest(&prims, &ray, t_limit);
             let found = render.closest(&ray, t_limit);
             assert_eq!(
                 brute.map(|(_, t)| t.to_bits()),

@@ -9,18 +9,15 @@ use anim::scene::load_file;
 use anim::sdf::LoadOptions;
 use std::path::{Path, PathBuf};
 
+/// Scene files below `dir`: `.sdf`, `.txt` and files without an extension (as the corpus
+/// names them).
 fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries.flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            scene_files(&path, out);
-        } else if path.extension().is_none_or(|e| e == "sdf" || e == "txt") {
-            out.push(path);
-        }
-    }
+    let mut all = Vec::new();
+    common::files_below(dir, &mut all);
+    out.extend(
+        all.into_iter()
+            .filter(|p| p.extension().is_none_or(|e| e == "sdf" || e == "txt")),
+    );
 }
 
 #[test]
