@@ -97,7 +97,7 @@ pub fn build(
     path: &Path,
     opts: &LoadOptions,
 ) -> Result<Loaded, Vec<Diagnostic>> {
-    let (jobs, diagnostics) = build_jobs(statements, path, opts, None);
+    let (jobs, diagnostics) = build_jobs(statements, Default::default(), path, opts, None);
     conclude(jobs, finish_diagnostics(diagnostics, opts), path, || None)
 }
 
@@ -109,6 +109,18 @@ pub fn load_str(text: &str, path: &Path, opts: &LoadOptions) -> Result<Loaded, V
     finish_load(parsed, path, opts, || Some(Cow::Borrowed(text)))
 }
 
+/// [`load_str`] with the shapes of a flat file read as statements: what the compact form of
+/// `sdf::ast::FlatShapes` must give the same result as.
+#[cfg(test)]
+pub(super) fn load_str_whole(
+    text: &str,
+    path: &Path,
+    opts: &LoadOptions,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    let parsed = sdf::parse_source_whole(text, path, opts);
+    finish_load(parsed, path, opts, || Some(Cow::Borrowed(text)))
+}
+
 /// Builds the jobs of a parsed file; `text` gives the file's text again for quoting.
 fn finish_load<'t>(
     parsed: sdf::Parsed,
@@ -116,7 +128,13 @@ fn finish_load<'t>(
     opts: &LoadOptions,
     text: impl FnOnce() -> Option<Cow<'t, str>>,
 ) -> Result<Loaded, Vec<Diagnostic>> {
-    let (jobs, built) = build_jobs(&parsed.statements, path, opts, Some(&parsed.omissions));
+    let (jobs, built) = build_jobs(
+        &parsed.statements,
+        parsed.shapes,
+        path,
+        opts,
+        Some(&parsed.omissions),
+    );
     // The statements are no longer needed once the jobs hold the scenes: freed before the
     // images are made.
     drop(parsed.statements);
