@@ -124,7 +124,12 @@ impl FlatShapes {
     }
 
     fn material_id(&mut self, name: &str) -> u32 {
-        if let Some(&id) = self.material_ids.get(name) {
+        // Files use few materials: comparing names is then faster than hashing them.
+        if self.materials.len() <= 8 {
+            if let Some(id) = self.materials.iter().position(|m| m == name) {
+                return id as u32;
+            }
+        } else if let Some(&id) = self.material_ids.get(name) {
             return id;
         }
         let id = self.materials.len() as u32;
@@ -205,6 +210,11 @@ impl FlatShapes {
     /// The shapes, in file order.
     pub fn iter(&self) -> impl Iterator<Item = &FlatShape> {
         self.chunks.iter().flatten()
+    }
+
+    /// The shapes in file order, a chunk at a time.
+    pub fn chunks(&self) -> impl Iterator<Item = &[FlatShape]> {
+        self.chunks.iter().map(Vec::as_slice)
     }
 
     /// Shape `k` (from 0, in file order).

@@ -82,36 +82,35 @@ pub fn each_line<'t>(text: &'t str, mut f: impl FnMut(&Line<'t>)) {
 fn scan_line<'t>(rest: &'t str, tokens: &mut Vec<Token<'t>>) -> (usize, usize) {
     tokens.clear();
     let bytes = rest.as_bytes();
-    let push = |tokens: &mut Vec<Token<'t>>, start: usize, end: usize| {
-        // Past the cap the rest is not kept (see `overlong`, by which the line is reported).
-        if tokens.len() < crate::limits::MAX_TOKENS_PER_LINE {
+    let class = |i: usize| bytes.get(i).map_or(END, |&b| BYTE_CLASS[usize::from(b)]);
+    let mut i = 0;
+    loop {
+        while class(i) == SPACE {
+            i += 1;
+        }
+        let start = i;
+        while class(i) == WORD {
+            i += 1;
+        }
+        if i > start && tokens.len() < crate::limits::MAX_TOKENS_PER_LINE {
+            // Past the cap the rest is not kept (see `overlong`, by which the line is
+            // reported).
             tokens.push(Token {
-                text: &rest[start..end],
+                text: &rest[start..i],
                 col: u32::try_from(start + 1).unwrap_or(u32::MAX),
-                width: u32::try_from(end - start).unwrap_or(u32::MAX),
+                width: u32::try_from(i - start).unwrap_or(u32::MAX),
             });
         }
-    };
-    let mut start: Option<usize> = None;
-    let mut code = true;
-    let mut i = 0;
-    while i < bytes.len() {
-        match bytes[i] {
-            b'\n' | b'\r' => break,
-            _ if !code => {}
-            // The whitespace of ASCII as `char::is_whitespace` knows it.
-            b' ' | b'\t' | 0x0b | 0x0c => {
-                if let Some(s) = start.take() {
-                    push(tokens, s, i);
+        match class(i) {
+            SPACE | WORD => {}
+            HASH => {
+                // A comment: the rest of the line is skipped, whatever it holds.
+                while !matches!(class(i), NEWLINE | END) {
+                    i += 1;
                 }
+                break;
             }
-            b'#' => {
-                if let Some(s) = start.take() {
-                    push(tokens, s, i);
-                }
-                code = false;
-            }
-            0x80.. => {
+            BEYOND_ASCII => {
                 // A character beyond ASCII before any comment: columns count characters.
                 let end = bytes[i..]
                     .iter()
@@ -120,16 +119,8 @@ fn scan_line<'t>(rest: &'t str, tokens: &mut Vec<Token<'t>>) -> (usize, usize) {
                 tokenize_into(&rest[..end], tokens);
                 return (end, line_ending(bytes, end));
             }
-            _ => {
-                if start.is_none() {
-                    start = Some(i);
-                }
-            }
+            _ => break,
         }
-        i += 1;
-    }
-    if let Some(s) = start {
-        push(tokens, s, i);
     }
     // A line starting with `//` is a comment as a whole (`//define shape ...` included).
     if tokens.first().is_some_and(|t| t.text.starts_with("//")) {
@@ -137,6 +128,33 @@ fn scan_line<'t>(rest: &'t str, tokens: &mut Vec<Token<'t>>) -> (usize, usize) {
     }
     (i, line_ending(bytes, i))
 }
+
+/// Classes of bytes for [`scan_line`].
+const WORD: u8 = 0;
+/// The whitespace of ASCII as `char::is_whitespace` knows it, but for line endings.
+const SPACE: u8 = 1;
+const NEWLINE: u8 = 2;
+const HASH: u8 = 3;
+const BEYOND_ASCII: u8 = 4;
+/// Past the end of the text.
+const END: u8 = 5;
+
+const BYTE_CLASS: [u8; 256] = {
+    let mut class = [WORD; 256];
+    class[b' ' as usize] = SPACE;
+    class[b'\t' as usize] = SPACE;
+    class[0x0b] = SPACE;
+    class[0x0c] = SPACE;
+    class[b'\n' as usize] = NEWLINE;
+    class[b'\r' as usize] = NEWLINE;
+    class[b'#' as usize] = HASH;
+    let mut b = 0x80;
+    while b < 256 {
+        class[b] = BEYOND_ASCII;
+        b += 1;
+    }
+    class
+};
 
 /// The length of the line ending at byte `end`: CRLF, LF, a lone CR, or none at the end.
 fn line_ending(bytes: &[u8], end: usize) -> usize {
@@ -432,8 +450,10 @@ fn is_decimal(s: &str) -> bool {
 /// `nan`). Used to tell layouts apart, e.g. a material name written before the coordinates.
 pub fn looks_numeric(s: &str) -> bool {
     let unsigned = s.trim_start_matches(['+', '-']);
-    let lower = unsigned.to_ascii_lowercase();
-    if matches!(lower.as_str(), "nan" | "inf" | "infinity") {
+    if ["nan", "inf", "infinity"]
+        .iter()
+        .any(|w| unsigned.eq_ignore_ascii_case(w))
+    {
         return true;
     }
     let mut chars = unsigned.chars();

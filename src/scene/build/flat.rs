@@ -73,29 +73,39 @@ impl Builder<'_> {
         let mut first_root: Option<usize> = None;
         {
             let mut latest = NameTable::new(shapes.len());
-            for (k, s) in shapes.iter().enumerate() {
-                let name = shapes.name(s);
-                let earlier =
-                    latest.insert(name, k, |j| shapes.get(j).map_or("", |e| shapes.name(e)));
-                if let Some((earlier, earlier_line)) =
-                    earlier.and_then(|j| Some((j, shapes.get(j)?.line())))
-                {
-                    superseded[earlier] = true;
-                    let (loc, width) = shapes.name_place(s);
-                    self.warn(
-                        At::Place(&loc, width),
-                        format!(
-                            "shape `{name}` is already defined (line {earlier_line}); the later definition replaces it"
-                        ),
-                        None,
-                    );
-                }
-                let material = shapes.material_of(s);
-                if !shapes.material_defined_before(s)
-                    && d.material_index
-                        .contains_key(shapes.material_name(material))
-                {
-                    self.resolve_material(&d, &first_def, 0, &shapes.material_ref(s));
+            let mut hashes = Vec::new();
+            let mut k = 0;
+            for chunk in shapes.chunks() {
+                // The names of a chunk are hashed first: the table's slots, far apart in
+                // memory, are then looked up in a tight loop whose loads overlap.
+                hashes.clear();
+                hashes.extend(chunk.iter().map(|s| NameTable::hash(shapes.name(s))));
+                for (s, &hash) in chunk.iter().zip(&hashes) {
+                    let name = shapes.name(s);
+                    let earlier = latest.insert(hash, name, k, |j| {
+                        shapes.get(j).map_or("", |e| shapes.name(e))
+                    });
+                    k += 1;
+                    if let Some((earlier, earlier_line)) =
+                        earlier.and_then(|j| Some((j, shapes.get(j)?.line())))
+                    {
+                        superseded[earlier] = true;
+                        let (loc, width) = shapes.name_place(s);
+                        self.warn(
+                            At::Place(&loc, width),
+                            format!(
+                                "shape `{name}` is already defined (line {earlier_line}); the later definition replaces it"
+                            ),
+                            None,
+                        );
+                    }
+                    let material = shapes.material_of(s);
+                    if !shapes.material_defined_before(s)
+                        && d.material_index
+                            .contains_key(shapes.material_name(material))
+                    {
+                        self.resolve_material(&d, &first_def, 0, &shapes.material_ref(s));
+                    }
                 }
             }
         }
@@ -178,15 +188,20 @@ impl NameTable {
         }
     }
 
-    /// Records shape `k` (below 2^32 - 1) named `name`; the last shape recorded under the same
+    /// The hash of `name` to record it under.
+    fn hash(name: &str) -> u64 {
+        FastHash::default().hash_one(name)
+    }
+
+    /// Records shape `k` (below 2^32 - 1) named `name`, of hash [`NameTable::hash`]; the last shape recorded under the same
     /// name, if any. `name_of` gives the name of a shape recorded before.
     fn insert<'n>(
         &mut self,
+        hash: u64,
         name: &str,
         k: usize,
         name_of: impl Fn(usize) -> &'n str,
     ) -> Option<usize> {
-        let hash = FastHash::default().hash_one(name);
         let tag = hash >> 32;
         let entry = (tag << 32) | (k as u64 + 1);
         let mut i = hash as usize & self.mask;
@@ -219,15 +234,22 @@ mod tests {
         let earlier: Vec<Option<usize>> = names
             .iter()
             .enumerate()
-            .map(|(k, n)| t.insert(n, k, |j| names[j]))
+            .map(|(k, n)| t.insert(NameTable::hash(n), n, k, |j| names[j]))
             .collect();
         assert_eq!(earlier, [None, None, Some(0), None, Some(1), Some(2)]);
         // A full run of distinct names, more than the table's first guess of slots.
         let many: Vec<String> = (0..5000).map(|i| format!("s{i}")).collect();
         let mut t = NameTable::new(many.len());
         for (k, n) in many.iter().enumerate() {
-            assert_eq!(t.insert(n, k, |j| many[j].as_str()), None);
+            assert_eq!(
+                t.insert(NameTable::hash(n), n, k, |j| many[j].as_str()),
+                None
+            );
         }
-        assert_eq!(t.insert("s4999", 5000, |j| many[j].as_str()), Some(4999));
+        let hash = NameTable::hash("s4999");
+        assert_eq!(
+            t.insert(hash, "s4999", 5000, |j| many[j].as_str()),
+            Some(4999)
+        );
     }
 }
