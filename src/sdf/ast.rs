@@ -141,70 +141,62 @@ impl FlatShapes {
 
     /// Takes `stmt`, read after `pos` other statements, if it is a primitive shape whose
     /// places fit the compact form; else gives it back.
-    pub fn push(&mut self, stmt: Statement, pos: usize) -> Result<(), Statement> {
+    pub fn push(&mut self, stmt: Statement, pos: usize) -> Option<Statement> {
         let fits = |v: usize| u32::try_from(v).ok().filter(|&v| v < DEFINED_BEFORE);
-        let StatementKind::Shape {
-            name,
-            geometry,
-            material,
-        } = &stmt.kind
-        else {
-            return Err(stmt);
+        let (Some(name_start), Some(pos)) = (fits(self.names.len()), fits(pos)) else {
+            return Some(stmt);
         };
-        let Some(spans) = &stmt.spans else {
-            return Err(stmt);
+        let (name, geometry, material, loc, name_span) = match stmt {
+            Statement {
+                kind:
+                    StatementKind::Shape {
+                        name,
+                        geometry,
+                        material,
+                    },
+                loc,
+                spans:
+                    Some(StatementSpans {
+                        first_width: FIRST_WIDTH,
+                        name: Some(name_span),
+                    }),
+            } if !matches!(geometry, Geometry::Mesh(_))
+                && self.file.as_ref().is_none_or(|f| Arc::ptr_eq(f, &loc.file))
+                && fits(name.len()).is_some()
+                && name_span.width as usize == name.chars().count()
+                && material.loc.line == loc.line
+                && (self.materials.len() as u64) < u64::from(DEFINED_BEFORE) =>
+            {
+                (name, geometry, material, loc, name_span)
+            }
+            other => return Some(other),
         };
-        let same_file = self
-            .file
-            .as_ref()
-            .is_none_or(|f| Arc::ptr_eq(f, &stmt.loc.file));
-        let (Some(name_span), Some(name_start), Some(name_len), Some(pos)) = (
-            spans.name,
-            fits(self.names.len()),
-            fits(name.len()),
-            fits(pos),
-        ) else {
-            return Err(stmt);
-        };
-        if matches!(geometry, Geometry::Mesh(_))
-            || !same_file
-            || spans.first_width != FIRST_WIDTH
-            || name_span.width as usize != name.chars().count()
-            || material.loc.line != stmt.loc.line
-            || self.materials.len() as u64 >= u64::from(DEFINED_BEFORE)
-        {
-            return Err(stmt);
-        }
         let id = self.material_id(&material.name);
         let before = if self.material_defined[id as usize] {
             DEFINED_BEFORE
         } else {
             0
         };
-        self.names.push_str(name);
-        let material_col = material.loc.col;
-        let StatementKind::Shape { geometry, .. } = stmt.kind else {
-            unreachable!("matched above");
-        };
+        self.names.push_str(&name);
         let shape = FlatShape {
             geometry,
             name_start,
-            name_len,
+            name_len: name.len() as u32,
             material: id | before,
-            line: stmt.loc.line,
-            col: stmt.loc.col,
+            line: loc.line,
+            col: loc.col,
             name_col: name_span.col,
-            material_col,
+            material_col: material.loc.col,
             pos,
         };
-        self.file.get_or_insert(stmt.loc.file);
+        self.file.get_or_insert(loc.file);
         match self.chunks.last_mut() {
             Some(chunk) if chunk.len() < FLAT_CHUNK => chunk.push(shape),
             // The last chunk grows as a vector does: a small file holds no empty chunk.
             _ => self.chunks.push(vec![shape]),
         }
         self.len += 1;
-        Ok(())
+        None
     }
 
     /// The shapes, in file order.

@@ -379,7 +379,7 @@ impl Parser<'_> {
             self.statements.push(stmt);
             return;
         }
-        if let Err(stmt) = self.shapes.push(stmt, self.statements.len()) {
+        if let Some(stmt) = self.shapes.push(stmt, self.statements.len()) {
             self.flat &= !matches!(stmt.kind, StatementKind::Shape { .. });
             self.statements.push(stmt);
         }
