@@ -181,7 +181,6 @@ fn a_flat_sphere_costs_at_most_200_bytes_once_read() {
         parsed.omissions.skipped.capacity() * 32 + parsed.omissions.commented.capacity() * 40;
     let bytes = parsed.shapes.bytes() + statements + diagnostics + omissions;
     let per_sphere = bytes as f64 / n as f64;
-    println!("{per_sphere:.1} bytes per flat sphere once read");
     assert!(per_sphere <= 200.0, "{per_sphere:.1} bytes per sphere");
     // Not vacuous: the geometry alone is 80 bytes.
     assert!(per_sphere >= 80.0, "{per_sphere:.1} bytes per sphere");
