@@ -6,6 +6,8 @@
 #
 # Usage: scripts/bench-scale.sh [ANIM_BINARY] [COUNTS...]
 # Default binary: target/release/anim; default counts: 1000 10000 100000 1000000.
+# With READER=1, first the reader alone (the source tree's `anim::sdf::parse_source`, no scene
+# building) on a million-sphere file, in lines per CPU-second: an ignored test of tests/scale.rs.
 set -euo pipefail
 
 bin=${1:-target/release/anim}
@@ -13,6 +15,10 @@ shift || true
 counts=("$@")
 if [ ${#counts[@]} -eq 0 ]; then
     counts=(1000 10000 100000 1000000)
+fi
+if [ "${READER:-0}" = 1 ]; then
+    cargo test --release --test scale -- --ignored --nocapture the_reader_reads 2>&1 |
+        grep -E '^reader:|panicked|FAILED' || true
 fi
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
@@ -49,7 +55,7 @@ measure() { # label count command...
     read -r user sys kb <"$dir/time"
     awk -v l="$label" -v n="$n" -v u="$user" -v s="$sys" -v kb="$kb" -v lines="$((n + 6))" \
         'BEGIN { cpu = u + s; rate = "";
-                 if (l == "check") rate = sprintf("  %5.2f M lines/s", lines / (cpu > 0 ? cpu : 1e-9) / 1e6);
+                 if (l == "check") rate = cpu >= 0.01 ? sprintf("  %5.2f M lines/s", lines / cpu / 1e6) : "  (too fast to time)";
                  printf "%-7s %9d spheres  %7.2f CPU s  %8.1f MiB peak  %6.0f B/sphere%s\n",
                  l, n, cpu, kb / 1024, kb * 1024 / n, rate }'
 }

@@ -101,14 +101,16 @@ pub fn image_extensions_list() -> String {
         .join(", ")
 }
 
-/// Memory one shape of a scene costs from reading to rendering, in bytes: its statement, its
-/// instance and its share of the render scene and its BVH. A scene whose shapes would need more
-/// than the memory budget (`--max-memory`, else [`default_memory_budget`]) is refused before
-/// it is built: a composite tree that multiplies out of all proportion (each level listing
-/// the one below twice) is refused from its counts, and a flat file from its size.
-/// Measured with scripts/bench-scale.sh (peak RSS of `anim render --spp 1` on 10^6 spheres,
-/// BENCHMARKS.md "Scale"), rounded up.
-pub const SCENE_BYTES_PER_SHAPE: u64 = 512;
+/// Memory one shape of a scene costs from reading to rendering, in bytes: what the reader
+/// keeps of it, its instance and its share of the render scene and its BVH. A scene whose
+/// shapes would need more than the memory budget (`--max-memory`, else
+/// [`default_memory_budget`]) is refused before it is built: a composite tree that multiplies
+/// out of all proportion (each level listing the one below twice) is refused from its counts,
+/// and a flat file from its size. Measured with scripts/bench-scale.sh (peak RSS of
+/// `anim render --spp 1` on 10^6 spheres: 361 B a sphere, BENCHMARKS.md "Scale"), rounded up.
+/// A file whose shapes are read as statements (one with a transform or a composite) holds
+/// about 300 bytes more per shape statement while it is built.
+pub const SCENE_BYTES_PER_SHAPE: u64 = 384;
 
 /// Bytes needed to build and render a scene of `shapes` shapes.
 pub fn scene_memory(shapes: u64) -> u64 {

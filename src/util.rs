@@ -105,6 +105,75 @@ impl Fnv64 {
     }
 }
 
+/// A fast deterministic hasher for the reader's and the scene builder's tables of names
+/// (the multiply-rotate hash of rustc's `FxHasher`): keys come from one file, not from an
+/// adversary probing collisions, and std's SipHash took an eighth of loading a flat file of a
+/// million shapes (BENCHMARKS.md §10).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FastHasher(u64);
+
+const FAST_SEED: u64 = 0x51_7c_c1_b7_27_22_0a_95;
+
+impl FastHasher {
+    fn add(&mut self, word: u64) {
+        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(FAST_SEED);
+    }
+}
+
+impl std::hash::Hasher for FastHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        let mut chunks = bytes.chunks_exact(8);
+        for c in &mut chunks {
+            let mut word = [0u8; 8];
+            word.copy_from_slice(c);
+            self.add(u64::from_le_bytes(word));
+        }
+        let rest = chunks.remainder();
+        if !rest.is_empty() {
+            // The last byte holds the remainder's length, so `a` and `a\0` differ.
+            let mut word = [0u8; 8];
+            word[..rest.len()].copy_from_slice(rest);
+            word[7] = rest.len() as u8;
+            self.add(u64::from_le_bytes(word));
+        }
+    }
+
+    fn write_u8(&mut self, i: u8) {
+        self.add(u64::from(i));
+    }
+
+    fn write_u32(&mut self, i: u32) {
+        self.add(u64::from(i));
+    }
+
+    fn write_u64(&mut self, i: u64) {
+        self.add(i);
+    }
+
+    fn write_usize(&mut self, i: usize) {
+        self.add(i as u64);
+    }
+
+    fn finish(&self) -> u64 {
+        // The multiply leaves the low bits, which pick the bucket, depending on the low
+        // bytes of the key only (`s1`, `s2`, ... would share them); fold the high bits in.
+        let mut h = self.0;
+        h ^= h >> 33;
+        h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+        h ^= h >> 33;
+        h
+    }
+}
+
+/// Builds [`FastHasher`]s.
+pub type FastHash = std::hash::BuildHasherDefault<FastHasher>;
+
+/// A `HashMap` hashed with [`FastHasher`].
+pub type FastMap<K, V> = std::collections::HashMap<K, V, FastHash>;
+
+/// A `HashSet` hashed with [`FastHasher`].
+pub type FastSet<K> = std::collections::HashSet<K, FastHash>;
+
 /// The machine's physical memory in bytes, if the system says (Linux `/proc/meminfo`).
 pub fn physical_memory() -> Option<u64> {
     let info = fs::read_to_string("/proc/meminfo").ok()?;
@@ -142,6 +211,24 @@ mod tests {
         assert_eq!(Fnv64::default().finish(), 0xcbf29ce484222325);
         assert_eq!(Fnv64::of(b"a"), 0xaf63dc4c8601ec8c);
         assert_eq!(Fnv64::of(b"foobar"), 0x85944171f73967e8);
+    }
+
+    #[test]
+    fn the_fast_hasher_tells_names_apart_and_is_deterministic() {
+        use std::hash::{BuildHasher, Hash, Hasher};
+        let hash = |s: &str| FastHash::default().hash_one(s);
+        assert_eq!(hash("s12"), hash("s12"));
+        // Names that differ only past the first 8 bytes, or only in length.
+        assert_ne!(hash("sphere_0001"), hash("sphere_0002"));
+        assert_ne!(hash("s1"), hash("s1\0"));
+        let mut set: FastSet<String> = FastSet::default();
+        for i in 0..10_000 {
+            assert!(set.insert(format!("s{i}")));
+        }
+        assert!(!set.insert("s9999".to_string()));
+        let mut h = FastHasher::default();
+        42u32.hash(&mut h);
+        assert_ne!(h.finish(), 0);
     }
 
     #[test]

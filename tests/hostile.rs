@@ -149,7 +149,7 @@ fn a_doubling_composite_chain_is_refused_from_its_counts() {
     assert!(took < QUICK, "{took:?}");
     assert!(
         stderr.contains(
-            "error: the composite tree expands to 1099511627776 shapes, which need about 524288.0 GiB of memory"
+            "error: the composite tree expands to 1099511627776 shapes, which need about 393216.0 GiB of memory"
         ),
         "{stderr}"
     );
@@ -165,7 +165,7 @@ fn a_doubling_composite_chain_is_refused_from_its_counts() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
     assert!(
-        stderr.contains("expands to 1048576 shapes, which need about 512.0 MiB of memory, more than the 64.0 MiB allowed (`c300` is the largest part)"),
+        stderr.contains("expands to 1048576 shapes, which need about 384.0 MiB of memory, more than the 64.0 MiB allowed (`c300` is the largest part)"),
         "{stderr}"
     );
 

@@ -88,3 +88,56 @@ fn a_scene_over_the_budget_is_refused_with_what_it_needs() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// The reader alone (`anim::sdf::parse_source`, no scene building) on a flat file of a million
+/// random spheres, in lines per CPU-second of the reading thread, against issue 8's target of
+/// 2 M lines/s. A measurement, run by scripts/bench-scale.sh:
+/// `cargo test --release --test scale -- --ignored --nocapture the_reader_reads`.
+#[test]
+#[ignore]
+fn the_reader_reads_two_million_lines_a_second() {
+    let n = 1_000_000;
+    let mut text = String::with_capacity(n * 64 + 512);
+    text.push_str(HEAD);
+    text.push_str("define material blue 0 0 0.2 0.1 0.1 0.8 0.5 0.5 0.5 20\n");
+    text.push_str("render eye out.png 640 360\n");
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for i in 0..n {
+        let (x, y, z) = (
+            next() * 200.0 - 100.0,
+            next() * 200.0 - 100.0,
+            next() * 200.0 - 100.0,
+        );
+        writeln!(
+            text,
+            "define shape sphere s{i} {x:.4} {y:.4} {z:.4} {:.4} {}",
+            0.2 + next() * 0.4,
+            if i % 2 == 0 { "red" } else { "blue" }
+        )
+        .unwrap();
+    }
+    let lines = text.lines().count();
+    let opts = anim::sdf::LoadOptions::default();
+    let mut best = f64::INFINITY;
+    for _ in 0..5 {
+        let start = cpu_time::ThreadTime::now();
+        let parsed = anim::sdf::parse_source(&text, Path::new("spheres.sdf"), &opts);
+        let seconds = start.elapsed().as_secs_f64();
+        assert_eq!(parsed.shapes.len(), n);
+        assert!(parsed.diagnostics.iter().all(|d| !d.is_error()));
+        drop(parsed);
+        best = best.min(seconds);
+    }
+    let rate = lines as f64 / best;
+    println!(
+        "reader: {lines} lines in {best:.3} CPU-s (best of 5): {:.2} M lines/s",
+        rate / 1e6
+    );
+    assert!(rate >= 2e6, "{:.2} M lines/s", rate / 1e6);
+}

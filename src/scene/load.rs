@@ -31,7 +31,13 @@ pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnost
         return load_str(&String::from_utf8_lossy(&bytes), path, opts);
     }
     let length = bytes.len();
-    let parsed = sdf::parse_source(&String::from_utf8_lossy(&bytes), path, opts);
+    // Valid UTF-8 (almost every file) is checked by the faster of the two validators.
+    let text = match std::str::from_utf8(&bytes) {
+        Ok(text) => Cow::Borrowed(text),
+        Err(_) => String::from_utf8_lossy(&bytes),
+    };
+    let parsed = sdf::parse_source(&text, path, opts);
+    drop(text);
     drop(bytes);
     let again = || {
         read_input(path, opts.max_input, "file")
@@ -97,7 +103,7 @@ pub fn build(
     path: &Path,
     opts: &LoadOptions,
 ) -> Result<Loaded, Vec<Diagnostic>> {
-    let (jobs, diagnostics) = build_jobs(statements, path, opts, None);
+    let (jobs, diagnostics) = build_jobs(statements, Default::default(), path, opts, None);
     conclude(jobs, finish_diagnostics(diagnostics, opts), path, || None)
 }
 
@@ -109,6 +115,18 @@ pub fn load_str(text: &str, path: &Path, opts: &LoadOptions) -> Result<Loaded, V
     finish_load(parsed, path, opts, || Some(Cow::Borrowed(text)))
 }
 
+/// [`load_str`] with the shapes of a flat file read as statements: what the compact form of
+/// `sdf::ast::FlatShapes` must give the same result as.
+#[cfg(test)]
+pub(super) fn load_str_whole(
+    text: &str,
+    path: &Path,
+    opts: &LoadOptions,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    let parsed = sdf::parse_source_whole(text, path, opts);
+    finish_load(parsed, path, opts, || Some(Cow::Borrowed(text)))
+}
+
 /// Builds the jobs of a parsed file; `text` gives the file's text again for quoting.
 fn finish_load<'t>(
     parsed: sdf::Parsed,
@@ -116,7 +134,13 @@ fn finish_load<'t>(
     opts: &LoadOptions,
     text: impl FnOnce() -> Option<Cow<'t, str>>,
 ) -> Result<Loaded, Vec<Diagnostic>> {
-    let (jobs, built) = build_jobs(&parsed.statements, path, opts, Some(&parsed.omissions));
+    let (jobs, built) = build_jobs(
+        &parsed.statements,
+        parsed.shapes,
+        path,
+        opts,
+        Some(&parsed.omissions),
+    );
     // The statements are no longer needed once the jobs hold the scenes: freed before the
     // images are made.
     drop(parsed.statements);

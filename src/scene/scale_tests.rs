@@ -1,6 +1,7 @@
 //! Scenes of many shapes: the memory budget, and what the jobs of a file share.
 
 use super::*;
+use crate::diag::Diagnostic;
 use crate::sdf::LoadOptions;
 use glam::DVec3;
 
@@ -83,4 +84,104 @@ render c f2.png 1 1
     assert_ne!(slot("g/b").0, slot("g/s").0);
     let loc = j2.scene.instance_loc(&j2.scene.instances[0]).unwrap();
     assert_eq!((loc.line, loc.col), (2, 1));
+}
+
+/// Loads `text` both ways: with the shapes of a flat file kept compactly by the reader (when
+/// `flat`, checked) and with every shape as a statement; the results must be the same.
+fn same_both_ways(text: &str, opts: &LoadOptions, flat: bool) -> Result<Loaded, Vec<Diagnostic>> {
+    let path = Path::new("scene.sdf");
+    let parsed = crate::sdf::parse_source(text, path, opts);
+    assert_eq!(!parsed.shapes.is_empty(), flat, "{text}");
+    let compact = load_str(text, path, opts);
+    let whole = super::load::load_str_whole(text, path, opts);
+    match (&compact, &whole) {
+        (Ok(a), Ok(b)) => {
+            assert_eq!(a.jobs, b.jobs, "{text}");
+            assert_eq!(a.diagnostics, b.diagnostics, "{text}");
+        }
+        (Err(a), Err(b)) => assert_eq!(a, b, "{text}"),
+        _ => panic!("{text}\n{compact:?}\n{whole:?}"),
+    }
+    compact
+}
+
+#[test]
+fn flat_shapes_kept_compactly_load_as_their_statements_do() {
+    let opts = LoadOptions::default();
+    let cases = [
+        // Plain, with a material defined after the shapes that use it and one never defined.
+        format!(
+            "define shape sphere a 0 0 -5 1 m\n{MATERIAL}define shape box b 0 0 0 1 1 1 m\n\
+             define shape sphere c 1 1 1 1 nowhere\ndefine shape sphere d 1 1 1 1 nowhere\n\
+             define camera c 60\nrender c o.png 4 3\n"
+        ),
+        // A name defined three times, a degenerate shape, every primitive kind.
+        format!(
+            "{MATERIAL}define shape sphere s 0 0 0 1 m\ndefine shape sphere s 1 0 0 1 m\n\
+             define shape cylinder cy 0 0 0 0 1 0 0.5 m\ndefine shape cone co 0 0 0 0 1 0 0.5 m\n\
+             define shape triangle t 0 0 0 1 0 0 0 1 0 m\ndefine shape plane p 0 -1 0 0 1 0 m\n\
+             define shape sphere z 0 0 0 0 m\n  define shape sphere s 2 0 0 1 m\n\
+             define camera c 60\nrender c o.png 4 3\nrender c p.png 4 3\n"
+        ),
+        // No render line, a rejected material, the `define sphere` variant, odd spacing.
+        "define material bad 1 1 1 1 1 1 1 1 1\ndefine sphere a 0 0 -5 1 bad\n\
+         define   shape   sphere   jklö 0 0 -5 1 bad  # comment\n"
+            .to_string(),
+        // A material defined twice, a second file-wide ambient, a light.
+        format!(
+            "{MATERIAL}{MATERIAL}ambient 0.1 0.1 0.1\ndefine light l 0 5 0 1 1 1 1\n\
+             define shape sphere a 0 0 -5 1 m\ndefine camera c 60\nrender c o.png 4 3\n"
+        ),
+    ];
+    // Some of these files are refused (an error), some load: either way, as statements.
+    for text in &cases {
+        let _ = same_both_ways(text, &opts, true);
+    }
+    // A transform or a composite anywhere puts the shapes back among the statements.
+    for tail in [
+        "transform a translate 1 0 0\n",
+        "define shape composite g a\n",
+    ] {
+        let text = format!("{}{tail}", cases[0]);
+        let _ = same_both_ways(&text, &opts, false);
+    }
+    // Over the memory budget: refused at the first shape, as for statements.
+    let tight = LoadOptions {
+        max_memory: crate::limits::scene_memory(1),
+        ..LoadOptions::default()
+    };
+    let ds = same_both_ways(&cases[0], &tight, true).unwrap_err();
+    assert!(
+        ds.iter().any(|d| d.message.contains("shapes need about")),
+        "{ds:?}"
+    );
+}
+
+#[test]
+fn a_flat_sphere_costs_at_most_200_bytes_once_read() {
+    let n = 20_000;
+    let mut text = format!("{MATERIAL}define camera c 60\nrender c o.png 1 1\n");
+    for i in 0..n {
+        text.push_str(&format!(
+            "define shape sphere s{i} {}.25 {}.5 -{}.125 0.5 m\n",
+            i % 97,
+            i % 89,
+            i % 83 + 5
+        ));
+    }
+    let parsed = crate::sdf::parse_source(&text, Path::new("scene.sdf"), &LoadOptions::default());
+    assert_eq!(parsed.shapes.len(), n);
+    // Everything the reader hands on: the compact shapes, the other statements (with what
+    // their strings hold), the diagnostics and what was left out.
+    let statements = parsed.statements.capacity()
+        * std::mem::size_of::<crate::sdf::ast::Statement>()
+        + parsed.statements.len() * 64;
+    let diagnostics = parsed.diagnostics.capacity() * std::mem::size_of::<Diagnostic>();
+    let omissions =
+        parsed.omissions.skipped.capacity() * 32 + parsed.omissions.commented.capacity() * 40;
+    let bytes = parsed.shapes.bytes() + statements + diagnostics + omissions;
+    let per_sphere = bytes as f64 / n as f64;
+    assert!(per_sphere <= 200.0, "{per_sphere:.1} bytes per sphere");
+    // Not vacuous: the geometry alone is 80 bytes.
+    assert!(per_sphere >= 80.0, "{per_sphere:.1} bytes per sphere");
 }

@@ -6,8 +6,11 @@
 
 use crate::diag::Loc;
 use crate::shape::Geometry;
+use crate::util::FastMap;
 use glam::{DVec3, Vec3};
 use std::fmt;
+use std::path::Path;
+use std::sync::Arc;
 
 /// A name used to refer to something defined elsewhere, kept with where it was written.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,6 +56,279 @@ pub struct StatementSpans {
     /// The name the statement is about: the one a definition gives (a material, shape,
     /// composite, light or camera), or a transform's target.
     pub name: Option<Span>,
+}
+
+/// Shapes per chunk of [`FlatShapes`]: chunks are freed one by one as the scene builder
+/// turns them into instances, so the two are never both whole in memory.
+const FLAT_CHUNK: usize = 1 << 14;
+
+/// The primitive shape statements of a file read from text, when nothing in the file refers
+/// to a shape by name (no composite, no transform, no mesh), kept compactly instead of as
+/// [`Statement`]s: a flat file of a million spheres is held in about 120 bytes a sphere
+/// (BENCHMARKS.md §10). Each shape keeps what the scene builder can point at: where its
+/// statement, name and material are written.
+#[derive(Debug, Default)]
+pub struct FlatShapes {
+    file: Option<Arc<Path>>,
+    chunks: Vec<Vec<FlatShape>>,
+    len: usize,
+    /// Every shape name, one after the other.
+    names: String,
+    /// The distinct material names the shapes use, by id.
+    materials: Vec<String>,
+    material_ids: FastMap<String, u32>,
+    /// Whether a material statement of that name was read (so far, while reading).
+    material_defined: Vec<bool>,
+}
+
+/// One shape statement of [`FlatShapes`]. Its name token is as wide as the name has
+/// characters, and its statement starts with `define` (else it is kept as a [`Statement`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FlatShape {
+    pub geometry: Geometry,
+    name_start: u32,
+    name_len: u32,
+    /// Material id; the top bit says whether the material was defined before this line.
+    material: u32,
+    line: u32,
+    col: u32,
+    name_col: u32,
+    material_col: u32,
+    /// Statements (other than these shapes) read before this one.
+    pos: u32,
+}
+
+impl FlatShape {
+    /// The line its statement is on.
+    pub fn line(&self) -> u32 {
+        self.line
+    }
+}
+
+const DEFINED_BEFORE: u32 = 1 << 31;
+const FIRST_WIDTH: u32 = "define".len() as u32;
+
+impl FlatShapes {
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Records that a material statement named `name` was read.
+    pub fn define_material(&mut self, name: &str) {
+        let id = self.material_id(name);
+        self.material_defined[id as usize] = true;
+    }
+
+    fn material_id(&mut self, name: &str) -> u32 {
+        // Files use few materials: comparing names is then faster than hashing them.
+        if self.materials.len() <= 8 {
+            if let Some(id) = self.materials.iter().position(|m| m == name) {
+                return id as u32;
+            }
+        } else if let Some(&id) = self.material_ids.get(name) {
+            return id;
+        }
+        let id = self.materials.len() as u32;
+        self.materials.push(name.to_string());
+        self.material_ids.insert(name.to_string(), id);
+        self.material_defined.push(false);
+        id
+    }
+
+    /// Takes `stmt`, read after `pos` other statements, if it is a primitive shape whose
+    /// places fit the compact form; else gives it back.
+    pub fn push(&mut self, stmt: Statement, pos: usize) -> Option<Statement> {
+        let fits = |v: usize| u32::try_from(v).ok().filter(|&v| v < DEFINED_BEFORE);
+        let (Some(name_start), Some(pos)) = (fits(self.names.len()), fits(pos)) else {
+            return Some(stmt);
+        };
+        let (name, geometry, material, loc, name_span) = match stmt {
+            Statement {
+                kind:
+                    StatementKind::Shape {
+                        name,
+                        geometry,
+                        material,
+                    },
+                loc,
+                spans:
+                    Some(StatementSpans {
+                        first_width: FIRST_WIDTH,
+                        name: Some(name_span),
+                    }),
+            } if !matches!(geometry, Geometry::Mesh(_))
+                && self.file.as_ref().is_none_or(|f| Arc::ptr_eq(f, &loc.file))
+                && fits(name.len()).is_some()
+                && name_span.width as usize == name.chars().count()
+                && material.loc.line == loc.line
+                && (self.materials.len() as u64) < u64::from(DEFINED_BEFORE) =>
+            {
+                (name, geometry, material, loc, name_span)
+            }
+            other => return Some(other),
+        };
+        let id = self.material_id(&material.name);
+        let before = if self.material_defined[id as usize] {
+            DEFINED_BEFORE
+        } else {
+            0
+        };
+        self.names.push_str(&name);
+        let shape = FlatShape {
+            geometry,
+            name_start,
+            name_len: name.len() as u32,
+            material: id | before,
+            line: loc.line,
+            col: loc.col,
+            name_col: name_span.col,
+            material_col: material.loc.col,
+            pos,
+        };
+        self.file.get_or_insert(loc.file);
+        match self.chunks.last_mut() {
+            Some(chunk) if chunk.len() < FLAT_CHUNK => chunk.push(shape),
+            // The last chunk grows as a vector does: a small file holds no empty chunk.
+            _ => self.chunks.push(vec![shape]),
+        }
+        self.len += 1;
+        None
+    }
+
+    /// The shapes, in file order.
+    pub fn iter(&self) -> impl Iterator<Item = &FlatShape> {
+        self.chunks.iter().flatten()
+    }
+
+    /// The shapes in file order, a chunk at a time.
+    pub fn chunks(&self) -> impl Iterator<Item = &[FlatShape]> {
+        self.chunks.iter().map(Vec::as_slice)
+    }
+
+    /// Shape `k` (from 0, in file order).
+    pub fn get(&self, k: usize) -> Option<&FlatShape> {
+        // Every chunk but the last is full.
+        self.chunks.get(k / FLAT_CHUNK)?.get(k % FLAT_CHUNK)
+    }
+
+    /// The shapes in chunks, in file order, each chunk freed once the caller drops it.
+    pub fn take_chunks(&mut self) -> Vec<Vec<FlatShape>> {
+        self.len = 0;
+        std::mem::take(&mut self.chunks)
+    }
+
+    pub fn name(&self, s: &FlatShape) -> &str {
+        let start = s.name_start as usize;
+        self.names
+            .get(start..start + s.name_len as usize)
+            .unwrap_or("")
+    }
+
+    /// The material id of `s` (from 0, below [`FlatShapes::material_count`]).
+    pub fn material_of(&self, s: &FlatShape) -> usize {
+        (s.material & !DEFINED_BEFORE) as usize
+    }
+
+    pub fn material_count(&self) -> usize {
+        self.materials.len()
+    }
+
+    pub fn material_name(&self, id: usize) -> &str {
+        self.materials.get(id).map_or("", String::as_str)
+    }
+
+    /// Whether a statement defining the material of `s` was read before `s`.
+    pub fn material_defined_before(&self, s: &FlatShape) -> bool {
+        s.material & DEFINED_BEFORE != 0
+    }
+
+    /// Where the statement of `s` starts.
+    pub fn loc(&self, s: &FlatShape) -> Loc {
+        self.loc_at(s, s.col)
+    }
+
+    fn loc_at(&self, s: &FlatShape, col: u32) -> Loc {
+        Loc {
+            file: self
+                .file
+                .clone()
+                .unwrap_or_else(|| Arc::from(Path::new(""))),
+            line: s.line,
+            col,
+        }
+    }
+
+    /// Where the name of `s` is written, and its width.
+    pub fn name_place(&self, s: &FlatShape) -> (Loc, u32) {
+        let width = self.name(s).chars().count() as u32;
+        (self.loc_at(s, s.name_col), width)
+    }
+
+    /// The material reference of `s` as written.
+    pub fn material_ref(&self, s: &FlatShape) -> NameRef {
+        NameRef {
+            name: self.material_name(self.material_of(s)).to_string(),
+            loc: self.loc_at(s, s.material_col),
+        }
+    }
+
+    /// `s` as the statement it was read as.
+    pub fn statement(&self, s: &FlatShape) -> Statement {
+        let name = self.name(s);
+        Statement {
+            kind: StatementKind::Shape {
+                name: name.to_string(),
+                geometry: s.geometry.clone(),
+                material: self.material_ref(s),
+            },
+            loc: self.loc(s),
+            spans: Some(StatementSpans {
+                first_width: FIRST_WIDTH,
+                name: Some(Span {
+                    col: s.name_col,
+                    width: name.chars().count() as u32,
+                }),
+            }),
+        }
+    }
+
+    /// Every statement of a file: `others` (the statements that are not in `self`) with the
+    /// shapes put back where they were read. `others` must be as they were read (each shape's
+    /// place counts them); the new index of `others[k]` is `moved[k]`.
+    pub fn merge_into(self, others: Vec<Statement>) -> (Vec<Statement>, Vec<usize>) {
+        let mut out = Vec::with_capacity(others.len() + self.len);
+        let mut moved = Vec::with_capacity(others.len());
+        let mut shapes = self.iter().peekable();
+        for (k, stmt) in others.into_iter().enumerate() {
+            while let Some(s) = shapes.next_if(|s| s.pos as usize <= k) {
+                out.push(self.statement(s));
+            }
+            moved.push(out.len());
+            out.push(stmt);
+        }
+        out.extend(shapes.map(|s| self.statement(s)));
+        (out, moved)
+    }
+
+    /// Bytes held, for the memory measurements of tests.
+    pub fn bytes(&self) -> usize {
+        self.chunks.capacity() * std::mem::size_of::<Vec<FlatShape>>()
+            + self
+                .chunks
+                .iter()
+                .map(|c| c.capacity() * std::mem::size_of::<FlatShape>())
+                .sum::<usize>()
+            + self.names.capacity()
+            // Each material name is held twice: in the list and as the key of its id.
+            + self.materials.iter().map(|m| m.capacity() * 2).sum::<usize>()
+            + self.materials.capacity() * std::mem::size_of::<String>()
+            + self.material_ids.capacity() * (std::mem::size_of::<(String, u32)>() + 1)
+            + self.material_defined.capacity()
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -56,18 +56,112 @@ pub fn lines(text: &str) -> Vec<Line<'_>> {
 
 /// Calls `f` with every line of `text` (as [`lines`] splits them), tokenized into one buffer
 /// that is reused from line to line: reading a file of a million lines allocates no token
-/// list per line, and never holds more than one.
+/// list per line, and never holds more than one. A line of ASCII is split from the text and
+/// tokenized in the same pass over its bytes.
 pub fn each_line<'t>(text: &'t str, mut f: impl FnMut(&Line<'t>)) {
     let mut tokens = Vec::new();
-    for (i, raw) in raw_lines(text).enumerate() {
-        tokenize_into(raw, &mut tokens);
+    let mut rest = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut i = 0;
+    // A final line ending does not start another line.
+    while !rest.is_empty() {
+        let (end, skip) = scan_line(rest, &mut tokens);
         let line = Line {
             number: line_number(i),
-            text: raw,
+            text: &rest[..end],
             tokens,
         };
         f(&line);
         tokens = line.tokens;
+        rest = &rest[end + skip..];
+        i += 1;
+    }
+}
+
+/// Tokenizes the first line of `rest` into `tokens` (as [`tokenize_into`] does); the line's
+/// length in bytes and the length of its line ending.
+fn scan_line<'t>(rest: &'t str, tokens: &mut Vec<Token<'t>>) -> (usize, usize) {
+    tokens.clear();
+    let bytes = rest.as_bytes();
+    let class = |i: usize| bytes.get(i).map_or(END, |&b| BYTE_CLASS[usize::from(b)]);
+    let mut i = 0;
+    loop {
+        while class(i) == SPACE {
+            i += 1;
+        }
+        let start = i;
+        while class(i) == WORD {
+            i += 1;
+        }
+        if i > start && tokens.len() < crate::limits::MAX_TOKENS_PER_LINE {
+            // Past the cap the rest is not kept (see `overlong`, by which the line is
+            // reported).
+            tokens.push(Token {
+                text: &rest[start..i],
+                col: u32::try_from(start + 1).unwrap_or(u32::MAX),
+                width: u32::try_from(i - start).unwrap_or(u32::MAX),
+            });
+        }
+        match class(i) {
+            SPACE | WORD => {}
+            HASH => {
+                // A comment: the rest of the line is skipped, whatever it holds.
+                while !matches!(class(i), NEWLINE | END) {
+                    i += 1;
+                }
+                break;
+            }
+            BEYOND_ASCII => {
+                // A character beyond ASCII before any comment: columns count characters.
+                let end = bytes[i..]
+                    .iter()
+                    .position(|&b| b == b'\n' || b == b'\r')
+                    .map_or(bytes.len(), |n| i + n);
+                tokenize_into(&rest[..end], tokens);
+                return (end, line_ending(bytes, end));
+            }
+            _ => break,
+        }
+    }
+    // A line starting with `//` is a comment as a whole (`//define shape ...` included).
+    if tokens.first().is_some_and(|t| t.text.starts_with("//")) {
+        tokens.clear();
+    }
+    (i, line_ending(bytes, i))
+}
+
+/// Classes of bytes for [`scan_line`].
+const WORD: u8 = 0;
+/// The whitespace of ASCII as `char::is_whitespace` knows it, but for line endings.
+const SPACE: u8 = 1;
+const NEWLINE: u8 = 2;
+const HASH: u8 = 3;
+const BEYOND_ASCII: u8 = 4;
+/// Past the end of the text.
+const END: u8 = 5;
+
+const BYTE_CLASS: [u8; 256] = {
+    let mut class = [WORD; 256];
+    class[b' ' as usize] = SPACE;
+    class[b'\t' as usize] = SPACE;
+    class[0x0b] = SPACE;
+    class[0x0c] = SPACE;
+    class[b'\n' as usize] = NEWLINE;
+    class[b'\r' as usize] = NEWLINE;
+    class[b'#' as usize] = HASH;
+    let mut b = 0x80;
+    while b < 256 {
+        class[b] = BEYOND_ASCII;
+        b += 1;
+    }
+    class
+};
+
+/// The length of the line ending at byte `end`: CRLF, LF, a lone CR, or none at the end.
+fn line_ending(bytes: &[u8], end: usize) -> usize {
+    match (bytes.get(end), bytes.get(end + 1)) {
+        (Some(b'\r'), Some(b'\n')) => 2,
+        (Some(_), _) => 1,
+        (None, _) => 0,
     }
 }
 
@@ -112,19 +206,24 @@ fn line_number(i: usize) -> u32 {
     u32::try_from(i).map_or(u32::MAX, |n| n.saturating_add(1))
 }
 
-/// Lines holding more than [`crate::limits::MAX_TOKENS_PER_LINE`] tokens: (line number, tokens on it).
+/// The tokens on a line, when they are more than [`crate::limits::MAX_TOKENS_PER_LINE`].
+pub fn overlong(raw: &str) -> Option<usize> {
+    // Only long lines can hold that many tokens; counting is skipped for the rest.
+    if raw.len() < crate::limits::MAX_TOKENS_PER_LINE {
+        return None;
+    }
+    let code = raw.split('#').next().unwrap_or("");
+    let count = code.split_whitespace().count();
+    (count > crate::limits::MAX_TOKENS_PER_LINE).then_some(count)
+}
+
+/// Lines holding more than [`crate::limits::MAX_TOKENS_PER_LINE`] tokens: (line number,
+/// tokens on it).
+#[cfg(test)]
 pub fn overlong_lines(text: &str) -> Vec<(u32, usize)> {
     raw_lines(text)
         .enumerate()
-        .filter_map(|(i, raw)| {
-            // Only long lines can hold that many tokens; counting is skipped for the rest.
-            if raw.len() < crate::limits::MAX_TOKENS_PER_LINE {
-                return None;
-            }
-            let code = raw.split('#').next().unwrap_or("");
-            let count = code.split_whitespace().count();
-            (count > crate::limits::MAX_TOKENS_PER_LINE).then_some((line_number(i), count))
-        })
+        .filter_map(|(i, raw)| Some((line_number(i), overlong(raw)?)))
         .collect()
 }
 
@@ -233,6 +332,9 @@ pub enum NumberError {
 
 /// Reads a finite decimal number: `1`, `-1.5`, `.5`, `-.5`, `+100`, `1e-3`, `1.`.
 pub fn parse_number(s: &str) -> Result<f64, NumberError> {
+    if let Some(v) = short_decimal(s) {
+        return Ok(v);
+    }
     if is_decimal(s) {
         let v: f64 = s.parse().map_err(|_| NumberError::Malformed)?;
         if !v.is_finite() || v.abs() > MAX_MAGNITUDE {
@@ -257,6 +359,51 @@ pub fn parse_number(s: &str) -> Result<f64, NumberError> {
         }
     }
     Err(NumberError::Malformed)
+}
+
+/// Powers of ten exactly representable as `f64`.
+const EXACT_POWERS_OF_TEN: [f64; 16] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+];
+
+/// The common number without exponent and with at most 15 digits (`-12.3456`), read in one
+/// pass: its digits as an integer (exact, below 2^53) over a power of ten (exact), one
+/// correctly rounded division, so the same value as `str::parse` gives. `None` for anything
+/// else (read by the general path) and for magnitudes beyond [`MAX_MAGNITUDE`].
+fn short_decimal(s: &str) -> Option<f64> {
+    let b = s.as_bytes();
+    let (negative, digits) = match b.first()? {
+        b'-' => (true, &b[1..]),
+        b'+' => (false, &b[1..]),
+        _ => (false, b),
+    };
+    let mut mantissa: u64 = 0;
+    let mut count = 0;
+    let mut fraction: Option<usize> = None;
+    for &c in digits {
+        match c {
+            b'0'..=b'9' => {
+                if count == 15 {
+                    return None;
+                }
+                mantissa = mantissa * 10 + u64::from(c - b'0');
+                count += 1;
+                if let Some(f) = &mut fraction {
+                    *f += 1;
+                }
+            }
+            b'.' if fraction.is_none() => fraction = Some(0),
+            _ => return None,
+        }
+    }
+    if count == 0 {
+        return None;
+    }
+    let v = mantissa as f64 / EXACT_POWERS_OF_TEN[fraction.unwrap_or(0)];
+    if v > MAX_MAGNITUDE {
+        return None;
+    }
+    Some(if negative { -v } else { v })
 }
 
 /// Whether `s` has the shape of a decimal number (checked before calling `str::parse`, which
@@ -303,8 +450,10 @@ fn is_decimal(s: &str) -> bool {
 /// `nan`). Used to tell layouts apart, e.g. a material name written before the coordinates.
 pub fn looks_numeric(s: &str) -> bool {
     let unsigned = s.trim_start_matches(['+', '-']);
-    let lower = unsigned.to_ascii_lowercase();
-    if matches!(lower.as_str(), "nan" | "inf" | "infinity") {
+    if ["nan", "inf", "infinity"]
+        .iter()
+        .any(|w| unsigned.eq_ignore_ascii_case(w))
+    {
         return true;
     }
     let mut chars = unsigned.chars();
@@ -334,6 +483,52 @@ mod tests {
         ] {
             assert_eq!(parse_number(text), Ok(value), "{text}");
         }
+    }
+
+    #[test]
+    fn short_decimals_read_as_the_standard_library_reads_them() {
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..200_000 {
+            let r = next();
+            let int = (r >> 20) % 10u64.pow((r % 9) as u32 + 1);
+            let frac_digits = ((r >> 8) % 9) as usize;
+            let frac = next() % 10u64.pow(frac_digits as u32);
+            let sign = ["", "-", "+"][(r % 3) as usize];
+            let text = match (r >> 4) % 4 {
+                0 => format!("{sign}{int}"),
+                1 => format!("{sign}.{frac:0frac_digits$}"),
+                2 => format!("{sign}{int}."),
+                _ => format!("{sign}{int}.{frac:0frac_digits$}"),
+            };
+            let expected: f64 = text.parse().unwrap_or_else(|_| panic!("{text}"));
+            let got = parse_number(&text);
+            if text.trim_start_matches(['+', '-']) == "." {
+                assert_eq!(got, Err(NumberError::Malformed), "{text}");
+            } else {
+                assert_eq!(got.map(f64::to_bits), Ok(expected.to_bits()), "{text}");
+            }
+        }
+        for (text, value) in [
+            ("-0", -0.0f64),
+            ("0.1", 0.1),
+            ("999999999999", 999999999999.0),
+            ("123456789012.345", 123456789012.345),
+            ("0.000000000000001", 1e-15),
+        ] {
+            let got = parse_number(text);
+            assert!(got.is_ok() || value.abs() > MAX_MAGNITUDE, "{text}");
+            if let Ok(v) = got {
+                assert_eq!(v.to_bits(), value.to_bits(), "{text}");
+            }
+        }
+        assert_eq!(parse_number("1000000000001"), Err(NumberError::TooLarge));
+        assert_eq!(parse_number("1.2.3"), Err(NumberError::Malformed));
     }
 
     #[test]
@@ -413,6 +608,20 @@ mod tests {
 
     #[test]
     fn each_line_sees_what_lines_splits() {
+        for text in [
+            "a # jklö\n  b\u{a0}c d\n\u{a0}x // y\n//z w\n  // v\n#\n\n\r\n\r",
+            "x\ty\x0bz\x0c\n\u{feff}q",
+            "\u{feff}",
+            "a",
+        ] {
+            let mut seen = Vec::new();
+            each_line(text, |l| seen.push((l.number, l.text, l.tokens.clone())));
+            let expected: Vec<_> = lines(text)
+                .into_iter()
+                .map(|l| (l.number, l.text, l.tokens))
+                .collect();
+            assert_eq!(seen, expected, "{text:?}");
+        }
         let text = "\u{feff}a b\r\nc\r\n\r\nd # x\rjklö 1";
         let mut seen = Vec::new();
         each_line(text, |l| seen.push((l.number, l.text, l.tokens.clone())));

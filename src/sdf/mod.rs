@@ -103,7 +103,7 @@ pub fn parse(
     path: &Path,
     opts: &LoadOptions,
 ) -> (Vec<ast::Statement>, Vec<Diagnostic>) {
-    let parsed = parse_source(text, path, opts);
+    let parsed = read(text, path, opts, false);
     (
         parsed.statements,
         finish_diagnostics(parsed.diagnostics, opts),
@@ -111,13 +111,23 @@ pub fn parse(
 }
 
 /// A file's text as the reader leaves it: canonical statements (with the spans later problems
-/// point at), the problems met, and what it left out.
+/// point at), the problems met, and what it left out. The primitive shapes of a file in which
+/// nothing refers to a shape by name are kept apart, compactly, in `Parsed::shapes`.
 pub fn parse_source(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
-    let mut parsed = parse::parse(text, path, opts);
+    read(text, path, opts, true)
+}
+
+/// [`parse_source`] with every statement kept as a statement, shapes included.
+pub fn parse_source_whole(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
+    read(text, path, opts, false)
+}
+
+fn read(text: &str, path: &Path, opts: &LoadOptions, flat: bool) -> Parsed {
+    let mut parsed = parse::parse(text, path, opts, flat);
     // The lexer keeps only the first tokens of an overlong line; the line is refused here so
     // that a truncated statement is never taken for what was written.
     let file: Arc<Path> = Arc::from(path);
-    for (line, count) in lexer::overlong_lines(text) {
+    for (line, count) in std::mem::take(&mut parsed.overlong) {
         parsed.diagnostics.push(Diagnostic::new(
             Severity::Error,
             Loc {

@@ -49,8 +49,19 @@ impl Builder<'_> {
         };
         // The counts are freed before the instances are made.
         let flat = self.flatten_tree(d, &roots, shapes, &moved);
+        self.jobs_of(d, &snapshots, &flat)
+    }
+
+    /// One job per render statement (or the default one), each placing the shared instances
+    /// of `flat` by its own transforms.
+    pub(super) fn jobs_of(
+        &mut self,
+        d: &Definitions,
+        snapshots: &[(Option<&Statement>, Snapshot)],
+        flat: &Flat,
+    ) -> Vec<RenderJob> {
         let mut jobs = Vec::new();
-        for (render, snapshot) in &snapshots {
+        for (render, snapshot) in snapshots {
             let job = match render {
                 Some(stmt) => {
                     let StatementKind::Render(r) = &stmt.kind else {
@@ -60,7 +71,7 @@ impl Builder<'_> {
                         continue;
                     };
                     RenderJob {
-                        scene: self.scene(d, &flat, snapshot),
+                        scene: self.scene(d, flat, snapshot),
                         camera,
                         output: PathBuf::from(&r.output),
                         width: r.width,
@@ -92,7 +103,7 @@ impl Builder<'_> {
                     w.severity = Severity::Warning;
                     self.diagnostics.push(w);
                     RenderJob {
-                        scene: self.scene(d, &flat, snapshot),
+                        scene: self.scene(d, flat, snapshot),
                         camera,
                         output: PathBuf::from(output),
                         width: DEFAULT_IMAGE_SIZE.0,
@@ -264,17 +275,9 @@ impl Builder<'_> {
                     );
                     return;
                 }
-                // The parser makes radii positive; statements made by a program may not.
-                let mut geometry = (*geometry).clone();
-                if let Geometry::Sphere { radius, .. }
-                | Geometry::Cylinder { radius, .. }
-                | Geometry::Cone { radius, .. } = &mut geometry
-                {
-                    *radius = limits::fixed_radius(*radius);
-                }
                 let object = out.name_id(i, object);
                 out.instances.push(Instance {
-                    geometry,
+                    geometry: placed_geometry((*geometry).clone()),
                     material,
                     transform: slot,
                     object,
@@ -318,13 +321,25 @@ impl Builder<'_> {
     }
 }
 
+/// A shape's geometry as an instance holds it: the parser makes radii positive, statements
+/// made by a program may not.
+pub(super) fn placed_geometry(mut geometry: Geometry) -> Geometry {
+    if let Geometry::Sphere { radius, .. }
+    | Geometry::Cylinder { radius, .. }
+    | Geometry::Cone { radius, .. } = &mut geometry
+    {
+        *radius = limits::fixed_radius(*radius);
+    }
+    geometry
+}
+
 /// The composite tree flattened, as the jobs of a file share it.
-struct Flat {
-    instances: Arc<Vec<Instance>>,
+pub(super) struct Flat {
+    pub(super) instances: Arc<Vec<Instance>>,
     /// Transform slot `k` (from 1; slot 0 is the top of the tree) is `slots[k - 1]`: the slot
     /// it is listed in, and the object whose own transform it adds.
-    slots: Vec<(u32, usize)>,
-    names: Arc<Names>,
+    pub(super) slots: Vec<(u32, usize)>,
+    pub(super) names: Arc<Names>,
 }
 
 /// A [`Flat`] being made.
@@ -356,12 +371,19 @@ pub(super) struct Tree<'t> {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(super) struct Expansion {
     /// Instances made (shapes with a material).
-    shapes: u64,
+    pub(super) shapes: u64,
     /// Objects visited on the way, shapes and composites (composites holding nothing cost
     /// walking time too).
-    nodes: u64,
+    pub(super) nodes: u64,
     /// Transform slots made on the way (visits of objects a transform statement moves).
-    slots: u64,
+    pub(super) slots: u64,
+}
+
+/// The largest part of a tree, where a tree too large is reported.
+pub(super) struct Largest<'a> {
+    pub(super) name: &'a str,
+    pub(super) composite: bool,
+    pub(super) at: At<'a>,
 }
 
 /// The roots of the composite tree, in definition order: the composite `root` if there is
@@ -482,7 +504,32 @@ impl Builder<'_> {
             return Some(0);
         };
         let object = &d.objects[largest];
-        let composite = matches!(object.kind, ObjectKind::Composite { .. });
+        let largest = Largest {
+            name: object.name,
+            composite: matches!(object.kind, ObjectKind::Composite { .. }),
+            at: At::Name(object.statement),
+        };
+        self.fits(
+            Expansion {
+                shapes,
+                nodes,
+                slots,
+            },
+            &largest,
+            jobs,
+        )
+    }
+
+    /// The shapes of a scene whose tree expands to `total`, when they fit in the memory
+    /// budget together with the transforms of the file's `jobs` jobs and the tree has at most
+    /// [`MAX_WALK`] objects that make no shape; else reports why at `largest`.
+    pub(super) fn fits(&mut self, total: Expansion, largest: &Largest, jobs: u64) -> Option<u64> {
+        let Expansion {
+            shapes,
+            nodes,
+            slots,
+        } = total;
+        let composite = largest.composite;
         let count = |n: u64| {
             if n == u64::MAX {
                 "more than 10^19".to_string()
@@ -504,7 +551,7 @@ impl Builder<'_> {
                         count(shapes),
                         human_bytes(needed),
                         human_bytes(budget),
-                        object.name
+                        largest.name
                     ),
                     format!("{DOUBLING}; {RAISE}"),
                 )
@@ -524,7 +571,7 @@ impl Builder<'_> {
                 format!(
                     "the composite tree expands to {} composites and shapes, more than the {MAX_WALK} that are walked (`{}` is the largest part)",
                     count(nodes),
-                    object.name
+                    largest.name
                 ),
                 DOUBLING.to_string(),
             ))
@@ -543,7 +590,7 @@ impl Builder<'_> {
         match problem {
             Some((message, help)) => {
                 self.too_many_reported = true;
-                self.error(At::Name(object.statement), message, Some(help));
+                self.error(largest.at, message, Some(help));
                 None
             }
             None => Some(shapes),

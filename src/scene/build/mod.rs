@@ -7,13 +7,14 @@
 //! instances, so a shape listed in two composites is drawn twice.
 
 mod definitions;
+mod flat;
 mod jobs;
 mod references;
 mod transforms;
 
 use crate::diag::{suggest, Diagnostic, Loc, Severity};
 use crate::scene::RenderJob;
-use crate::sdf::ast::{NameRef, Statement};
+use crate::sdf::ast::{FlatShapes, NameRef, Statement};
 use crate::sdf::{LoadOptions, Omissions};
 use std::collections::HashSet;
 use std::path::Path;
@@ -25,9 +26,11 @@ const SUGGESTION_BUDGET: usize = 1_000_000;
 /// Builds the render jobs of a statement list. `omissions` is present when the statements
 /// come from `sdf::parse_source` in this same load, which has already checked (and reported)
 /// the values of every statement; without it (statements made by a program) those checks are
-/// made here.
+/// made here. `shapes` are the file's primitive shapes the reader kept apart (see
+/// `sdf::parse_source`), if any: they are built into instances directly.
 pub(super) fn build_jobs(
     statements: &[Statement],
+    shapes: FlatShapes,
     path: &Path,
     opts: &LoadOptions,
     omissions: Option<&Omissions>,
@@ -44,6 +47,10 @@ pub(super) fn build_jobs(
 
         suggestion_budget: SUGGESTION_BUDGET,
     };
+    if !shapes.is_empty() {
+        let jobs = b.flat_jobs(statements, shapes);
+        return (jobs, b.diagnostics);
+    }
     let defs = b.definitions(statements);
     b.check_cycles(&defs);
     let jobs = b.jobs(statements, &defs);
@@ -59,6 +66,8 @@ enum At<'s> {
     Name(&'s Statement),
     /// A name used to refer to a definition.
     Ref(&'s NameRef),
+    /// A place in the file and the width of its caret.
+    Place(&'s Loc, u32),
 }
 
 struct Builder<'a> {
@@ -87,6 +96,7 @@ impl<'a> Builder<'a> {
     fn place(&self, at: At) -> (Loc, u32) {
         match at {
             At::Ref(r) => (r.loc.clone(), r.name.chars().count() as u32),
+            At::Place(loc, width) => (loc.clone(), width),
             At::Name(stmt) if self.from_reader => match stmt.spans.as_ref().and_then(|s| s.name) {
                 Some(name) => (
                     Loc {

@@ -18,7 +18,7 @@ mod transform;
 
 pub use resolve::default_output;
 
-use super::ast::{NameRef, Span, Statement, StatementKind, StatementSpans};
+use super::ast::{FlatShapes, NameRef, Span, Statement, StatementKind, StatementSpans};
 use super::lexer::{self, looks_numeric, Line, NumberError};
 use super::LoadOptions;
 use crate::diag::{suggest, Diagnostic, Loc, Severity};
@@ -58,9 +58,15 @@ const SHAPE_KINDS: [&str; 7] = [
 
 /// The statements of a file, the problems met, and what the reader left out.
 pub struct Parsed {
+    /// The statements, but for those in `shapes`.
     pub statements: Vec<Statement>,
+    /// The primitive shapes of a file in which nothing refers to a shape by name, when the
+    /// reader was asked to keep them apart (`parse_source`); else empty.
+    pub shapes: FlatShapes,
     pub diagnostics: Vec<Diagnostic>,
     pub omissions: Omissions,
+    /// Lines with more tokens than a line may hold: (line, tokens on it).
+    pub(in crate::sdf) overlong: Vec<(u32, usize)>,
 }
 
 /// What the reader left out of the statements that building must still account for: its
@@ -103,7 +109,9 @@ struct Anchor {
     text: String,
 }
 
-pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
+/// Reads `text`. With `flat`, the primitive shapes are kept apart in compact form when nothing
+/// in the file refers to a shape by name.
+pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions, flat: bool) -> Parsed {
     let mut p = Parser {
         file: Arc::from(path),
         path,
@@ -120,16 +128,34 @@ pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
         layout: material_layout(text, opts),
         render_errors: Vec::new(),
         camera_sizes: HashMap::new(),
+        shapes: FlatShapes::default(),
+        flat,
     };
     // Line by line, one line's tokens at a time: the file is never held as a list of lines.
-    lexer::each_line(text, |line| p.line(line));
-    let commented = commented_definitions(text);
+    // The same pass finds the lines too long to read whole and the definitions in comments.
+    let mut overlong = Vec::new();
+    let mut commented: HashMap<&str, u32> = HashMap::new();
+    lexer::each_line(text, |line| {
+        if let Some(count) = lexer::overlong(line.text) {
+            overlong.push((line.number, count));
+        }
+        if line.tokens.is_empty() && line.text.trim_start().starts_with(['#', '/']) {
+            for (name, _) in commented_definitions(line.text) {
+                commented.entry(name).or_insert(line.number);
+            }
+        }
+        p.line(line);
+    });
+    if !p.flat {
+        p.merge_shapes();
+    }
     p.resolve_renders();
     p.resolve_camera_role(text);
     p.prune_skipped_references();
     p.drop_transforms_of_commented_definitions(text, &commented);
     Parsed {
         statements: p.statements,
+        shapes: p.shapes,
         diagnostics: p.diagnostics,
         omissions: Omissions {
             skipped: p.skipped,
@@ -140,6 +166,7 @@ pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
                 .map(|(name, line)| (name.to_string(), line))
                 .collect(),
         },
+        overlong,
     }
 }
 
@@ -169,6 +196,11 @@ struct Parser<'a> {
     /// Image sizes written on camera lines (`camera eye 45 500 500`), for the render lines
     /// of that camera that give none.
     camera_sizes: HashMap<String, (u32, u32)>,
+    /// Primitive shapes read while `flat` holds.
+    shapes: FlatShapes,
+    /// Whether shapes are kept apart: asked for, and nothing read so far refers to a shape
+    /// by name (a composite, a transform) or is a shape kept as a statement (a mesh).
+    flat: bool,
 }
 
 /// The layout of the numbers after the colours of the file's materials: the one named by
@@ -180,11 +212,8 @@ fn material_layout(text: &str, opts: &LoadOptions) -> layout::Layout {
     }
     let mut extras: Vec<Vec<f64>> = Vec::new();
     let mut tokens = Vec::new();
-    for raw in lexer::raw_lines(text) {
+    for raw in lines_containing(text, "material") {
         // Only lines naming a material can be material lines; the rest are not tokenized.
-        if !raw.contains("material") {
-            continue;
-        }
         lexer::tokenize_into(raw, &mut tokens);
         let is_material = tokens.first().is_some_and(|t| t.text == "define")
             && tokens.get(1).is_some_and(|t| t.text == "material");
@@ -200,6 +229,20 @@ fn material_layout(text: &str, opts: &LoadOptions) -> layout::Layout {
         extras.extend(nums.filter(|n| n.len() >= 10).map(|n| n[9..].to_vec()));
     }
     layout::infer(&extras).unwrap_or_else(layout::default_layout)
+}
+
+/// The lines of `text` (as `lexer::raw_lines` splits them) that contain `word`, found by
+/// searching the whole text for it rather than line by line.
+fn lines_containing<'t>(text: &'t str, word: &'t str) -> impl Iterator<Item = &'t str> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut from = 0;
+    std::iter::from_fn(move || {
+        let at = from + text.get(from..)?.find(word)?;
+        let start = text[..at].rfind(['\n', '\r']).map_or(0, |i| i + 1);
+        let end = text[at..].find(['\n', '\r']).map_or(text.len(), |i| at + i);
+        from = end;
+        Some(&text[start..end])
+    })
 }
 
 /// A number as the reader takes it, a C-style suffix (`1.0f`) included.
@@ -320,11 +363,42 @@ impl Parser<'_> {
     fn push(&mut self, line: &Line, kind: StatementKind, name: Option<Span>) {
         let loc = self.loc(line, At::Tok(0));
         let first_width = Self::place(line, At::Tok(0)).1;
-        self.statements.push(Statement {
+        match &kind {
+            StatementKind::Material(m) => self.shapes.define_material(&m.name),
+            StatementKind::Composite { .. } | StatementKind::Transform { .. } => {
+                self.flat = false;
+            }
+            _ => {}
+        }
+        let stmt = Statement {
             kind,
             loc,
             spans: Some(StatementSpans { first_width, name }),
-        });
+        };
+        if !self.flat {
+            self.statements.push(stmt);
+            return;
+        }
+        if let Some(stmt) = self.shapes.push(stmt, self.statements.len()) {
+            self.flat &= !matches!(stmt.kind, StatementKind::Shape { .. });
+            self.statements.push(stmt);
+        }
+    }
+
+    /// Puts the shapes kept apart back among the statements, where they were read: the file
+    /// turned out to refer to shapes by name, or the caller wants every statement.
+    fn merge_shapes(&mut self) {
+        if self.shapes.is_empty() {
+            return;
+        }
+        let shapes = std::mem::take(&mut self.shapes);
+        let others = std::mem::take(&mut self.statements);
+        let (all, moved) = shapes.merge_into(others);
+        self.statements = all;
+        // Pending render lines point at their statements.
+        for pending in &mut self.pending {
+            pending.index = moved.get(pending.index).copied().unwrap_or(pending.index);
+        }
     }
 
     fn name_ref(&self, line: &Line, i: usize) -> NameRef {
@@ -499,6 +573,28 @@ impl Parser<'_> {
                 );
                 self.skip_name(line, 2);
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_containing_a_word_are_those_a_line_by_line_search_finds() {
+        for text in [
+            "\u{feff}define material m\r\nx\rmaterial material\n\nno\nmaterialmaterial",
+            "material",
+            "a\nb material\n",
+            "",
+            "\u{feff}",
+        ] {
+            let found: Vec<&str> = lines_containing(text, "material").collect();
+            let expected: Vec<&str> = lexer::raw_lines(text)
+                .filter(|l| l.contains("material"))
+                .collect();
+            assert_eq!(found, expected, "{text:?}");
         }
     }
 }
