@@ -16,6 +16,31 @@ fn is_image_side(v: f64) -> bool {
         && v <= f64::from(*limits::IMAGE_SIDE.end())
 }
 
+/// Tokens `from..to` joined by spaces, as written.
+fn joined(toks: &[crate::sdf::lexer::Token], from: usize, to: usize) -> String {
+    toks[from..to]
+        .iter()
+        .map(|t| t.text)
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// The eye and direction of `<fov> <angle> [center] <radius>`: a camera at `angle` degrees
+/// from +x on a circle of `radius` about `center` in the xz-plane, looking at the center.
+/// `None` unless the six numbers can be that (a field of view and a positive radius).
+fn orbit(nums: &[f64]) -> Option<(DVec3, DVec3)> {
+    let [fov, angle, cx, cy, cz, radius] = *nums else {
+        return None;
+    };
+    if !limits::fov_is_valid(fov) || radius <= 0.0 {
+        return None;
+    }
+    let center = DVec3::new(cx, cy, cz);
+    let a = angle.to_radians();
+    let eye = center + radius * DVec3::new(a.cos(), 0.0, a.sin());
+    Some((eye, center - eye))
+}
+
 impl Parser<'_> {
     pub(super) fn camera(&mut self, line: &Line, name_at: usize) {
         if let Some(t) = line.tokens.get(name_at) {
@@ -67,6 +92,22 @@ impl Parser<'_> {
             );
             self.camera_sizes.insert(name.clone(), size);
             nums.truncate(1);
+        } else if nums.len() == 7 && is_zero(DVec3::new(nums[4], nums[5], nums[6])) {
+            // `[eye] <yaw> <pitch> <roll>` in degrees (renderers that turn the default view):
+            // 0 0 0 is no turn, whereas as a direction it would be none.
+            self.warn(
+                line,
+                At::Span(first + 4, first + 6),
+                "camera with an eye position and `0 0 0` read as the yaw, pitch and roll of \
+                 the default view: looking along -z with +y up",
+                Some(format!(
+                    "write `define camera {name} {} {} 0 0 -1 0 1 0`",
+                    toks[first].text,
+                    joined(toks, first + 1, first + 4)
+                )),
+            );
+            nums.truncate(4);
+            nums.extend([0.0, 0.0, -1.0, 0.0, 1.0, 0.0]);
         } else if nums.len() == 7 {
             self.warn(
                 line,
@@ -75,6 +116,59 @@ impl Parser<'_> {
                 Some(format!("canonical form: `{FORM_CAMERA}`")),
             );
             nums.extend([0.0, 1.0, 0.0]);
+        } else if nums.len() == 9 && is_image_side(nums[1]) && is_image_side(nums[2]) {
+            // `<fov> <width> <height> [eye] [dir]`: cameras that carry the image size, in
+            // the order of their constructor.
+            let size = (nums[1] as u32, nums[2] as u32);
+            self.warn(
+                line,
+                At::Span(first + 1, first + 2),
+                format!(
+                    "camera read as <fov-x> <width> <height> [eye] [dir]: image size {}×{} for \
+                     render lines of this camera that give none, +y is up",
+                    size.0, size.1
+                ),
+                Some(format!(
+                    "the image size belongs on the render line: write `define camera {name} {} {}` \
+                     and `render {name} <file> {} {}`",
+                    toks[first].text,
+                    joined(toks, first + 3, first + 9),
+                    toks[first + 1].text,
+                    toks[first + 2].text
+                )),
+            );
+            self.camera_sizes.insert(name.clone(), size);
+            nums.drain(1..3);
+            nums.extend([0.0, 1.0, 0.0]);
+        } else if let Some(orbit) = orbit(&nums) {
+            // `<fov> <angle> [center] <radius>`: a camera on a circle about the scene's
+            // center, as written by animation generators that circle the scene.
+            self.warn(
+                line,
+                At::Span(first + 1, first + 5),
+                format!(
+                    "6-number camera read as <fov-x> <angle> [center] <radius>: the eye on a \
+                     circle of radius {} about {} in the xz-plane, {}° from +x, looking at the \
+                     center with +y up",
+                    nums[5],
+                    joined(toks, first + 2, first + 5),
+                    nums[1]
+                ),
+                Some(format!(
+                    "write the pose it gives: `define camera {name} {} {} {} {} {} {} {} 0 1 0`",
+                    toks[first].text,
+                    orbit.0.x,
+                    orbit.0.y,
+                    orbit.0.z,
+                    orbit.1.x,
+                    orbit.1.y,
+                    orbit.1.z
+                )),
+            );
+            nums = vec![
+                nums[0], orbit.0.x, orbit.0.y, orbit.0.z, orbit.1.x, orbit.1.y, orbit.1.z, 0.0,
+                1.0, 0.0,
+            ];
         } else if nums.len() == 11 {
             self.warn(
                 line,
@@ -89,18 +183,7 @@ impl Parser<'_> {
         } else if nums.len() != 1 && nums.len() != 10 {
             let n = nums.len();
             let mut help = format!("canonical form: `{FORM_CAMERA}` (1 or 10 numbers)");
-            if n == 9 && is_image_side(nums[1]) && is_image_side(nums[2]) {
-                // Without the size the line is `<fov> [eye] [dir]`, which is read.
-                let rest: Vec<&str> = toks[first + 3..].iter().map(|t| t.text).collect();
-                help = format!(
-                    "the image size belongs on the render line: write `define camera {name} {} {}` \
-                     and `render {name} <file> {} {}`",
-                    toks[first].text,
-                    rest.join(" "),
-                    toks[first + 1].text,
-                    toks[first + 2].text
-                );
-            } else if n == 3 || n == 9 {
+            if n == 3 || n == 9 {
                 help.push_str("; the image size belongs on the render line, not after the fov");
             }
             return Err(self.error(
@@ -175,13 +258,22 @@ impl Parser<'_> {
                     )),
                 ));
             }
-            if is_zero(def.up) && !parallel(def.dir, DVec3::Y) {
-                // A zero up vector is no up vector: the default one is meant.
+            if parallel(def.dir, def.up) && !parallel(def.dir, DVec3::Y) && toks.len() > first + 9 {
+                // An up vector that is zero or along the view gives no roll: nothing of the
+                // author's is lost by taking the default one (renderers that ignore it drew
+                // the view that way).
+                let what = if is_zero(def.up) {
+                    "zero"
+                } else {
+                    "parallel to its viewing direction"
+                };
                 self.warn(
                     line,
                     At::Span(first + 7, first + 9),
-                    "the camera's up vector is zero: +y is up",
-                    Some(format!("canonical form: `{FORM_CAMERA}`")),
+                    format!("the camera's up vector is {what}: +y is up"),
+                    Some(format!(
+                        "up must point away from the viewing direction, e.g. 0 1 0; canonical form: `{FORM_CAMERA}`"
+                    )),
                 );
                 def.up = DVec3::Y;
             }
