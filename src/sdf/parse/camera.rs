@@ -46,9 +46,14 @@ impl Parser<'_> {
         if let Some(t) = line.tokens.get(name_at) {
             self.camera_names.push(t.text.to_string());
         }
+        let reported = self.diagnostics.len();
         if self.camera_inner(line, name_at).is_err() {
             self.cameras_rejected = true;
             self.skip_name(line, name_at);
+            // Whether that stops the file depends on its other cameras and render lines.
+            let problems = self.diagnostics.split_off(reported);
+            let name = line.tokens.get(name_at).map_or("", |t| t.text).to_string();
+            self.camera_errors.push((name, problems));
         }
     }
 

@@ -120,6 +120,7 @@ pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions) -> Parsed {
         layout: material_layout(text, opts),
         render_errors: Vec::new(),
         camera_sizes: HashMap::new(),
+        camera_errors: Vec::new(),
     };
     // Line by line, one line's tokens at a time: the file is never held as a list of lines.
     lexer::each_line(text, |line| p.line(line));
@@ -169,6 +170,9 @@ struct Parser<'a> {
     /// Image sizes written on camera lines (`camera eye 45 500 500`), for the render lines
     /// of that camera that give none.
     camera_sizes: HashMap<String, (u32, u32)>,
+    /// Problems of rejected camera lines, by camera: each rejects only its own camera and
+    /// the render lines using it when another render line stands (settled in `resolve`).
+    camera_errors: Vec<(String, Vec<Diagnostic>)>,
 }
 
 /// The layout of the numbers after the colours of the file's materials: the one named by

@@ -116,6 +116,21 @@ impl Parser<'_> {
         let mut need_default_camera = false;
         let mut rejected = Vec::new();
         let mut outputs: HashMap<String, u32> = HashMap::new();
+        let defined_cameras: HashSet<&str> = self
+            .statements
+            .iter()
+            .filter_map(|s| match &s.kind {
+                StatementKind::Camera(c) => Some(c.name.as_str()),
+                _ => None,
+            })
+            .collect();
+        let rejected_cameras: HashSet<String> = self
+            .camera_errors
+            .iter()
+            .map(|(name, _)| name.clone())
+            .filter(|name| !defined_cameras.contains(name.as_str()))
+            .collect();
+        let mut skipped_renders: HashMap<String, Vec<u32>> = HashMap::new();
         for pending in std::mem::take(&mut self.pending) {
             let mut notes = pending.notes;
             let Some(Statement {
@@ -126,6 +141,17 @@ impl Parser<'_> {
                 continue;
             };
             let mut camera_missing = false;
+            if matches!(pending.camera, RenderCamera::Named)
+                && rejected_cameras.contains(&def.camera.name)
+            {
+                // Its camera's problem is reported once, on the camera's line.
+                skipped_renders
+                    .entry(def.camera.name.clone())
+                    .or_default()
+                    .push(pending.anchor.loc.line);
+                rejected.push(pending.index);
+                continue;
+            }
             match pending.camera {
                 RenderCamera::Named if self.camera_names.contains(&def.camera.name) => {}
                 RenderCamera::Named => match self.camera_names.as_slice() {
@@ -227,6 +253,15 @@ impl Parser<'_> {
                     ));
                 }
             }
+            if let Some(image) = image_name(&def.output) {
+                // The renderers these files were written for save PPM whatever the name
+                // says; a name without an image extension (or the scene's own) means that.
+                notes.push(format!(
+                    "`{}` is no image file name: `{image}` is written",
+                    def.output
+                ));
+                def.output = image;
+            }
             let output = def.output.clone();
             let canonical = StatementKind::Render(def.clone()).to_string();
             if is_scene_file(self.path, &output) {
@@ -269,7 +304,7 @@ impl Parser<'_> {
         for index in rejected.into_iter().rev() {
             self.statements.remove(index);
         }
-        self.settle_render_errors();
+        self.settle_render_errors(&skipped_renders);
         if need_default_camera {
             let loc = Loc {
                 file: self.file.clone(),
@@ -290,11 +325,30 @@ impl Parser<'_> {
 impl Parser<'_> {
     /// A rejected render line stops the file only when no other render line stands: each
     /// render line is its own image, and the others can still be made (warnings then).
-    fn settle_render_errors(&mut self) {
+    fn settle_render_errors(&mut self, skipped_renders: &HashMap<String, Vec<u32>>) {
         let standing = self
             .statements
             .iter()
             .any(|s| matches!(s.kind, StatementKind::Render(_)));
+        for (camera, problems) in std::mem::take(&mut self.camera_errors) {
+            for mut d in problems {
+                if standing && d.severity == Severity::Error {
+                    d.severity = Severity::Warning;
+                    d.message
+                        .push_str(&format!("; camera `{camera}` is skipped"));
+                    if let Some(lines) = skipped_renders.get(&camera) {
+                        let lines: Vec<String> = lines.iter().map(u32::to_string).collect();
+                        d.message.push_str(&format!(
+                            " with the render line{s} that use{v} it (line{s} {}), the other render lines are rendered",
+                            lines.join(", "),
+                            s = if lines.len() == 1 { "" } else { "s" },
+                            v = if lines.len() == 1 { "s" } else { "" },
+                        ));
+                    }
+                }
+                self.diagnostics.push(d);
+            }
+        }
         for mut d in std::mem::take(&mut self.render_errors) {
             if standing && d.severity == Severity::Error {
                 d.severity = Severity::Warning;
@@ -380,6 +434,23 @@ pub fn default_output(path: &Path) -> String {
         .filter(|s| !s.is_empty())
         .unwrap_or_else(|| "image".to_string());
     format!("{stem}.png")
+}
+
+/// The PPM file meant by an output name without an image extension: its extension replaced
+/// when it is a word (`scene.sdf` → `scene.ppm`), `.ppm` added otherwise (`out`, `frame.001`).
+/// `None` for a name that already ends in an image extension.
+fn image_name(output: &str) -> Option<String> {
+    let path = Path::new(output);
+    let ext = path.extension().and_then(|e| e.to_str());
+    if ext.is_some_and(limits::is_image_extension) || path.file_name().is_none() {
+        return None;
+    }
+    let word = ext.is_some_and(|e| e.chars().all(|c| c.is_ascii_alphabetic()));
+    Some(if word {
+        path.with_extension("ppm").to_string_lossy().into_owned()
+    } else {
+        format!("{output}.ppm")
+    })
 }
 
 /// Whether the output path, resolved (as the renderer does) against the scene file's
