@@ -301,3 +301,112 @@ impl Parser<'_> {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::diag::{Diagnostic, Severity};
+    use crate::sdf::ast::{CameraDef, StatementKind};
+    use crate::sdf::{parse, LoadOptions};
+    use glam::DVec3;
+    use std::path::Path;
+
+    /// The camera `c` read from `line`, with the diagnostics; and whether `--strict` rejects it.
+    fn read(line: &str) -> (Option<CameraDef>, Vec<Diagnostic>, bool) {
+        let text = format!("{line}\nrender c out.png 8 8\n");
+        let (statements, ds) = parse(&text, Path::new("s.sdf"), &LoadOptions::default());
+        let camera = statements.into_iter().find_map(|s| match s.kind {
+            StatementKind::Camera(c) => Some(c),
+            _ => None,
+        });
+        let strict = LoadOptions {
+            strict: true,
+            ..LoadOptions::default()
+        };
+        let (_, strict_ds) = parse(&text, Path::new("s.sdf"), &strict);
+        let strict_rejects = strict_ds.iter().any(|d| d.severity == Severity::Error);
+        (camera, ds, strict_rejects)
+    }
+
+    fn close(a: DVec3, b: DVec3) -> bool {
+        a.abs_diff_eq(b, 1e-9)
+    }
+
+    /// One warning containing `text`, no error, and an error under `--strict`.
+    fn accepted(ds: &[Diagnostic], strict_rejects: bool, text: &str) {
+        assert!(ds.iter().all(|d| d.severity == Severity::Warning), "{ds:?}");
+        assert!(ds.iter().any(|d| d.message.contains(text)), "{ds:?}");
+        assert!(strict_rejects, "--strict must reject the form");
+    }
+
+    #[test]
+    fn image_size_then_eye_and_direction() {
+        let (c, ds, strict) = read("define camera c 60 800 600 0 0 45 0 0 -45");
+        let c = c.expect("camera read");
+        assert_eq!(c.fov_x_deg, 60.0);
+        assert!(close(c.eye, DVec3::new(0.0, 0.0, 45.0)));
+        assert!(close(c.dir, DVec3::new(0.0, 0.0, -45.0)));
+        assert!(close(c.up, DVec3::Y));
+        accepted(&ds, strict, "<fov-x> <width> <height> [eye] [dir]");
+    }
+
+    #[test]
+    fn zero_angles_after_the_eye_are_the_default_view() {
+        let (c, ds, strict) = read("define camera c 60 0 5 13.66 0 0 0");
+        let c = c.expect("camera read");
+        assert!(close(c.eye, DVec3::new(0.0, 5.0, 13.66)));
+        assert!(close(c.dir, DVec3::NEG_Z));
+        assert!(close(c.up, DVec3::Y));
+        accepted(&ds, strict, "yaw, pitch and roll");
+    }
+
+    #[test]
+    fn orbit_camera_looks_at_the_center_from_the_circle() {
+        let (c, ds, strict) = read("define camera c 45 90 0 1 -30 10");
+        let c = c.expect("camera read");
+        // 90° from +x on the circle of radius 10 about (0, 1, -30): +z of the center.
+        assert!(close(c.eye, DVec3::new(0.0, 1.0, -20.0)), "{:?}", c.eye);
+        assert!(close(c.dir.normalize(), DVec3::NEG_Z), "{:?}", c.dir);
+        accepted(&ds, strict, "<fov-x> <angle> [center] <radius>");
+        // Not an orbit: no valid fov, or no positive radius.
+        assert!(read("define camera c 45 90 0 1 -30 0").0.is_none());
+        assert!(read("define camera c 200 90 0 1 -30 10").0.is_none());
+    }
+
+    #[test]
+    fn an_up_vector_along_the_view_means_y_up() {
+        let (c, ds, strict) = read("define camera c 0 0 0 0 0 -1 0 0 1 1.5");
+        let c = c.expect("camera read");
+        assert!(close(c.up, DVec3::Y));
+        assert!(ds.iter().all(|d| d.severity == Severity::Warning), "{ds:?}");
+        accepted(&ds, strict, "parallel to its viewing direction: +y is up");
+        // Looking along y, +y is no up either: still an error.
+        let (c, ds, _) = read("define camera c 60 0 0 0 0 1 0 0 2 0");
+        assert!(c.is_none());
+        assert!(ds.iter().any(|d| d.severity == Severity::Error), "{ds:?}");
+    }
+
+    #[test]
+    fn a_broken_camera_skips_only_its_render_lines_when_another_stands() {
+        let text = "define camera good 60\ndefine camera bad 60 0 0 0 0 0 0 0 1 0\n\
+                    render bad a.png 8 8\nrender good b.png 8 8\n";
+        let (statements, ds) = parse(text, Path::new("s.sdf"), &LoadOptions::default());
+        assert!(ds.iter().all(|d| d.severity == Severity::Warning), "{ds:?}");
+        let skipped = ds
+            .iter()
+            .find(|d| d.message.contains("camera `bad` is skipped"))
+            .expect("the skipped camera is reported");
+        assert!(skipped.message.contains("(line 3)"), "{}", skipped.message);
+        let renders: Vec<String> = statements
+            .iter()
+            .filter_map(|s| match &s.kind {
+                StatementKind::Render(r) => Some(r.output.clone()),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(renders, ["b.png"]);
+        // As the only render line's camera it stops the file.
+        let text = "define camera bad 60 0 0 0 0 0 0 0 1 0\nrender bad a.png 8 8\n";
+        let (_, ds) = parse(text, Path::new("s.sdf"), &LoadOptions::default());
+        assert!(ds.iter().any(|d| d.severity == Severity::Error), "{ds:?}");
+    }
+}

@@ -466,3 +466,40 @@ fn is_scene_file(scene: &Path, output: &str) -> bool {
     });
     in_same_dir && out.file_name().is_some() && out.file_name() == scene.file_name()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::image_name;
+    use crate::diag::Severity;
+    use crate::sdf::ast::StatementKind;
+    use crate::sdf::{parse, LoadOptions};
+    use std::path::Path;
+
+    #[test]
+    fn output_names_without_an_image_extension_write_ppm() {
+        assert_eq!(image_name("out.png"), None);
+        assert_eq!(image_name("a/b.PPM"), None);
+        assert_eq!(image_name("test0.sdf").as_deref(), Some("test0.ppm"));
+        assert_eq!(image_name("../sdf/box").as_deref(), Some("../sdf/box.ppm"));
+        assert_eq!(image_name("frame.001").as_deref(), Some("frame.001.ppm"));
+    }
+
+    #[test]
+    fn a_render_line_writing_its_own_scene_file_writes_ppm_beside_it() {
+        let text = "define camera c 60\nrender c s.sdf 8 8\n";
+        let (statements, ds) = parse(text, Path::new("s.sdf"), &LoadOptions::default());
+        let output = statements.iter().find_map(|s| match &s.kind {
+            StatementKind::Render(r) => Some(r.output.clone()),
+            _ => None,
+        });
+        assert_eq!(output.as_deref(), Some("s.ppm"));
+        assert!(ds.iter().all(|d| d.severity == Severity::Warning), "{ds:?}");
+        assert!(ds.iter().any(|d| d.message.contains("no image file name")));
+        let strict = LoadOptions {
+            strict: true,
+            ..LoadOptions::default()
+        };
+        let (_, ds) = parse(text, Path::new("s.sdf"), &strict);
+        assert!(ds.iter().any(|d| d.severity == Severity::Error));
+    }
+}

@@ -481,3 +481,76 @@ fn geometry_from(kind: &str, nums: &[f64]) -> Geometry {
         },
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::diag::Severity;
+    use crate::sdf::ast::StatementKind;
+    use crate::sdf::{parse, LoadOptions};
+    use crate::shape::Geometry;
+    use glam::DVec3;
+    use std::path::Path;
+
+    fn shapes(text: &str, strict: bool) -> (Vec<Geometry>, Vec<crate::diag::Diagnostic>) {
+        let opts = LoadOptions {
+            strict,
+            ..LoadOptions::default()
+        };
+        let (statements, ds) = parse(text, Path::new("s.sdf"), &opts);
+        let geometries = statements
+            .into_iter()
+            .filter_map(|s| match s.kind {
+                StatementKind::Shape { geometry, .. } => Some(geometry),
+                _ => None,
+            })
+            .collect();
+        (geometries, ds)
+    }
+
+    #[test]
+    fn five_number_cones_and_cylinders_stand_upright_on_their_base() {
+        let text = "define material m 1 1 1 1 1 1 1 1 1 10\n\
+                    define shape cone k 1 2 3 50 25 m\n\
+                    define shape cylinder z -1 0 -2 4 0.5 m\n";
+        let (g, ds) = shapes(text, false);
+        assert_eq!(
+            g,
+            [
+                Geometry::Cone {
+                    base: DVec3::new(1.0, 2.0, 3.0),
+                    tip: DVec3::new(1.0, 52.0, 3.0),
+                    radius: 25.0
+                },
+                Geometry::Cylinder {
+                    p1: DVec3::new(-1.0, 0.0, -2.0),
+                    p2: DVec3::new(-1.0, 4.0, -2.0),
+                    radius: 0.5
+                }
+            ]
+        );
+        // One warning for the file: later lines written this way are read the same.
+        let upright: Vec<_> = ds
+            .iter()
+            .filter(|d| d.message.contains("[base] <height> <radius>"))
+            .collect();
+        assert_eq!(upright.len(), 1, "{ds:?}");
+        assert_eq!(upright[0].severity, Severity::Warning);
+        let (_, ds) = shapes(text, true);
+        assert!(ds.iter().any(
+            |d| d.severity == Severity::Error && d.message.contains("[base] <height> <radius>")
+        ));
+    }
+
+    #[test]
+    fn other_cone_layouts_stay_errors() {
+        let text = "define material m 1 1 1 1 1 1 1 1 1 10\n\
+                    define shape cone k 0 6 30 0 1 0 10 20 m\n";
+        let (g, ds) = shapes(text, false);
+        assert!(g.is_empty());
+        let e = ds
+            .iter()
+            .find(|d| d.severity == Severity::Error)
+            .expect("an error");
+        assert!(e.message.contains("found 8"), "{}", e.message);
+    }
+}
