@@ -136,3 +136,11 @@ fn a_broken_camera_skips_its_own_render_line() {
         "camera `eye2` is skipped with the render line that uses it",
     );
 }
+
+#[test]
+fn lights_with_a_radius() {
+    accepted_and_drawn(
+        "EmilReinert__raytracer/sdf_scene.txt",
+        "[pos] <radius> [color] <brightness>",
+    );
+}
