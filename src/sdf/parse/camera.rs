@@ -404,6 +404,20 @@ mod tests {
             })
             .collect();
         assert_eq!(renders, ["b.png"]);
+        // A render line naming no camera takes the first one: when that one is rejected, the
+        // line goes with it.
+        let text = "define camera bad 60 0 0 0 0 0 0 0 1 0\ndefine camera good 60\n\
+                    render a.png 8 8\nrender good b.png 8 8\n";
+        let (statements, ds) = parse(text, Path::new("s.sdf"), &LoadOptions::default());
+        assert!(ds.iter().all(|d| d.severity == Severity::Warning), "{ds:?}");
+        let cameras: Vec<String> = statements
+            .iter()
+            .filter_map(|s| match &s.kind {
+                StatementKind::Render(r) => Some(r.camera.name.clone()),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(cameras, ["good"]);
         // As the only render line's camera it stops the file.
         let text = "define camera bad 60 0 0 0 0 0 0 0 1 0\nrender bad a.png 8 8\n";
         let (_, ds) = parse(text, Path::new("s.sdf"), &LoadOptions::default());

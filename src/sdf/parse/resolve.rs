@@ -141,17 +141,6 @@ impl Parser<'_> {
                 continue;
             };
             let mut camera_missing = false;
-            if matches!(pending.camera, RenderCamera::Named)
-                && rejected_cameras.contains(&def.camera.name)
-            {
-                // Its camera's problem is reported once, on the camera's line.
-                skipped_renders
-                    .entry(def.camera.name.clone())
-                    .or_default()
-                    .push(pending.anchor.loc.line);
-                rejected.push(pending.index);
-                continue;
-            }
             match pending.camera {
                 RenderCamera::Named if self.camera_names.contains(&def.camera.name) => {}
                 RenderCamera::Named => match self.camera_names.as_slice() {
@@ -231,6 +220,15 @@ impl Parser<'_> {
                         ));
                     }
                 }
+            }
+            if rejected_cameras.contains(&def.camera.name) {
+                // Its camera's problem is reported once, on the camera's line.
+                skipped_renders
+                    .entry(def.camera.name.clone())
+                    .or_default()
+                    .push(pending.anchor.loc.line);
+                rejected.push(pending.index);
+                continue;
             }
             if !pending.size_given {
                 match self.camera_sizes.get(&def.camera.name) {
