@@ -136,3 +136,48 @@ fn canonical_text_of_corpus_files_loads_to_the_same_jobs() {
     }
     println!("{compared} corpus files round-trip through their canonical text");
 }
+
+/// The corpus summary of `anim check --summary` (BENCHMARKS.md §8) as a regression test: how
+/// many files render an image that is not blank, render blank (each with its reason) or are
+/// rejected, over the 83 distinct files and over all 154 with their `.fake.sdf` twins. A
+/// change in these numbers is a change in what the reader accepts: update them with §8.
+#[test]
+fn corpus_summary_counts() {
+    use anim::scene::probe::{classify, Classification};
+    let Some(shared) = common::shared_dir("corpus_summary_counts") else {
+        return;
+    };
+    let dir = shared.join("corpus/wild");
+    let mut files = Vec::new();
+    common::files_below(&dir, &mut files);
+    files.retain(|f| f.file_name().is_some_and(|n| n != "MANIFEST.tsv"));
+    let opts = LoadOptions {
+        material_fields: anim::sdf::MaterialLayout::Auto,
+        ..LoadOptions::default()
+    };
+    // [renders, blank, rejected] over all files, then over the distinct ones.
+    let (mut all, mut distinct) = ([0usize; 3], [0usize; 3]);
+    let mut silent = Vec::new();
+    for file in &files {
+        let k = match classify(file, &opts) {
+            Classification::Renders => 0,
+            Classification::BlankExplained(why) => {
+                if why.is_empty() {
+                    silent.push(file.display().to_string());
+                }
+                1
+            }
+            Classification::Rejected(_) => 2,
+        };
+        all[k] += 1;
+        if !file.to_string_lossy().ends_with(".fake.sdf") {
+            distinct[k] += 1;
+        }
+    }
+    assert!(silent.is_empty(), "blank without a reason: {silent:?}");
+    assert_eq!(
+        (distinct, all),
+        ([69, 12, 2], [128, 21, 5]),
+        "[renders, blank, rejected] of the distinct files, then of all files"
+    );
+}

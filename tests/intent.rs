@@ -190,6 +190,12 @@ fn accepted_forms_are_errors_when_strict() {
         "define shape sphere b 0 0 -5 1 nothing\n",
         "define light l2 0 5 0 0.1 0.1 0.1 1 1 1 2\n",
         "define camera c3 60 0 0 0 0 0 -1\n",
+        "define camera c4 60 800 600 0 0 5 0 0 -1\n",
+        "define camera c5 60 0 0 5 0 0 0\n",
+        "define camera c6 45 90 0 0 -5 10\n",
+        "define camera c7 60 0 0 5 0 0 -1 0 0 1\n",
+        "define shape cone k 0 0 -5 1 1 red\n",
+        "define shape cylinder z 0 0 -5 1 1 red\n",
     ];
     for form in forms {
         let dir = tempfile::tempdir().expect("temp dir");

@@ -158,6 +158,26 @@ impl Parser<'_> {
                     }
                 }
             }
+            8 if !(0.0..=1.0).contains(&nums[3])
+                && nums[4..7].iter().all(|v| (0.0..=1.0).contains(v)) =>
+            {
+                // `[pos] <radius> [color] <brightness>`: a spherical light of renderers with
+                // soft shadows. The fourth number cannot be a colour component and the next
+                // three can, so the layout is clear; the radius has no point-light meaning.
+                let l = light(c(4), nums[7] as f32);
+                self.variant(
+                    line,
+                    At::Tok(name_at + 4),
+                    "light-radius",
+                    format!(
+                        "8-number light read as [pos] <radius> [color] <brightness>: a point \
+                         light at its centre, the radius {} is ignored",
+                        nums[3]
+                    ),
+                    format!("read as `{}`", StatementKind::Light(l.clone())),
+                );
+                self.emit_named(line, name_at, StatementKind::Light(l));
+            }
             4 => {
                 // No position: the only meaning left is an ambient term, colour × brightness
                 // (`define light ambient1 .3 .2 .6 5`), added like the lecture form's La.
@@ -181,7 +201,8 @@ impl Parser<'_> {
                     At::End
                 };
                 let mut help = format!(
-                    "canonical form: `{FORM_LIGHT}`; 6 numbers (no brightness), 9 and 10 are also read"
+                    "canonical form: `{FORM_LIGHT}`; 6 numbers (no brightness), 9 and 10 are also read, \
+                     and 8 as [pos] <radius> [color] <brightness> when the colour lies in 0..1 and the radius does not"
                 );
                 if matches!(n, 1 | 3) {
                     help.push_str(&format!(
@@ -262,5 +283,52 @@ impl Parser<'_> {
                 );
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::diag::Severity;
+    use crate::sdf::ast::{LightDef, StatementKind};
+    use crate::sdf::{parse, LoadOptions};
+    use glam::{DVec3, Vec3};
+    use std::path::Path;
+
+    fn lights(text: &str, strict: bool) -> (Vec<LightDef>, Vec<crate::diag::Diagnostic>) {
+        let opts = LoadOptions {
+            strict,
+            ..LoadOptions::default()
+        };
+        let (statements, ds) = parse(text, Path::new("s.sdf"), &opts);
+        let lights = statements
+            .into_iter()
+            .filter_map(|s| match s.kind {
+                StatementKind::Light(l) => Some(l),
+                _ => None,
+            })
+            .collect();
+        (lights, ds)
+    }
+
+    #[test]
+    fn eight_number_lights_carry_a_radius_before_the_colour() {
+        let text = "define light small 0 100 0 10 1 0.5 1 0.7\n";
+        let (l, ds) = lights(text, false);
+        assert_eq!(l.len(), 1, "{ds:?}");
+        assert_eq!(l[0].position, DVec3::new(0.0, 100.0, 0.0));
+        assert_eq!(l[0].color, Vec3::new(1.0, 0.5, 1.0));
+        assert_eq!(l[0].brightness, 0.7);
+        assert!(ds.iter().all(|d| d.severity == Severity::Warning), "{ds:?}");
+        assert!(ds.iter().any(|d| d.message.contains("<radius> [color]")));
+        let (_, ds) = lights(text, true);
+        assert!(ds.iter().any(|d| d.severity == Severity::Error));
+    }
+
+    #[test]
+    fn eight_number_lights_without_that_layout_stay_errors() {
+        // The fourth number could be a colour component: no clear reading.
+        let (l, ds) = lights("define light l 0 1 0 0.5 1 1 1 0.7\n", false);
+        assert!(l.is_empty());
+        assert!(ds.iter().any(|d| d.severity == Severity::Error), "{ds:?}");
     }
 }

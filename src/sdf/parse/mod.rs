@@ -130,6 +130,7 @@ pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions, flat: bool) -> 
         camera_sizes: HashMap::new(),
         shapes: FlatShapes::default(),
         flat,
+        camera_errors: Vec::new(),
     };
     // Line by line, one line's tokens at a time: the file is never held as a list of lines.
     // The same pass finds the lines too long to read whole and the definitions in comments.
@@ -201,6 +202,9 @@ struct Parser<'a> {
     /// Whether shapes are kept apart: asked for, and nothing read so far refers to a shape
     /// by name (a composite, a transform) or is a shape kept as a statement (a mesh).
     flat: bool,
+    /// Problems of rejected camera lines, by camera: each rejects only its own camera and
+    /// the render lines using it when another render line stands (settled in `resolve`).
+    camera_errors: Vec<(String, Vec<Diagnostic>)>,
 }
 
 /// The layout of the numbers after the colours of the file's materials: the one named by

@@ -116,6 +116,21 @@ impl Parser<'_> {
         let mut need_default_camera = false;
         let mut rejected = Vec::new();
         let mut outputs: HashMap<String, u32> = HashMap::new();
+        let defined_cameras: HashSet<&str> = self
+            .statements
+            .iter()
+            .filter_map(|s| match &s.kind {
+                StatementKind::Camera(c) => Some(c.name.as_str()),
+                _ => None,
+            })
+            .collect();
+        let rejected_cameras: HashSet<String> = self
+            .camera_errors
+            .iter()
+            .map(|(name, _)| name.clone())
+            .filter(|name| !defined_cameras.contains(name.as_str()))
+            .collect();
+        let mut skipped_renders: HashMap<String, Vec<u32>> = HashMap::new();
         for pending in std::mem::take(&mut self.pending) {
             let mut notes = pending.notes;
             let Some(Statement {
@@ -206,6 +221,15 @@ impl Parser<'_> {
                     }
                 }
             }
+            if rejected_cameras.contains(&def.camera.name) {
+                // Its camera's problem is reported once, on the camera's line.
+                skipped_renders
+                    .entry(def.camera.name.clone())
+                    .or_default()
+                    .push(pending.anchor.loc.line);
+                rejected.push(pending.index);
+                continue;
+            }
             if !pending.size_given {
                 match self.camera_sizes.get(&def.camera.name) {
                     Some(&(w, h)) => {
@@ -226,6 +250,15 @@ impl Parser<'_> {
                         "no output file named: `{default_output}` is written"
                     ));
                 }
+            }
+            if let Some(image) = image_name(&def.output) {
+                // The renderers these files were written for save PPM whatever the name
+                // says; a name without an image extension (or the scene's own) means that.
+                notes.push(format!(
+                    "`{}` is no image file name: `{image}` is written",
+                    def.output
+                ));
+                def.output = image;
             }
             let output = def.output.clone();
             let canonical = StatementKind::Render(def.clone()).to_string();
@@ -269,7 +302,7 @@ impl Parser<'_> {
         for index in rejected.into_iter().rev() {
             self.statements.remove(index);
         }
-        self.settle_render_errors();
+        self.settle_render_errors(&skipped_renders);
         if need_default_camera {
             let loc = Loc {
                 file: self.file.clone(),
@@ -290,11 +323,30 @@ impl Parser<'_> {
 impl Parser<'_> {
     /// A rejected render line stops the file only when no other render line stands: each
     /// render line is its own image, and the others can still be made (warnings then).
-    fn settle_render_errors(&mut self) {
+    fn settle_render_errors(&mut self, skipped_renders: &HashMap<String, Vec<u32>>) {
         let standing = self
             .statements
             .iter()
             .any(|s| matches!(s.kind, StatementKind::Render(_)));
+        for (camera, problems) in std::mem::take(&mut self.camera_errors) {
+            for mut d in problems {
+                if standing && d.severity == Severity::Error {
+                    d.severity = Severity::Warning;
+                    d.message
+                        .push_str(&format!("; camera `{camera}` is skipped"));
+                    if let Some(lines) = skipped_renders.get(&camera) {
+                        let lines: Vec<String> = lines.iter().map(u32::to_string).collect();
+                        d.message.push_str(&format!(
+                            " with the render line{s} that use{v} it (line{s} {}), the other render lines are rendered",
+                            lines.join(", "),
+                            s = if lines.len() == 1 { "" } else { "s" },
+                            v = if lines.len() == 1 { "s" } else { "" },
+                        ));
+                    }
+                }
+                self.diagnostics.push(d);
+            }
+        }
         for mut d in std::mem::take(&mut self.render_errors) {
             if standing && d.severity == Severity::Error {
                 d.severity = Severity::Warning;
@@ -382,6 +434,23 @@ pub fn default_output(path: &Path) -> String {
     format!("{stem}.png")
 }
 
+/// The PPM file meant by an output name without an image extension: its extension replaced
+/// when it is a word (`scene.sdf` → `scene.ppm`), `.ppm` added otherwise (`out`, `frame.001`).
+/// `None` for a name that already ends in an image extension.
+fn image_name(output: &str) -> Option<String> {
+    let path = Path::new(output);
+    let ext = path.extension().and_then(|e| e.to_str());
+    if ext.is_some_and(limits::is_image_extension) || path.file_name().is_none() {
+        return None;
+    }
+    let word = ext.is_some_and(|e| e.chars().all(|c| c.is_ascii_alphabetic()));
+    Some(if word {
+        path.with_extension("ppm").to_string_lossy().into_owned()
+    } else {
+        format!("{output}.ppm")
+    })
+}
+
 /// Whether the output path, resolved (as the renderer does) against the scene file's
 /// directory, is the scene file itself.
 fn is_scene_file(scene: &Path, output: &str) -> bool {
@@ -394,4 +463,41 @@ fn is_scene_file(scene: &Path, output: &str) -> bool {
             .all(|c| matches!(c, std::path::Component::CurDir))
     });
     in_same_dir && out.file_name().is_some() && out.file_name() == scene.file_name()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::image_name;
+    use crate::diag::Severity;
+    use crate::sdf::ast::StatementKind;
+    use crate::sdf::{parse, LoadOptions};
+    use std::path::Path;
+
+    #[test]
+    fn output_names_without_an_image_extension_write_ppm() {
+        assert_eq!(image_name("out.png"), None);
+        assert_eq!(image_name("a/b.PPM"), None);
+        assert_eq!(image_name("test0.sdf").as_deref(), Some("test0.ppm"));
+        assert_eq!(image_name("../sdf/box").as_deref(), Some("../sdf/box.ppm"));
+        assert_eq!(image_name("frame.001").as_deref(), Some("frame.001.ppm"));
+    }
+
+    #[test]
+    fn a_render_line_writing_its_own_scene_file_writes_ppm_beside_it() {
+        let text = "define camera c 60\nrender c s.sdf 8 8\n";
+        let (statements, ds) = parse(text, Path::new("s.sdf"), &LoadOptions::default());
+        let output = statements.iter().find_map(|s| match &s.kind {
+            StatementKind::Render(r) => Some(r.output.clone()),
+            _ => None,
+        });
+        assert_eq!(output.as_deref(), Some("s.ppm"));
+        assert!(ds.iter().all(|d| d.severity == Severity::Warning), "{ds:?}");
+        assert!(ds.iter().any(|d| d.message.contains("no image file name")));
+        let strict = LoadOptions {
+            strict: true,
+            ..LoadOptions::default()
+        };
+        let (_, ds) = parse(text, Path::new("s.sdf"), &strict);
+        assert!(ds.iter().any(|d| d.severity == Severity::Error));
+    }
 }

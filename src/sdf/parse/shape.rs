@@ -120,6 +120,27 @@ impl Parser<'_> {
         let layout = Layout::of(kind);
         let args = self.shape_arguments(line, kind_at, &layout)?;
         let mut geometry = geometry_from(kind, &args.nums);
+        if args.nums.len() == UPRIGHT_NUMBERS {
+            // `[base] <height> <radius>`: the upright cones and cylinders of renderers whose
+            // shapes stand on their base along +y.
+            self.variant(
+                line,
+                At::Span(args.nums_from, args.nums_to - 1),
+                "upright",
+                format!(
+                    "{kind} with 5 numbers read as [base] <height> <radius>, standing upright \
+                     along +y from its base"
+                ),
+                format!(
+                    "read as `{}`",
+                    StatementKind::Shape {
+                        name: args.name.clone(),
+                        geometry: geometry.clone(),
+                        material: self.name_ref(line, args.material_at),
+                    }
+                ),
+            );
+        }
         self.check_geometry(line, kind, &args, &mut geometry);
         let material = self.name_ref(line, args.material_at);
         let kind_stmt = StatementKind::Shape {
@@ -202,7 +223,7 @@ impl Parser<'_> {
             ));
         }
         let nums = self.numbers(line, nums_from, nums_to)?;
-        if nums.len() != expected {
+        if nums.len() != expected && Some(nums.len()) != layout.upright_numbers() {
             let at = if nums.len() > expected {
                 At::Span(nums_from + expected, nums_to - 1)
             } else if material_first {
@@ -380,11 +401,18 @@ impl Layout {
         }
     }
 
+    /// How many numbers the upright form `[base] <height> <radius>` takes, for the kinds
+    /// that have one.
+    fn upright_numbers(&self) -> Option<usize> {
+        matches!(self.kind, "cylinder" | "cone").then_some(UPRIGHT_NUMBERS)
+    }
+
     fn canonical(&self) -> String {
         let form = self.form;
         if matches!(self.kind, "cylinder" | "cone") {
             format!(
-                "canonical form: `{form}` (layouts such as `center height radius` or `pos axis radius height` are not read)"
+                "canonical form: `{form}`; also read: [base] <height> <radius> (5 numbers, upright along +y); \
+                 layouts such as `pos axis radius height` are not read"
             )
         } else {
             format!("canonical form: `{form}`")
@@ -403,9 +431,31 @@ struct ShapeArguments {
     material_first: bool,
 }
 
-/// The primitive of kind `kind` from its numbers (as many as its layout takes).
+/// Numbers of the upright cone and cylinder: `[base] <height> <radius>`.
+const UPRIGHT_NUMBERS: usize = 5;
+
+/// The primitive of kind `kind` from its numbers (as many as its layout takes, or the upright
+/// form's five for a cone or cylinder).
 fn geometry_from(kind: &str, nums: &[f64]) -> Geometry {
     let p = |i: usize| DVec3::new(nums[i], nums[i + 1], nums[i + 2]);
+    if nums.len() == UPRIGHT_NUMBERS {
+        let base = p(0);
+        let top = base + DVec3::new(0.0, nums[3], 0.0);
+        let radius = nums[4];
+        return if kind == "cone" {
+            Geometry::Cone {
+                base,
+                tip: top,
+                radius,
+            }
+        } else {
+            Geometry::Cylinder {
+                p1: base,
+                p2: top,
+                radius,
+            }
+        };
+    }
     match kind {
         "sphere" => Geometry::Sphere {
             center: p(0),
@@ -429,5 +479,78 @@ fn geometry_from(kind: &str, nums: &[f64]) -> Geometry {
             point: p(0),
             normal: p(3),
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::diag::Severity;
+    use crate::sdf::ast::StatementKind;
+    use crate::sdf::{parse, LoadOptions};
+    use crate::shape::Geometry;
+    use glam::DVec3;
+    use std::path::Path;
+
+    fn shapes(text: &str, strict: bool) -> (Vec<Geometry>, Vec<crate::diag::Diagnostic>) {
+        let opts = LoadOptions {
+            strict,
+            ..LoadOptions::default()
+        };
+        let (statements, ds) = parse(text, Path::new("s.sdf"), &opts);
+        let geometries = statements
+            .into_iter()
+            .filter_map(|s| match s.kind {
+                StatementKind::Shape { geometry, .. } => Some(geometry),
+                _ => None,
+            })
+            .collect();
+        (geometries, ds)
+    }
+
+    #[test]
+    fn five_number_cones_and_cylinders_stand_upright_on_their_base() {
+        let text = "define material m 1 1 1 1 1 1 1 1 1 10\n\
+                    define shape cone k 1 2 3 50 25 m\n\
+                    define shape cylinder z -1 0 -2 4 0.5 m\n";
+        let (g, ds) = shapes(text, false);
+        assert_eq!(
+            g,
+            [
+                Geometry::Cone {
+                    base: DVec3::new(1.0, 2.0, 3.0),
+                    tip: DVec3::new(1.0, 52.0, 3.0),
+                    radius: 25.0
+                },
+                Geometry::Cylinder {
+                    p1: DVec3::new(-1.0, 0.0, -2.0),
+                    p2: DVec3::new(-1.0, 4.0, -2.0),
+                    radius: 0.5
+                }
+            ]
+        );
+        // One warning for the file: later lines written this way are read the same.
+        let upright: Vec<_> = ds
+            .iter()
+            .filter(|d| d.message.contains("[base] <height> <radius>"))
+            .collect();
+        assert_eq!(upright.len(), 1, "{ds:?}");
+        assert_eq!(upright[0].severity, Severity::Warning);
+        let (_, ds) = shapes(text, true);
+        assert!(ds.iter().any(
+            |d| d.severity == Severity::Error && d.message.contains("[base] <height> <radius>")
+        ));
+    }
+
+    #[test]
+    fn other_cone_layouts_stay_errors() {
+        let text = "define material m 1 1 1 1 1 1 1 1 1 10\n\
+                    define shape cone k 0 6 30 0 1 0 10 20 m\n";
+        let (g, ds) = shapes(text, false);
+        assert!(g.is_empty());
+        let e = ds
+            .iter()
+            .find(|d| d.severity == Severity::Error)
+            .expect("an error");
+        assert!(e.message.contains("found 8"), "{}", e.message);
     }
 }
