@@ -56,8 +56,7 @@ const ORIGIN_ERROR_FLOOR: f32 = 7.888_609e-31;
 /// where ray origins are offset.
 #[inline]
 pub fn spawn_origin(p: Vec3A, n: Vec3A, dir: Vec3A) -> Vec3A {
-    let magnitude = p.abs().max_element();
-    let offset = ORIGIN_ERROR_FLOOR + magnitude * ORIGIN_ERROR_SCALE;
+    let offset = relative_offset(p);
     let side = if n.dot(dir) >= 0.0 { 1.0 } else { -1.0 };
     p + n * (offset * side)
 }
@@ -66,6 +65,65 @@ pub fn spawn_origin(p: Vec3A, n: Vec3A, dir: Vec3A) -> Vec3A {
 #[inline]
 pub fn spawn_ray(p: Vec3A, n: Vec3A, dir: Vec3A) -> Ray {
     Ray::new(spawn_origin(p, n, dir), dir)
+}
+
+/// The spawn offset `spawn_origin` applies at `p`: the relative bound, before any per-hit
+/// bound raises it.
+#[inline]
+pub fn relative_offset(p: Vec3A) -> f32 {
+    ORIGIN_ERROR_FLOOR + p.abs().max_element() * ORIGIN_ERROR_SCALE
+}
+
+/// `spawn_origin` for a hit that carries its own error bound (`crate::render::primitive`'s
+/// `SurfaceHit`): the side is still chosen by the reported normal `n`, but the origin moves
+/// along `lift`, a unit direction that clears *every* face meeting at `p` (on a face, `n`
+/// itself; on an edge, the bisector of the faces' unit normals), by at least `min_offset`,
+/// the hit's own bound on how far its point and the next ray's view of it can be from the
+/// true surface, divided by how much of the move each face sees (see `Lift`).
+///
+/// Why the side comes from `n` and the move from `lift`: both lie in the edge's cone of
+/// normals, so the half-space `n` bounds holds the solid and moving along `+lift` leaves it
+/// (a ray with `n · dir ≥ 0` then never enters), while `−lift` goes into every face at once
+/// (a ray with `n · dir < 0` starts inside, whichever face it leaves by).
+#[inline]
+pub fn spawn_origin_lifted(p: Vec3A, n: Vec3A, lift: Lift, dir: Vec3A) -> Vec3A {
+    let offset = relative_offset(p).max(lift.min_offset);
+    let side = if n.dot(dir) >= 0.0 { 1.0 } else { -1.0 };
+    p + lift.dir * (offset * side)
+}
+
+/// How a spawned origin leaves a surface point (see `spawn_origin_lifted`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lift {
+    /// Unit direction, in the cone of normals of the faces meeting at the point.
+    pub dir: Vec3A,
+    /// Least offset along `dir`, in world units: the point's error bound over the fraction of
+    /// the move that the most oblique face sees (1 on a face, cos(θ/2) on an edge whose face
+    /// normals are θ apart). 0 when the relative bound alone is enough.
+    pub min_offset: f32,
+}
+
+impl Lift {
+    /// Along the normal, with the relative bound: a hit on one face computed in world space.
+    #[inline]
+    pub fn normal(n: Vec3A) -> Lift {
+        Lift {
+            dir: n,
+            min_offset: 0.0,
+        }
+    }
+}
+
+/// f32 unit round-off, 2⁻²⁴.
+pub const UNIT_ROUNDOFF: f32 = f32::EPSILON * 0.5;
+
+/// Higham's γₙ = n·u / (1 − n·u): the relative error bound of n chained f32 operations (a
+/// sum of n terms, a dot product of length n), taken against the sum of the terms' absolute
+/// values (Higham, "Accuracy and Stability of Numerical Algorithms", §3.1; pbrt-v4 §6.8).
+#[inline]
+pub fn gamma(n: u32) -> f32 {
+    let nu = n as f32 * UNIT_ROUNDOFF;
+    nu / (1.0 - nu)
 }
 
 /// Mirror `d` about the plane with unit normal `n`.
@@ -115,6 +173,63 @@ mod tests {
         let n = Vec3A::X;
         assert!(spawn_origin(p, n, Vec3A::X).x > 1000.0);
         assert!(spawn_origin(p, n, -Vec3A::X).x < 1000.0);
+    }
+
+    #[test]
+    fn lifted_origin_matches_the_plain_one_on_a_face() {
+        let p = Vec3A::new(3.0, -2.0, 7.5);
+        let n = Vec3A::new(0.6, 0.0, 0.8);
+        for dir in [n, -n, Vec3A::X, -Vec3A::Z] {
+            assert_eq!(
+                spawn_origin_lifted(p, n, Lift::normal(n), dir),
+                spawn_origin(p, n, dir)
+            );
+        }
+    }
+
+    #[test]
+    fn lifted_origin_moves_along_the_lift_by_at_least_its_bound() {
+        let p = Vec3A::new(1.0, 1.0, 0.0);
+        let n = Vec3A::X;
+        let lift = Lift {
+            dir: Vec3A::new(1.0, 1.0, 0.0).normalize(),
+            min_offset: 1e-3,
+        };
+        // The side follows the reported normal, the move follows the lift.
+        let out = spawn_origin_lifted(p, n, lift, Vec3A::new(1.0, -5.0, 0.0));
+        let inward = spawn_origin_lifted(p, n, lift, Vec3A::new(-1.0, 5.0, 0.0));
+        assert!(((out - p).length() - 1e-3).abs() < 1e-6, "{out:?}");
+        assert!((out - p).normalize().dot(lift.dir) > 0.999_999);
+        assert!((inward - p).normalize().dot(lift.dir) < -0.999_999);
+        // A bound below the relative one changes nothing.
+        let small = Lift {
+            dir: n,
+            min_offset: relative_offset(p) * 0.5,
+        };
+        assert_eq!(spawn_origin_lifted(p, n, small, n), spawn_origin(p, n, n));
+    }
+
+    #[test]
+    fn gamma_bounds_chained_rounding() {
+        assert_eq!(gamma(0), 0.0);
+        assert!(gamma(1) > UNIT_ROUNDOFF && gamma(1) < 1.000_001 * UNIT_ROUNDOFF);
+        // The sum of 4 terms in f32 against the exact sum, at its worst over many draws.
+        let mut worst = 0.0f64;
+        let mut x = 0x1234_5678u32;
+        for _ in 0..10_000 {
+            let mut next = || {
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                (x as f32 / u32::MAX as f32 - 0.5) * 1e3
+            };
+            let t = [next(), next(), next(), next()];
+            let sum32 = ((t[0] + t[1]) + t[2]) + t[3];
+            let exact: f64 = t.iter().map(|&v| v as f64).sum();
+            let abs: f64 = t.iter().map(|&v| (v as f64).abs()).sum();
+            worst = worst.max((sum32 as f64 - exact).abs() / abs);
+        }
+        assert!(worst > 0.0 && worst <= gamma(3) as f64, "{worst:e}");
     }
 
     #[test]

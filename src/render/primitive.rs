@@ -1,7 +1,7 @@
 //! A shape placed in the world: either baked into world space (no matrix work per ray) or
 //! kept in object space with its transform.
 
-use crate::math::{Aabb, Ray, Transform};
+use crate::math::{gamma, spawn_origin_lifted, Aabb, Lift, Ray, Transform, UNIT_ROUNDOFF};
 use crate::shape::Geometry;
 use crate::shape::{AaBox, Cone, Cylinder, Plane, Shape, ShapeHit, Sphere, Triangle};
 use glam::{Affine3A, DMat3, DVec3, Mat3A, Vec3A};
@@ -13,6 +13,59 @@ pub struct SurfaceHit {
     pub point: Vec3A,
     /// Unit geometric normal, outward for closed shapes (not flipped towards the ray).
     pub normal: Vec3A,
+    /// How rays spawned from here leave the surface: along the normal on a face, along the
+    /// bisector on a rim, by at least this hit's own error bound (see `Primitive::surface`).
+    pub lift: Lift,
+}
+
+impl SurfaceHit {
+    /// A hit on one face computed in world space, whose error the relative spawn bound covers.
+    #[inline]
+    pub fn on_face(t: f32, point: Vec3A, normal: Vec3A) -> SurfaceHit {
+        SurfaceHit {
+            t,
+            point,
+            normal,
+            lift: Lift::normal(normal),
+        }
+    }
+
+    /// Origin of a ray leaving this hit towards `dir`: on the side of the surface `dir`
+    /// points into, clear of it by more than the hit's error bound.
+    #[inline]
+    pub fn spawn_origin(&self, dir: Vec3A) -> Vec3A {
+        spawn_origin_lifted(self.point, self.normal, self.lift, dir)
+    }
+
+    /// A ray leaving this hit towards `dir` (see `spawn_origin`).
+    #[inline]
+    pub fn spawn_ray(&self, dir: Vec3A) -> Ray {
+        Ray::new(self.spawn_origin(dir), dir)
+    }
+}
+
+/// Lift off an edge whose faces have unit outward normals `n1` and `n2`, for a point whose
+/// error is at most `error + per_offset · s` once moved by `s`: along their bisector, which
+/// lies in the cone of normals and whose opposite points into both faces, far enough that
+/// each face, seeing only cos(θ/2) of the move, is cleared by the whole error. Faces within
+/// 2⁻¹⁰ of folding flat onto each other (an edge sharper than a tenth of a degree) are held
+/// to that: no scene holds one, and the bound would exceed the shape.
+fn edge_lift(n1: Vec3A, n2: Vec3A, error: f32, per_offset: f32) -> Lift {
+    let dir = (n1 + n2).normalize_or_zero();
+    let cos_half = dir.dot(n1).min(dir.dot(n2));
+    let seen = (cos_half - per_offset).max(1.0 / 1024.0);
+    Lift {
+        dir,
+        min_offset: error / seen,
+    }
+}
+
+/// Error bound of a hit point computed in world space: the f64 solve rounded to f32 (u·|p|
+/// per coordinate), the rounding of the spawned origin (u·(|p| + s)) and the f64 solve of
+/// the next ray (far below u; counted as one more u). Returns (bound at s = 0, growth per s).
+fn world_space_error(p: Vec3A) -> (f32, f32) {
+    let u = UNIT_ROUNDOFF;
+    ((p.abs() * (3.0 * u)).length(), (Vec3A::ONE * u).length())
 }
 
 /// The object-space side of a transformed primitive. Rays are moved relative to `anchor`
@@ -26,6 +79,71 @@ struct ObjectSpace {
     object_from_world: Affine3A,
     world_from_object: Affine3A,
     normal_to_world: Mat3A,
+    /// Absolute values of both matrices' entries, for the error bound of `Primitive::surface`.
+    abs_world: Affine3A,
+    abs_object: Affine3A,
+    /// Growth of that bound per unit of spawn offset (see `ObjectSpace::error`).
+    error_per_offset: f32,
+}
+
+impl ObjectSpace {
+    fn new(
+        anchor: Vec3A,
+        object_from_world: Affine3A,
+        world_from_object: Affine3A,
+        n: Mat3A,
+    ) -> Self {
+        let abs = |a: &Affine3A| Affine3A {
+            matrix3: Mat3A::from_cols(
+                a.matrix3.x_axis.abs(),
+                a.matrix3.y_axis.abs(),
+                a.matrix3.z_axis.abs(),
+            ),
+            translation: a.translation.abs(),
+        };
+        let (abs_world, abs_object) = (abs(&world_from_object), abs(&object_from_world));
+        let u = UNIT_ROUNDOFF;
+        let per = abs_world.matrix3 * (abs_object.matrix3 * Vec3A::ONE) * gamma(5)
+            + Vec3A::splat(2.0 * u);
+        ObjectSpace {
+            anchor,
+            object_from_world,
+            world_from_object,
+            normal_to_world: n,
+            abs_world,
+            abs_object,
+            error_per_offset: per.length(),
+        }
+    }
+
+    /// World-space bound on how far a spawned origin, as the next ray's transform into object
+    /// space sees it, can be from where exact arithmetic puts it, for a hit at object point
+    /// `p` shown at world point `pw`: (bound for a zero offset, growth per unit of offset).
+    /// The steps, each bounded per coordinate by γₙ times the sum of the absolute values of
+    /// the terms it adds (`crate::math::gamma`; pbrt-v4 carries the same terms as its
+    /// `pError` through `Transform::operator()(Point3fi)`):
+    /// - `p` itself, solved in f64 and rounded to f32: u·|p| in object space (and as much
+    ///   for the f64 solve of the next ray);
+    /// - `pw = W·p + t_W` in f32 (three products, three sums): γ₄·(|W|·|p| + |t_W|);
+    /// - the origin `o = pw ± s·lift` and `o − a` rounded: u·(|pw| + |pw − a| + 2s);
+    /// - `M·(o − a) + t'` in f32: γ₅·(|M|·|o − a| + |t'|) in object space (γ₅: one more u
+    ///   for M's entries rounded to f32), and the mismatch of the two f32 matrices, which
+    ///   are each other's inverse only to u: 2u·(|M|·(|W|·|p| + |t_W|) + |t'|).
+    ///
+    /// Errors made in object space reach the world through |W|. The sum's length bounds the
+    /// error along any unit direction.
+    fn error(&self, p: Vec3A, pw: Vec3A) -> (f32, f32) {
+        let u = UNIT_ROUNDOFF;
+        let (w, m) = (&self.abs_world, &self.abs_object);
+        let ap = p.abs();
+        let forward = w.matrix3 * ap + w.translation;
+        let pa = (pw - self.anchor).abs();
+        let back = m.matrix3 * pa + m.translation;
+        let mismatch = m.matrix3 * forward + m.translation;
+        let object = back * gamma(5) + (ap + mismatch) * (2.0 * u);
+        let world = forward * gamma(4) + (pw.abs() + pa) * u + w.matrix3 * object;
+        (world.length(), self.error_per_offset)
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -109,12 +227,12 @@ impl Primitive {
                 let mut rebased = xf.object_from_world;
                 // Composed in f64, so the object-space anchor keeps its precision.
                 rebased.w_axis = xf.object_from_world.transform_point3(anchor).extend(1.0);
-                let object = ObjectSpace {
-                    anchor: f(anchor),
-                    object_from_world: Affine3A::from_mat4(rebased.as_mat4()),
-                    world_from_object: Affine3A::from_mat4(xf.world_from_object.as_mat4()),
-                    normal_to_world: Mat3A::from(xf.normal_matrix().as_mat3()),
-                };
+                let object = ObjectSpace::new(
+                    f(anchor),
+                    Affine3A::from_mat4(rebased.as_mat4()),
+                    Affine3A::from_mat4(xf.world_from_object.as_mat4()),
+                    Mat3A::from(xf.normal_matrix().as_mat3()),
+                );
                 (shape, Some(Box::new(object)))
             }
         };
@@ -151,20 +269,55 @@ impl Primitive {
         }
     }
 
-    /// Full stage, for the one hit that is kept: world-space point and unit normal.
+    /// Full stage, for the one hit that is kept: world-space point, unit normal, and how
+    /// rays spawned from it leave the surface.
+    ///
+    /// A shape baked into world space keeps the relative spawn bound on its faces (it covers
+    /// world-space rounding many times over: `crate::math::spawn_origin`). A shape traced
+    /// through its matrix carries its own bound (`ObjectSpace::error`): the next ray sees
+    /// the spawned origin through two more f32 transforms, whose error the relative bound
+    /// does not know (for an object far from its own origin, it exceeds it). On a rim, rays
+    /// leave along the bisector of the two faces' world normals: the object-space bisector,
+    /// mapped by a non-uniform scale, may point out of one face while into the solid, so a
+    /// ray spawned inwards by it started outside that face (tests/robustness
+    /// `quadric_apex_and_rims_are_watertight`).
     #[inline]
     pub fn surface(&self, hit: &ShapeHit) -> SurfaceHit {
-        let (point, normal) = match &self.object {
-            None => (hit.point, hit.normal),
-            Some(o) => (
-                o.world_from_object.transform_point3a(hit.point),
-                o.normal_to_world * hit.normal,
-            ),
+        let faces = self.shape.rim_faces(hit.point);
+        let (point, normal, lift) = match &self.object {
+            None => {
+                let normal = hit.normal.normalize_or_zero();
+                let lift = match faces {
+                    None => Lift::normal(normal),
+                    Some([f1, f2]) => {
+                        let (error, per) = world_space_error(hit.point);
+                        edge_lift(f1.normalize_or_zero(), f2.normalize_or_zero(), error, per)
+                    }
+                };
+                (hit.point, normal, lift)
+            }
+            Some(o) => {
+                let point = o.world_from_object.transform_point3a(hit.point);
+                let normal = (o.normal_to_world * hit.normal).normalize_or_zero();
+                let (error, per) = o.error(hit.point, point);
+                let lift = match faces {
+                    None => Lift {
+                        dir: normal,
+                        min_offset: error / (1.0 - per),
+                    },
+                    Some([f1, f2]) => {
+                        let world = |f: Vec3A| (o.normal_to_world * f).normalize_or_zero();
+                        edge_lift(world(f1), world(f2), error, per)
+                    }
+                };
+                (point, normal, lift)
+            }
         };
         SurfaceHit {
             t: hit.t,
             point,
-            normal: normal.normalize_or_zero(),
+            normal,
+            lift,
         }
     }
 

@@ -162,6 +162,23 @@ impl Cone {
     }
 }
 
+impl Cone {
+    /// The outward normals of the side and the base meeting at `point` (in the cone's space)
+    /// when it is a base-rim point as `intersect` snaps hits onto the rim, `None` elsewhere
+    /// (the apex included: its normal, the axis, already clears the whole cone). See
+    /// `Cylinder::rim_faces`.
+    pub fn rim_faces(&self, point: Vec3A) -> Option<[Vec3A; 2]> {
+        let local = self.frame.point_to_local(point.as_dvec3());
+        let (r, h, k) = (self.radius as f64, self.frame.height, self.slope);
+        let rho = (local.x * local.x + local.y * local.y).sqrt();
+        if rho == 0.0 {
+            return None;
+        }
+        let side = DVec3::new(local.x / rho, local.y / rho, -k) / (1.0 + k * k).sqrt();
+        self.frame.rim_faces(local, h, r, r.min(h), side, 1.0)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -85,6 +85,34 @@ impl AxisFrame {
         self.origin + self.u * p.x + self.v * p.y + self.w * p.z
     }
 
+    /// The inverse of `point_to_world`.
+    #[inline]
+    pub fn point_to_local(&self, p: DVec3) -> DVec3 {
+        let rel = p - self.origin;
+        DVec3::new(rel.dot(self.u), rel.dot(self.v), rel.dot(self.w))
+    }
+
+    /// Outward normals (in the shape's space) of the side and the cap at local height `z`
+    /// meeting at a rim point `local`, if `local` is one: a hit `intersect` snapped onto the
+    /// rim lies on it to within rounding, a hit it left alone lies at least the edge band
+    /// from it, so half the band tells them apart. `side` is the side's unit normal there.
+    pub fn rim_faces(
+        &self,
+        local: DVec3,
+        z: f64,
+        radius: f64,
+        smallest: f64,
+        side: DVec3,
+        cap: f64,
+    ) -> Option<[Vec3A; 2]> {
+        let rho = (local.x * local.x + local.y * local.y).sqrt();
+        let half_band = 0.5 * self.edge_band(local, smallest);
+        let on_rim = (local.z - z).abs() <= half_band && (rho - radius).abs() <= half_band;
+        on_rim.then(|| {
+            [side, DVec3::new(0.0, 0.0, cap)].map(|n| self.vector_to_world(n).as_vec3().into())
+        })
+    }
+
     #[inline]
     pub fn vector_to_world(&self, v: DVec3) -> DVec3 {
         self.u * v.x + self.v * v.y + self.w * v.z
@@ -346,6 +374,28 @@ impl Cylinder {
         };
         let normal = AxisFrame::crossing_normal(normal, face, d, inside);
         self.frame.shape_hit(t, local, normal)
+    }
+}
+
+impl Cylinder {
+    /// The outward normals of the side and the cap meeting at `point` (in the cylinder's
+    /// space) when it is a rim point as `intersect` snaps hits onto the rims, `None`
+    /// elsewhere. Spawned rays leave a rim by the bisector of the two (see
+    /// `crate::math::spawn_origin_lifted`), whatever normal the hit reported.
+    pub fn rim_faces(&self, point: Vec3A) -> Option<[Vec3A; 2]> {
+        let local = self.frame.point_to_local(point.as_dvec3());
+        let (r, h) = (self.radius as f64, self.frame.height);
+        let rho = (local.x * local.x + local.y * local.y).sqrt();
+        if rho == 0.0 {
+            return None;
+        }
+        let side = DVec3::new(local.x / rho, local.y / rho, 0.0);
+        let (z, cap) = if local.z < 0.5 * h {
+            (0.0, -1.0)
+        } else {
+            (h, 1.0)
+        };
+        self.frame.rim_faces(local, z, r, r.min(h), side, cap)
     }
 }
 

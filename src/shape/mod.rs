@@ -65,6 +65,17 @@ impl Shape {
         }
     }
 
+    /// The outward normals of the two faces meeting at `point` (shape space) when it lies on
+    /// an edge that `intersect` snaps hits onto (the rims of cylinders and cones), `None`
+    /// for a point on one face. Only the kept hit asks, once.
+    pub fn rim_faces(&self, point: Vec3A) -> Option<[Vec3A; 2]> {
+        match self {
+            Shape::Cylinder(s) => s.rim_faces(point),
+            Shape::Cone(s) => s.rim_faces(point),
+            _ => None,
+        }
+    }
+
     pub fn bounds(&self) -> Aabb {
         match self {
             Shape::Sphere(s) => s.bounds(),
