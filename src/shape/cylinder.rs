@@ -10,7 +10,7 @@
 //!   the hit point is projected back onto the surface, so its only error is the final rounding
 //!   to f32.
 
-use super::ShapeHit;
+use super::{NearFaces, ShapeHit};
 use crate::math::{solve_quadratic, spawn_origin, Aabb, Ray};
 use glam::{DVec3, Vec3A};
 
@@ -92,25 +92,38 @@ impl AxisFrame {
         DVec3::new(rel.dot(self.u), rel.dot(self.v), rel.dot(self.w))
     }
 
-    /// Outward normals (in the shape's space) of the side and the cap at local height `z`
-    /// meeting at a rim point `local`, if `local` is one: a hit `intersect` snapped onto the
-    /// rim lies on it to within rounding, a hit it left alone lies at least the edge band
-    /// from it, so half the band tells them apart. `side` is the side's unit normal there.
-    pub fn rim_faces(
+    /// The side and the cap at local height `z` (outward normal `cap`·w) near local point
+    /// `local` of a shape of `radius` there: on the rim itself both at distance 0 (a hit
+    /// `intersect` snapped onto the rim lies on it to within rounding; one it left alone lies
+    /// at least the edge band away, so half the band tells them apart); elsewhere each with
+    /// the point's distance from its plane, `to_side` for the side (whose unit normal there
+    /// is `side`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn faces_near(
         &self,
         local: DVec3,
         z: f64,
         radius: f64,
         smallest: f64,
         side: DVec3,
+        to_side: f64,
         cap: f64,
-    ) -> Option<[Vec3A; 2]> {
+    ) -> NearFaces {
         let rho = (local.x * local.x + local.y * local.y).sqrt();
         let half_band = 0.5 * self.edge_band(local, smallest);
-        let on_rim = (local.z - z).abs() <= half_band && (rho - radius).abs() <= half_band;
-        on_rim.then(|| {
-            [side, DVec3::new(0.0, 0.0, cap)].map(|n| self.vector_to_world(n).as_vec3().into())
-        })
+        let to_cap = (local.z - z).abs();
+        let on_rim = to_cap <= half_band && (rho - radius).abs() <= half_band;
+        let world = |n: DVec3| -> Vec3A { self.vector_to_world(n).as_vec3().into() };
+        let normals = [world(side), world(DVec3::new(0.0, 0.0, cap))];
+        if on_rim {
+            NearFaces::edge(normals)
+        } else {
+            NearFaces {
+                normals: [normals[0], normals[1], Vec3A::ZERO],
+                distances: [to_side.max(0.0) as f32, to_cap as f32, 0.0],
+                len: 2,
+            }
+        }
     }
 
     #[inline]
@@ -378,16 +391,16 @@ impl Cylinder {
 }
 
 impl Cylinder {
-    /// The outward normals of the side and the cap meeting at `point` (in the cylinder's
-    /// space) when it is a rim point as `intersect` snaps hits onto the rims, `None`
-    /// elsewhere. Spawned rays leave a rim by the bisector of the two (see
-    /// `crate::math::spawn_origin_lifted`), whatever normal the hit reported.
-    pub fn rim_faces(&self, point: Vec3A) -> Option<[Vec3A; 2]> {
+    /// The side and the nearer cap around `point` (in the cylinder's space), with its
+    /// distances from them; both at 0 on a rim, where `intersect` snaps hits (see
+    /// `AxisFrame::faces_near`). Spawned rays leave clear of both
+    /// (`crate::render::primitive::Primitive::surface`), whatever normal the hit reported.
+    pub fn faces_near(&self, point: Vec3A) -> NearFaces {
         let local = self.frame.point_to_local(point.as_dvec3());
         let (r, h) = (self.radius as f64, self.frame.height);
         let rho = (local.x * local.x + local.y * local.y).sqrt();
         if rho == 0.0 {
-            return None;
+            return NearFaces::default();
         }
         let side = DVec3::new(local.x / rho, local.y / rho, 0.0);
         let (z, cap) = if local.z < 0.5 * h {
@@ -395,7 +408,8 @@ impl Cylinder {
         } else {
             (h, 1.0)
         };
-        self.frame.rim_faces(local, z, r, r.min(h), side, cap)
+        self.frame
+            .faces_near(local, z, r, r.min(h), side, r - rho, cap)
     }
 }
 

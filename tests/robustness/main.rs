@@ -27,6 +27,7 @@ use std::time::Instant;
 mod accuracy;
 mod contact;
 mod finite;
+mod lift;
 mod reintersection;
 mod watertight;
 
