@@ -75,41 +75,47 @@ pub fn relative_offset(p: Vec3A) -> f32 {
 }
 
 /// `spawn_origin` for a hit that carries its own error bound (`crate::render::primitive`'s
-/// `SurfaceHit`): the side is still chosen by the reported normal `n`, but the origin moves
-/// along `lift`, a unit direction that clears *every* face meeting at `p` (on a face, `n`
-/// itself; on an edge, the bisector of the faces' unit normals), by at least `min_offset`,
-/// the hit's own bound on how far its point and the next ray's view of it can be from the
-/// true surface, divided by how much of the move each face sees (see `Lift`).
-///
-/// Why the side comes from `n` and the move from `lift`: both lie in the edge's cone of
-/// normals, so the half-space `n` bounds holds the solid and moving along `+lift` leaves it
-/// (a ray with `n · dir ≥ 0` then never enters), while `−lift` goes into every face at once
-/// (a ray with `n · dir < 0` starts inside, whichever face it leaves by).
+/// `SurfaceHit`). The side is chosen by the reported normal `n`, as `spawn_origin` does.
+/// Outwards (`n · dir ≥ 0`) the origin moves along `n`: the half-space `n` bounds holds the
+/// solid (on an edge too: `n` is then in the edge's cone of normals), so a ray leaving it
+/// never comes back, and only the distance matters. Inwards it moves along `−lift.inward`,
+/// a unit direction into *every* face meeting at or passing near `p`, so that the ray starts
+/// inside whichever face it leaves by. Each way by at least the hit's own bound on how far
+/// its point and the next ray's view of it can be from the true surface, over the fraction
+/// of the move the most oblique face sees (see `Lift`).
 #[inline]
 pub fn spawn_origin_lifted(p: Vec3A, n: Vec3A, lift: Lift, dir: Vec3A) -> Vec3A {
-    let offset = relative_offset(p).max(lift.min_offset);
-    let side = if n.dot(dir) >= 0.0 { 1.0 } else { -1.0 };
-    p + lift.dir * (offset * side)
+    let rel = relative_offset(p);
+    if n.dot(dir) >= 0.0 {
+        p + n * rel.max(lift.outward_min)
+    } else {
+        p - lift.inward * rel.max(lift.inward_min)
+    }
 }
 
-/// How a spawned origin leaves a surface point (see `spawn_origin_lifted`).
+/// How spawned origins leave a surface point (see `spawn_origin_lifted`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lift {
-    /// Unit direction, in the cone of normals of the faces meeting at the point.
-    pub dir: Vec3A,
-    /// Least offset along `dir`, in world units: the point's error bound over the fraction of
-    /// the move that the most oblique face sees (1 on a face, cos(θ/2) on an edge whose face
-    /// normals are θ apart). 0 when the relative bound alone is enough.
-    pub min_offset: f32,
+    /// Least offset along the normal for rays leaving outwards, in world units: the point's
+    /// error bound. 0 when the relative bound alone is enough.
+    pub outward_min: f32,
+    /// Unit direction (into the surface along its opposite) for rays leaving inwards: the
+    /// normal on a face, the bisector of the faces' normals on an edge.
+    pub inward: Vec3A,
+    /// Least offset along it: the error bound over the fraction of the move that the most
+    /// oblique face sees (1 on a face, cos(θ/2) on an edge whose face normals are θ apart).
+    pub inward_min: f32,
 }
 
 impl Lift {
-    /// Along the normal, with the relative bound: a hit on one face computed in world space.
+    /// Along the normal both ways, with the relative bound: a hit on one face computed in
+    /// world space.
     #[inline]
     pub fn normal(n: Vec3A) -> Lift {
         Lift {
-            dir: n,
-            min_offset: 0.0,
+            outward_min: 0.0,
+            inward: n,
+            inward_min: 0.0,
         }
     }
 }
@@ -188,25 +194,34 @@ mod tests {
     }
 
     #[test]
-    fn lifted_origin_moves_along_the_lift_by_at_least_its_bound() {
+    fn lifted_origin_moves_along_the_normal_out_and_the_lift_in() {
         let p = Vec3A::new(1.0, 1.0, 0.0);
         let n = Vec3A::X;
         let lift = Lift {
-            dir: Vec3A::new(1.0, 1.0, 0.0).normalize(),
-            min_offset: 1e-3,
+            outward_min: 2e-3,
+            inward: Vec3A::new(1.0, 1.0, 0.0).normalize(),
+            inward_min: 1e-3,
         };
-        // The side follows the reported normal, the move follows the lift.
-        let out = spawn_origin_lifted(p, n, lift, Vec3A::new(1.0, -5.0, 0.0));
-        let inward = spawn_origin_lifted(p, n, lift, Vec3A::new(-1.0, 5.0, 0.0));
-        assert!(((out - p).length() - 1e-3).abs() < 1e-6, "{out:?}");
-        assert!((out - p).normalize().dot(lift.dir) > 0.999_999);
-        assert!((inward - p).normalize().dot(lift.dir) < -0.999_999);
-        // A bound below the relative one changes nothing.
+        // The side follows the reported normal; outwards the move follows it too, inwards
+        // the lift.
+        let out = spawn_origin_lifted(p, n, lift, Vec3A::new(0.1, -5.0, 0.0));
+        let inward = spawn_origin_lifted(p, n, lift, Vec3A::new(-0.1, 5.0, 0.0));
+        assert!(((out - p).length() - 2e-3).abs() < 1e-6, "{out:?}");
+        assert!((out - p).normalize().dot(n) > 0.999_999);
+        assert!(((inward - p).length() - 1e-3).abs() < 1e-6, "{inward:?}");
+        assert!((inward - p).normalize().dot(lift.inward) < -0.999_999);
+        // Bounds below the relative one change nothing.
         let small = Lift {
-            dir: n,
-            min_offset: relative_offset(p) * 0.5,
+            outward_min: relative_offset(p) * 0.5,
+            inward: n,
+            inward_min: relative_offset(p) * 0.5,
         };
-        assert_eq!(spawn_origin_lifted(p, n, small, n), spawn_origin(p, n, n));
+        for dir in [n, -n] {
+            assert_eq!(
+                spawn_origin_lifted(p, n, small, dir),
+                spawn_origin(p, n, dir)
+            );
+        }
     }
 
     #[test]

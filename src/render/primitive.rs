@@ -15,8 +15,9 @@ pub struct SurfaceHit {
     pub point: Vec3A,
     /// Unit geometric normal, outward for closed shapes (not flipped towards the ray).
     pub normal: Vec3A,
-    /// How rays spawned from here leave the surface: along the normal on a face, along the
-    /// bisector on a rim, by at least this hit's own error bound (see `Primitive::surface`).
+    /// How rays spawned from here leave the surface: outwards along the normal, inwards
+    /// into every face around the point, by at least this hit's own error bound (see
+    /// `Primitive::surface`).
     pub lift: Lift,
 }
 
@@ -100,8 +101,9 @@ fn lift_off(normal: Vec3A, point: Vec3A, faces: &[(Vec3A, f32)], error: f32, per
         on[i] = dist <= error;
     }
     let mut lift = Lift {
-        dir: normal,
-        min_offset: error / (1.0 - per),
+        outward_min: error / (1.0 - per),
+        inward: normal,
+        inward_min: error / (1.0 - per),
     };
     for _ in 0..3 {
         let mut chosen = [Vec3A::ZERO; 3];
@@ -113,15 +115,13 @@ fn lift_off(normal: Vec3A, point: Vec3A, faces: &[(Vec3A, f32)], error: f32, per
         if count > 1 {
             let d = lift_direction(&chosen[..count]);
             let clearance = (1.0 / d.length()).max(MIN_CLEARANCE);
-            lift = Lift {
-                dir: d.normalize_or_zero(),
-                min_offset: error / (clearance - per).max(MIN_CLEARANCE),
-            };
+            lift.inward = d.normalize_or_zero();
+            lift.inward_min = error / (clearance - per).max(MIN_CLEARANCE);
         }
-        let s = rel.max(lift.min_offset);
+        let s = rel.max(lift.inward_min);
         let mut grew = false;
         for (i, &(n, dist)) in faces.iter().enumerate() {
-            if !on[i] && dist + s * lift.dir.dot(n) < error + per * s {
+            if !on[i] && dist + s * lift.inward.dot(n) < error + per * s {
                 on[i] = true;
                 grew = true;
             }
@@ -362,8 +362,8 @@ impl Primitive {
     /// world-space rounding many times over: `crate::math::spawn_origin`). A shape traced
     /// through its matrix carries its own bound (`ObjectSpace::error`): the next ray sees
     /// the spawned origin through two more f32 transforms, whose error the relative bound
-    /// does not know (for an object far from its own origin, it exceeds it). On a rim, rays
-    /// leave along the bisector of the two faces' world normals: the object-space bisector,
+    /// does not know (for an object far from its own origin, it exceeds it). Rays spawned
+    /// inwards from a rim leave along the bisector of the two faces' world normals: the object-space bisector,
     /// mapped by a non-uniform scale, may point out of one face while into the solid, so a
     /// ray spawned inwards by it started outside that face (tests/robustness
     /// `quadric_apex_and_rims_are_watertight`).
@@ -584,7 +584,7 @@ mod tests {
         // it through the far side.
         let again = prim.intersect(&hit.spawn_ray(dir), f32::INFINITY).unwrap();
         assert!(again.normal.dot(dir) > 0.0 && again.t > 1000.0, "{again:?}");
-        assert!(hit.lift.dir.dot(hit.normal) < 0.9, "{:?}", hit.lift);
+        assert!(hit.lift.inward.dot(hit.normal) < 0.9, "{:?}", hit.lift);
     }
 
     #[test]
@@ -605,14 +605,14 @@ mod tests {
         let point = Vec3A::new(100.0, 0.0, 0.0);
         let near = [(faces[0], 0.0), (faces[1], relative_offset(point) * 0.5)];
         let lift = lift_off(faces[0], point, &near, 1e-6, 0.0);
-        assert!(lift.dir.dot(faces[1]) > 0.0, "{lift:?}");
-        let s = relative_offset(point).max(lift.min_offset);
+        assert!(lift.inward.dot(faces[1]) > 0.0, "{lift:?}");
+        let s = relative_offset(point).max(lift.inward_min);
         for (n, dist) in near {
-            assert!(dist + s * lift.dir.dot(n) >= 1e-6, "{lift:?}");
+            assert!(dist + s * lift.inward.dot(n) >= 1e-6, "{lift:?}");
         }
         // Far from the edge the normal alone is kept, by the relative bound.
         let far = [(faces[0], 0.0), (faces[1], 1.0)];
-        assert_eq!(lift_off(faces[0], point, &far, 1e-6, 0.0).dir, faces[0]);
+        assert_eq!(lift_off(faces[0], point, &far, 1e-6, 0.0).inward, faces[0]);
     }
 
     #[test]
