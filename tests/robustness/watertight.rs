@@ -240,8 +240,8 @@ fn watertight_uv_sphere_mesh() {
 /// The second kind used to fail (59 of 319,040 rays, all spawned inwards from a rim): the
 /// rim's halfway normal, taken in object space and mapped by a non-uniform scale, may point
 /// into the solid yet out of one face, so the origin moved "inwards" along it started outside
-/// that face. Rims now lift along the bisector of the world normals, by the hit's own error
-/// bound over cos(θ/2) (`Primitive::surface`).
+/// that face. Rays spawned inwards from a rim now move along the bisector of the faces' world
+/// normals, by the hit's own error bound over cos(θ/2) (`Primitive::surface`).
 #[test]
 fn quadric_apex_and_rims_are_watertight() {
     let mut rng = Rng::new(0xED6E ^ soak());
