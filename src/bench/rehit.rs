@@ -18,10 +18,11 @@
 //! negligible rays) plus two directions drawn at random on each side of the surface, so that
 //! rays leave at every angle, grazing ones included.
 
-use crate::math::{reflect, spawn_ray, Ray};
+use crate::math::{reflect, Ray};
 use crate::render::camera::CameraRays;
 use crate::render::compile::RenderScene;
 use crate::render::integrator::fresnel;
+use crate::render::primitive::SurfaceHit;
 use crate::scene::RenderJob;
 use crate::shape::Shape;
 use glam::Vec3A;
@@ -97,13 +98,15 @@ struct Walk<'a> {
 }
 
 impl Walk<'_> {
-    /// Spawns one ray from `hit` of primitive `prim` towards `dir` and judges it.
-    fn spawn(&self, prim: u32, point: Vec3A, normal: Vec3A, dir: Vec3A, out: &mut RehitCount) {
+    /// Spawns one ray from `hit` of primitive `prim` towards `dir`, as the renderer does
+    /// (`SurfaceHit::spawn_ray`), and judges it.
+    fn spawn(&self, prim: u32, hit: &SurfaceHit, dir: Vec3A, out: &mut RehitCount) {
         let shape = self.scene.object_shape(prim);
         let Some(kind) = kind_index(shape) else {
             return;
         };
-        let ray = spawn_ray(point, normal, dir);
+        let normal = hit.normal;
+        let ray = hit.spawn_ray(dir);
         out.by_kind[kind].0 += 1;
         let Some(again) = self.scene.intersect(prim, &ray, f32::INFINITY) else {
             return;
@@ -129,23 +132,18 @@ impl Walk<'_> {
         for light in &scene.lights {
             let l = (light.position - hit.point).normalize_or_zero();
             if n.dot(l) > 0.0 {
-                self.spawn(prim, hit.point, hit.normal, l, out);
+                self.spawn(prim, &hit, l, out);
             }
         }
         for side in [1.0, -1.0] {
             let dir = rng.hemisphere(hit.normal * side);
-            self.spawn(prim, hit.point, hit.normal, dir, out);
+            self.spawn(prim, &hit, dir, out);
         }
         let mirror = reflect(ray.dir, n);
-        self.spawn(prim, hit.point, hit.normal, mirror, out);
+        self.spawn(prim, &hit, mirror, out);
         let recurse = depth < self.max_depth;
         if mat.reflectivity > 0.0 && recurse {
-            self.trace(
-                &spawn_ray(hit.point, hit.normal, mirror),
-                depth + 1,
-                rng,
-                out,
-            );
+            self.trace(&hit.spawn_ray(mirror), depth + 1, rng, out);
         }
         if mat.is_transparent() {
             let eta = if entering { 1.0 / mat.ior } else { mat.ior };
@@ -153,9 +151,9 @@ impl Walk<'_> {
             let (f, cos_t) = fresnel(cos_i, eta);
             if f < 1.0 {
                 let dir = (ray.dir * eta + n * (eta * cos_i - cos_t)).normalize();
-                self.spawn(prim, hit.point, hit.normal, dir, out);
+                self.spawn(prim, &hit, dir, out);
                 if recurse {
-                    self.trace(&spawn_ray(hit.point, hit.normal, dir), depth + 1, rng, out);
+                    self.trace(&hit.spawn_ray(dir), depth + 1, rng, out);
                 }
             }
         }
@@ -240,7 +238,12 @@ mod tests {
         let mut out = RehitCount::default();
         // A "surface point" 1 % inside, claimed to leave outwards.
         let p = Vec3A::new(0.0, 0.0, -3.02);
-        walk.spawn(0, p, Vec3A::Z, Vec3A::Z, &mut out);
+        walk.spawn(
+            0,
+            &SurfaceHit::on_face(1.0, p, Vec3A::Z),
+            Vec3A::Z,
+            &mut out,
+        );
         assert_eq!(out.by_kind[0], (1, 1));
     }
 }

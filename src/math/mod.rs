@@ -56,8 +56,7 @@ const ORIGIN_ERROR_FLOOR: f32 = 7.888_609e-31;
 /// where ray origins are offset.
 #[inline]
 pub fn spawn_origin(p: Vec3A, n: Vec3A, dir: Vec3A) -> Vec3A {
-    let magnitude = p.abs().max_element();
-    let offset = ORIGIN_ERROR_FLOOR + magnitude * ORIGIN_ERROR_SCALE;
+    let offset = relative_offset(p);
     let side = if n.dot(dir) >= 0.0 { 1.0 } else { -1.0 };
     p + n * (offset * side)
 }
@@ -66,6 +65,71 @@ pub fn spawn_origin(p: Vec3A, n: Vec3A, dir: Vec3A) -> Vec3A {
 #[inline]
 pub fn spawn_ray(p: Vec3A, n: Vec3A, dir: Vec3A) -> Ray {
     Ray::new(spawn_origin(p, n, dir), dir)
+}
+
+/// The spawn offset `spawn_origin` applies at `p`: the relative bound, before any per-hit
+/// bound raises it.
+#[inline]
+pub fn relative_offset(p: Vec3A) -> f32 {
+    ORIGIN_ERROR_FLOOR + p.abs().max_element() * ORIGIN_ERROR_SCALE
+}
+
+/// `spawn_origin` for a hit that carries its own error bound (`crate::render::primitive`'s
+/// `SurfaceHit`). The side is chosen by the reported normal `n`, as `spawn_origin` does.
+/// Outwards (`n · dir ≥ 0`) the origin moves along `n`: the half-space `n` bounds holds the
+/// solid (on an edge too: `n` is then in the edge's cone of normals), so a ray leaving it
+/// never comes back, and only the distance matters. Inwards it moves along `−lift.inward`,
+/// a unit direction into *every* face meeting at or passing near `p`, so that the ray starts
+/// inside whichever face it leaves by. Each way by at least the hit's own bound on how far
+/// its point and the next ray's view of it can be from the true surface, over the fraction
+/// of the move the most oblique face sees (see `Lift`).
+#[inline]
+pub fn spawn_origin_lifted(p: Vec3A, n: Vec3A, lift: Lift, dir: Vec3A) -> Vec3A {
+    let rel = relative_offset(p);
+    if n.dot(dir) >= 0.0 {
+        p + n * rel.max(lift.outward_min)
+    } else {
+        p - lift.inward * rel.max(lift.inward_min)
+    }
+}
+
+/// How spawned origins leave a surface point (see `spawn_origin_lifted`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lift {
+    /// Least offset along the normal for rays leaving outwards, in world units: the point's
+    /// error bound. 0 when the relative bound alone is enough.
+    pub outward_min: f32,
+    /// Unit direction (into the surface along its opposite) for rays leaving inwards: the
+    /// normal on a face, the bisector of the faces' normals on an edge.
+    pub inward: Vec3A,
+    /// Least offset along it: the error bound over the fraction of the move that the most
+    /// oblique face sees (1 on a face, cos(θ/2) on an edge whose face normals are θ apart).
+    pub inward_min: f32,
+}
+
+impl Lift {
+    /// Along the normal both ways, with the relative bound: a hit on one face computed in
+    /// world space.
+    #[inline]
+    pub fn normal(n: Vec3A) -> Lift {
+        Lift {
+            outward_min: 0.0,
+            inward: n,
+            inward_min: 0.0,
+        }
+    }
+}
+
+/// f32 unit round-off, 2⁻²⁴.
+pub const UNIT_ROUNDOFF: f32 = f32::EPSILON * 0.5;
+
+/// Higham's γₙ = n·u / (1 − n·u): the relative error bound of n chained f32 operations (a
+/// sum of n terms, a dot product of length n), taken against the sum of the terms' absolute
+/// values (Higham, "Accuracy and Stability of Numerical Algorithms", §3.1; pbrt-v4 §6.8).
+#[inline]
+pub fn gamma(n: u32) -> f32 {
+    let nu = n as f32 * UNIT_ROUNDOFF;
+    nu / (1.0 - nu)
 }
 
 /// Mirror `d` about the plane with unit normal `n`.
@@ -115,6 +179,72 @@ mod tests {
         let n = Vec3A::X;
         assert!(spawn_origin(p, n, Vec3A::X).x > 1000.0);
         assert!(spawn_origin(p, n, -Vec3A::X).x < 1000.0);
+    }
+
+    #[test]
+    fn lifted_origin_matches_the_plain_one_on_a_face() {
+        let p = Vec3A::new(3.0, -2.0, 7.5);
+        let n = Vec3A::new(0.6, 0.0, 0.8);
+        for dir in [n, -n, Vec3A::X, -Vec3A::Z] {
+            assert_eq!(
+                spawn_origin_lifted(p, n, Lift::normal(n), dir),
+                spawn_origin(p, n, dir)
+            );
+        }
+    }
+
+    #[test]
+    fn lifted_origin_moves_along_the_normal_out_and_the_lift_in() {
+        let p = Vec3A::new(1.0, 1.0, 0.0);
+        let n = Vec3A::X;
+        let lift = Lift {
+            outward_min: 2e-3,
+            inward: Vec3A::new(1.0, 1.0, 0.0).normalize(),
+            inward_min: 1e-3,
+        };
+        // The side follows the reported normal; outwards the move follows it too, inwards
+        // the lift.
+        let out = spawn_origin_lifted(p, n, lift, Vec3A::new(0.1, -5.0, 0.0));
+        let inward = spawn_origin_lifted(p, n, lift, Vec3A::new(-0.1, 5.0, 0.0));
+        assert!(((out - p).length() - 2e-3).abs() < 1e-6, "{out:?}");
+        assert!((out - p).normalize().dot(n) > 0.999_999);
+        assert!(((inward - p).length() - 1e-3).abs() < 1e-6, "{inward:?}");
+        assert!((inward - p).normalize().dot(lift.inward) < -0.999_999);
+        // Bounds below the relative one change nothing.
+        let small = Lift {
+            outward_min: relative_offset(p) * 0.5,
+            inward: n,
+            inward_min: relative_offset(p) * 0.5,
+        };
+        for dir in [n, -n] {
+            assert_eq!(
+                spawn_origin_lifted(p, n, small, dir),
+                spawn_origin(p, n, dir)
+            );
+        }
+    }
+
+    #[test]
+    fn gamma_bounds_chained_rounding() {
+        assert_eq!(gamma(0), 0.0);
+        assert!(gamma(1) > UNIT_ROUNDOFF && gamma(1) < 1.000_001 * UNIT_ROUNDOFF);
+        // The sum of 4 terms in f32 against the exact sum, at its worst over many draws.
+        let mut worst = 0.0f64;
+        let mut x = 0x1234_5678u32;
+        for _ in 0..10_000 {
+            let mut next = || {
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                (x as f32 / u32::MAX as f32 - 0.5) * 1e3
+            };
+            let t = [next(), next(), next(), next()];
+            let sum32 = ((t[0] + t[1]) + t[2]) + t[3];
+            let exact: f64 = t.iter().map(|&v| v as f64).sum();
+            let abs: f64 = t.iter().map(|&v| (v as f64).abs()).sum();
+            worst = worst.max((sum32 as f64 - exact).abs() / abs);
+        }
+        assert!(worst > 0.0 && worst <= gamma(3) as f64, "{worst:e}");
     }
 
     #[test]

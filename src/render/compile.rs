@@ -352,9 +352,5 @@ impl RenderScene {
 /// What `Primitive::surface` makes of a world-space hit: the normal renormalised.
 #[inline]
 fn sphere_surface(h: &ShapeHit) -> SurfaceHit {
-    SurfaceHit {
-        t: h.t,
-        point: h.point,
-        normal: h.normal.normalize_or_zero(),
-    }
+    SurfaceHit::on_face(h.t, h.point, h.normal.normalize_or_zero())
 }

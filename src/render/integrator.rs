@@ -4,7 +4,7 @@
 use super::compile::{RenderScene, ShadeMaterial};
 use super::primitive::SurfaceHit;
 use super::RayCounts;
-use crate::math::{reflect, spawn_ray, Ray};
+use crate::math::{reflect, Ray};
 use glam::Vec3A;
 
 /// A ray whose contribution to the pixel is below half an 8-bit step cannot change the
@@ -73,7 +73,7 @@ impl Integrator<'_> {
         let entering = hit.normal.dot(ray.dir) < 0.0;
         // Shading normal faces the incoming ray; the geometric one decides inside/outside.
         let n = if entering { hit.normal } else { -hit.normal };
-        let local = self.local(mat, hit.point, n, -ray.dir, counts);
+        let local = self.local(mat, hit, n, -ray.dir, counts);
         let (rho, alpha) = (mat.reflectivity, mat.opacity);
         if rho == 0.0 && alpha == 1.0 {
             return local;
@@ -100,12 +100,12 @@ impl Integrator<'_> {
         if worth(w_reflect) {
             let dir = reflect(ray.dir, n);
             counts.reflected += 1;
-            let r = spawn_ray(hit.point, hit.normal, dir);
+            let r = hit.spawn_ray(dir);
             c += self.trace(&r, depth + 1, weight * w_reflect, counts) * w_reflect;
         }
         if let Some(dir) = refracted.filter(|_| worth(w_refract)) {
             counts.refracted += 1;
-            let r = spawn_ray(hit.point, hit.normal, dir);
+            let r = hit.spawn_ray(dir);
             c += self.trace(&r, depth + 1, weight * w_refract, counts) * w_refract;
         }
         c
@@ -116,7 +116,7 @@ impl Integrator<'_> {
     fn local(
         &self,
         mat: &ShadeMaterial,
-        p: Vec3A,
+        hit: &SurfaceHit,
         n: Vec3A,
         v: Vec3A,
         counts: &mut RayCounts,
@@ -124,7 +124,7 @@ impl Integrator<'_> {
         let scene = self.scene;
         let mut c = mat.ka * scene.ambient;
         for light in &scene.lights {
-            let to_light = light.position - p;
+            let to_light = light.position - hit.point;
             let dist = to_light.length();
             if dist == 0.0 {
                 continue;
@@ -135,7 +135,7 @@ impl Integrator<'_> {
                 continue;
             }
             counts.shadow += 1;
-            let vis = self.visibility(p, n, l, dist);
+            let vis = self.visibility(hit, l, dist);
             if vis == 0.0 {
                 continue;
             }
@@ -150,10 +150,10 @@ impl Integrator<'_> {
     /// (1 − α) for every transparent surface crossed (shadow rays are not refracted). Any-hit
     /// either way: the first opaque blocker ends the query, and crossings of transparent
     /// objects multiply in whatever order the hierarchy offers them.
-    fn visibility(&self, p: Vec3A, n: Vec3A, l: Vec3A, dist: f32) -> f32 {
+    fn visibility(&self, hit: &SurfaceHit, l: Vec3A, dist: f32) -> f32 {
         let scene = self.scene;
-        let ray = spawn_ray(p, n, l);
-        let light = p + l * dist;
+        let ray = hit.spawn_ray(l);
+        let light = hit.point + l * dist;
         let remaining = (light - ray.origin).dot(l);
         if !scene.any_transparent {
             return if scene.occluded(&ray, remaining) {
@@ -179,7 +179,7 @@ impl Integrator<'_> {
                 if transmit == 0.0 {
                     return true;
                 }
-                segment = spawn_ray(hit.point, hit.normal, l);
+                segment = hit.spawn_ray(l);
                 left = (light - segment.origin).dot(l);
                 if left <= 0.0 {
                     break;

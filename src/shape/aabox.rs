@@ -1,4 +1,4 @@
-use super::ShapeHit;
+use super::{NearFaces, ShapeHit};
 use crate::math::aabb::slabs;
 use crate::math::{Aabb, Ray};
 use glam::Vec3A;
@@ -50,6 +50,31 @@ impl AaBox {
             self.min[axis]
         };
         Some(ShapeHit { t, point, normal })
+    }
+}
+
+impl AaBox {
+    /// The face `hit` lies on and, on each other axis, the nearer of the two faces with the
+    /// hit point's distance from it: at an edge or corner, a ray spawned inwards along the
+    /// hit face's normal alone can start outside a neighbour that a shear made acute.
+    pub fn faces_near(&self, hit: &ShapeHit) -> NearFaces {
+        let mut out = NearFaces {
+            len: 3,
+            ..NearFaces::default()
+        };
+        for axis in 0..3 {
+            let mut n = Vec3A::ZERO;
+            if hit.normal[axis] != 0.0 {
+                n[axis] = hit.normal[axis].signum();
+            } else {
+                let below = hit.point[axis] - self.min[axis];
+                let above = self.max[axis] - hit.point[axis];
+                n[axis] = if above <= below { 1.0 } else { -1.0 };
+                out.distances[axis] = below.min(above).max(0.0);
+            }
+            out.normals[axis] = n;
+        }
+        out
     }
 }
 

@@ -8,7 +8,7 @@
 use super::cylinder::{
     conservative_aabb, discriminant_noise, quadratic_roots, AxisFrame, Nearest, Part,
 };
-use super::ShapeHit;
+use super::{NearFaces, ShapeHit};
 use crate::math::{Aabb, Ray};
 use glam::{DVec3, Vec3A};
 
@@ -159,6 +159,26 @@ impl Cone {
         };
         let normal = AxisFrame::crossing_normal(normal, face, d, inside);
         self.frame.shape_hit(t, local, normal)
+    }
+}
+
+impl Cone {
+    /// The side and the base around `point` (in the cone's space), with its distances from
+    /// them; both at 0 on the base rim, where `intersect` snaps hits; nothing at the apex,
+    /// whose normal, the axis, already clears the whole cone. See `Cylinder::faces_near`.
+    pub fn faces_near(&self, point: Vec3A) -> NearFaces {
+        let local = self.frame.point_to_local(point.as_dvec3());
+        let (r, h, k) = (self.radius as f64, self.frame.height, self.slope);
+        let rho = (local.x * local.x + local.y * local.y).sqrt();
+        if rho == 0.0 {
+            return NearFaces::default();
+        }
+        let norm = (1.0 + k * k).sqrt();
+        let side = DVec3::new(local.x / rho, local.y / rho, -k) / norm;
+        // Distance from the generator's line ρ = k·z in the point's half-plane.
+        let to_side = (k * local.z - rho) / norm;
+        self.frame
+            .faces_near(local, h, r, r.min(h), side, to_side, 1.0)
     }
 }
 

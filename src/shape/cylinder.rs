@@ -10,7 +10,7 @@
 //!   the hit point is projected back onto the surface, so its only error is the final rounding
 //!   to f32.
 
-use super::ShapeHit;
+use super::{NearFaces, ShapeHit};
 use crate::math::{solve_quadratic, spawn_origin, Aabb, Ray};
 use glam::{DVec3, Vec3A};
 
@@ -83,6 +83,47 @@ impl AxisFrame {
     #[inline]
     pub fn point_to_world(&self, p: DVec3) -> DVec3 {
         self.origin + self.u * p.x + self.v * p.y + self.w * p.z
+    }
+
+    /// The inverse of `point_to_world`.
+    #[inline]
+    pub fn point_to_local(&self, p: DVec3) -> DVec3 {
+        let rel = p - self.origin;
+        DVec3::new(rel.dot(self.u), rel.dot(self.v), rel.dot(self.w))
+    }
+
+    /// The side and the cap at local height `z` (outward normal `cap`·w) near local point
+    /// `local` of a shape of `radius` there: on the rim itself both at distance 0 (a hit
+    /// `intersect` snapped onto the rim lies on it to within rounding; one it left alone lies
+    /// at least the edge band away, so half the band tells them apart); elsewhere each with
+    /// the point's distance from its plane, `to_side` for the side (whose unit normal there
+    /// is `side`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn faces_near(
+        &self,
+        local: DVec3,
+        z: f64,
+        radius: f64,
+        smallest: f64,
+        side: DVec3,
+        to_side: f64,
+        cap: f64,
+    ) -> NearFaces {
+        let rho = (local.x * local.x + local.y * local.y).sqrt();
+        let half_band = 0.5 * self.edge_band(local, smallest);
+        let to_cap = (local.z - z).abs();
+        let on_rim = to_cap <= half_band && (rho - radius).abs() <= half_band;
+        let world = |n: DVec3| -> Vec3A { self.vector_to_world(n).as_vec3().into() };
+        let normals = [world(side), world(DVec3::new(0.0, 0.0, cap))];
+        if on_rim {
+            NearFaces::edge(normals)
+        } else {
+            NearFaces {
+                normals: [normals[0], normals[1], Vec3A::ZERO],
+                distances: [to_side.max(0.0) as f32, to_cap as f32, 0.0],
+                len: 2,
+            }
+        }
     }
 
     #[inline]
@@ -346,6 +387,29 @@ impl Cylinder {
         };
         let normal = AxisFrame::crossing_normal(normal, face, d, inside);
         self.frame.shape_hit(t, local, normal)
+    }
+}
+
+impl Cylinder {
+    /// The side and the nearer cap around `point` (in the cylinder's space), with its
+    /// distances from them; both at 0 on a rim, where `intersect` snaps hits (see
+    /// `AxisFrame::faces_near`). Spawned rays leave clear of both
+    /// (`crate::render::primitive::Primitive::surface`), whatever normal the hit reported.
+    pub fn faces_near(&self, point: Vec3A) -> NearFaces {
+        let local = self.frame.point_to_local(point.as_dvec3());
+        let (r, h) = (self.radius as f64, self.frame.height);
+        let rho = (local.x * local.x + local.y * local.y).sqrt();
+        if rho == 0.0 {
+            return NearFaces::default();
+        }
+        let side = DVec3::new(local.x / rho, local.y / rho, 0.0);
+        let (z, cap) = if local.z < 0.5 * h {
+            (0.0, -1.0)
+        } else {
+            (h, 1.0)
+        };
+        self.frame
+            .faces_near(local, z, r, r.min(h), side, r - rho, cap)
     }
 }
 

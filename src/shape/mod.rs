@@ -31,6 +31,35 @@ use crate::math::{Aabb, Ray};
 use glam::Vec3A;
 use std::sync::Arc;
 
+/// Up to three faces of a shape meeting at or passing near a surface point (shape space):
+/// each face's outward unit normal and the point's distance from its plane. Empty for a point
+/// with no edge nearby: the hit's normal is then the only face.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NearFaces {
+    pub normals: [Vec3A; 3],
+    pub distances: [f32; 3],
+    pub len: usize,
+}
+
+impl NearFaces {
+    /// Both faces of an edge a hit was snapped onto: the point lies on both.
+    pub fn edge(normals: [Vec3A; 2]) -> NearFaces {
+        NearFaces {
+            normals: [normals[0], normals[1], Vec3A::ZERO],
+            distances: [0.0; 3],
+            len: 2,
+        }
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = (Vec3A, f32)> + '_ {
+        self.normals
+            .iter()
+            .copied()
+            .zip(self.distances.iter().copied())
+            .take(self.len)
+    }
+}
+
 /// A hit in the shape's own space.
 #[derive(Clone, Copy, Debug)]
 pub struct ShapeHit {
@@ -62,6 +91,17 @@ impl Shape {
             Shape::Cylinder(s) => s.intersect(ray, t_max),
             Shape::Cone(s) => s.intersect(ray, t_max),
             Shape::Mesh(s) => s.intersect(ray, t_max),
+        }
+    }
+
+    /// The faces a kept hit lies on or near, for lifting rays spawned from it off all of them
+    /// (`crate::render::primitive::Primitive::surface`). Only the kept hit asks, once.
+    pub fn faces_near(&self, hit: &ShapeHit) -> NearFaces {
+        match self {
+            Shape::Cylinder(s) => s.faces_near(hit.point),
+            Shape::Cone(s) => s.faces_near(hit.point),
+            Shape::Box(s) => s.faces_near(hit),
+            _ => NearFaces::default(),
         }
     }
 

@@ -81,7 +81,7 @@ fn contact_shadows_reach_the_resting_sphere() {
                         hit.normal
                     );
                     let to_light = v32(light) - hit.point;
-                    let shadow = spawn_ray(hit.point, hit.normal, to_light);
+                    let shadow = hit.spawn_ray(to_light);
                     assert!(
                         support.intersect(&shadow, 1.0).is_none(),
                         "{name} at scale {scale}: the shadow ray hit its own surface"

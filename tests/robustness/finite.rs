@@ -84,7 +84,10 @@ proptest! {
                 dir
             };
             let ray = Ray::new(origin, dir);
-            if let Some(SurfaceHit { t, point, normal }) = prim.intersect(&ray, t_max) {
+            if let Some(SurfaceHit {
+                t, point, normal, ..
+            }) = prim.intersect(&ray, t_max)
+            {
                 prop_assert!(t.is_finite() && t > 0.0 && t < t_max, "{name}: t = {t} for {ray:?}");
                 prop_assert!(point.is_finite(), "{name}: point {point:?} for {ray:?}");
                 prop_assert!(

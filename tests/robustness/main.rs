@@ -1,7 +1,7 @@
 //! Numerical robustness of every primitive, tested through the same `Primitive` the renderer
 //! uses (world transforms, baking, object-space matrices and all):
 //!
-//! - re-intersection: rays spawned with `spawn_ray` from surface points never hit the surface
+//! - re-intersection: rays spawned with `SurfaceHit::spawn_ray` from surface points never hit the surface
 //!   they leave (10⁶ rays per primitive kind, scales 1e-4 … 1e5, random transforms);
 //! - contact: the spawn offset is small enough that a sphere resting on a plane or a box still
 //!   shadows the surface right next to the contact point;
@@ -14,7 +14,7 @@
 //! Randomness is a seeded SplitMix64, so every failure message (kind, seed, object, ray)
 //! reproduces exactly.
 
-use anim::math::{spawn_origin, spawn_ray, Ray, Transform};
+use anim::math::{Ray, Transform};
 use anim::render::primitive::{Primitive, SurfaceHit};
 use anim::scene::Geometry;
 use glam::{DVec3, Vec3A};
@@ -27,6 +27,7 @@ use std::time::Instant;
 mod accuracy;
 mod contact;
 mod finite;
+mod lift;
 mod reintersection;
 mod watertight;
 
@@ -512,8 +513,8 @@ struct Target<'a> {
     size: f64,
 }
 
-/// Spawns one ray from `hit` towards `dir`, with the offset `spawn_origin` applies scaled by
-/// `offset_factor` (1 = the renderer's own `spawn_ray`), and records in `stats` whether it
+/// Spawns one ray from `hit` towards `dir`, with the offset `SurfaceHit::spawn_origin` applies
+/// scaled by `offset_factor` (1 = the renderer's own `SurfaceHit::spawn_ray`), and records in `stats` whether it
 /// behaves: leaving a planar shape, or a closed (convex) one outwards, it must hit nothing;
 /// going into a closed shape it must reach the far side, judged against the exact f64 exit.
 fn spawn_and_check(
@@ -526,9 +527,9 @@ fn spawn_and_check(
 ) {
     let (p, n) = (hit.point, hit.normal);
     let ray = if offset_factor == 1.0 {
-        spawn_ray(p, n, dir)
+        hit.spawn_ray(dir)
     } else {
-        Ray::new(p + (spawn_origin(p, n, dir) - p) * offset_factor, dir)
+        Ray::new(p + (hit.spawn_origin(dir) - p) * offset_factor, dir)
     };
     stats.rays += 1;
     let again = target.prim.intersect(&ray, f32::INFINITY);

@@ -4,7 +4,7 @@ use super::*;
 
 /// Spawns `2 · points` rays (one on each side of the surface per point) from random surface
 /// points of `objects` random placements of `kind`. `offset_factor` scales the offset that
-/// `spawn_origin` applies (1 = the renderer's own `spawn_ray`); below 1 it measures how much
+/// `SurfaceHit::spawn_origin` applies (1 = the renderer's own `SurfaceHit::spawn_ray`); below 1 it measures how much
 /// margin the offset has.
 fn reintersection(
     kind: Kind,

@@ -234,14 +234,14 @@ fn watertight_uv_sphere_mesh() {
 /// rims where a side meets a cap. Rays aimed exactly at them, from outside into the solid and
 /// from inside out, must hit there (t = 1 for a direction of target − origin), neither
 /// slipping in (hitting the far side from inside instead) nor out (no hit at all); and rays
-/// spawned from those hits must not re-hit the surface.
+/// spawned from those hits must not re-hit the surface, whether the quadric is baked into
+/// world space (similarity transforms) or traced through its matrix (non-uniform scales).
 ///
-/// The last holds for shapes placed by similarity transforms (baked into world space), not yet
-/// for non-uniformly scaled ones: `Primitive` keeps those in object space, where the world
-/// offset along the world normal turns into an offset with a tangential part that the shape's
-/// edge band (`AxisFrame::edge_band`, in object units) cannot anticipate. Measured here and
-/// printed (~1e-4 of the rays spawned from hits exactly on an edge), not asserted; the
-/// random re-intersection tests above, with the same transforms, see none.
+/// The second kind used to fail (59 of 319,040 rays, all spawned inwards from a rim): the
+/// rim's halfway normal, taken in object space and mapped by a non-uniform scale, may point
+/// into the solid yet out of one face, so the origin moved "inwards" along it started outside
+/// that face. Rays spawned inwards from a rim now move along the bisector of the faces' world
+/// normals, by the hit's own error bound over cos(θ/2) (`Primitive::surface`).
 #[test]
 fn quadric_apex_and_rims_are_watertight() {
     let mut rng = Rng::new(0xED6E ^ soak());
@@ -250,7 +250,10 @@ fn quadric_apex_and_rims_are_watertight() {
         min_exit_ratio: f64::INFINITY,
         ..Stats::default()
     };
-    let mut spawned_object_space = Stats::default();
+    let mut spawned_object_space = Stats {
+        min_exit_ratio: f64::INFINITY,
+        ..Stats::default()
+    };
     for kind in [Kind::Cone, Kind::Cylinder] {
         for object in 0..400 {
             let obj = random_object(kind, &mut rng);
@@ -335,11 +338,15 @@ fn quadric_apex_and_rims_are_watertight() {
          (non-uniformly scaled) ones with {} failures",
         spawned.rays, spawned.failures, spawned_object_space.rays, spawned_object_space.failures
     );
-    assert!(
-        spawned.failures == 0,
-        "{} of {} rays spawned from apex or rim hits hit the surface they left:\n{}",
-        spawned.failures,
-        spawned.rays,
-        spawned.messages.join("\n")
-    );
+    for (stats, what) in [(&spawned, "baked"), (&spawned_object_space, "object-space")] {
+        assert!(
+            stats.failures == 0,
+            "{} of {} rays spawned from apex or rim hits of {what} quadrics hit the surface \
+             they left:\n{}",
+            stats.failures,
+            stats.rays,
+            stats.messages.join("\n")
+        );
+    }
+    assert!(spawned.rays > 300_000 && spawned_object_space.rays > 300_000);
 }
