@@ -95,10 +95,9 @@ impl Integrator<'_> {
         let entering = hit.normal.dot(ray.dir) < 0.0;
         // Shading normal faces the incoming ray; the geometric one decides inside/outside.
         let n = if entering { hit.normal } else { -hit.normal };
-        let local = self.local(mat, hit.point, n, -ray.dir, st);
         let (rho, alpha) = (mat.reflectivity, mat.opacity);
         if rho == 0.0 && alpha == 1.0 {
-            return local;
+            return self.local(mat, hit.point, n, -ray.dir, st);
         }
 
         // c = α·((1−ρ)·c_local + ρ·c_r) + (1−α)·(F·c_r + (1−F)·c_t)
@@ -115,7 +114,14 @@ impl Integrator<'_> {
         }
         let w_reflect = alpha * rho + (1.0 - alpha) * fresnel_f;
         let w_refract = (1.0 - alpha) * (1.0 - fresnel_f);
-        let mut c = local * (alpha * (1.0 - rho));
+        // A perfect mirror or clear glass shows none of its local colour: its shadow rays
+        // would be multiplied by zero.
+        let w_local = alpha * (1.0 - rho);
+        let mut c = if w_local == 0.0 {
+            Vec3A::ZERO
+        } else {
+            self.local(mat, hit.point, n, -ray.dir, st) * w_local
+        };
         let can_recurse = depth < self.max_depth;
         let worth =
             |w: f32| can_recurse && w > 0.0 && weight * w * scene.max_radiance >= NEGLIGIBLE;
