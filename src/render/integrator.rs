@@ -152,7 +152,7 @@ impl Integrator<'_> {
         let scene = self.scene;
         let mut c = mat.ka * scene.ambient;
         // `ks·spec` is exactly zero without a specular colour (spec is at most 1 for m ≥ 0).
-        let specular = mat.ks != Vec3A::ZERO || !(mat.m >= 0.0);
+        let specular = mat.ks != Vec3A::ZERO || mat.m < 0.0 || mat.m.is_nan();
         for (k, light) in scene.lights.iter().enumerate() {
             let to_light = light.position - p;
             let dist = to_light.length();
