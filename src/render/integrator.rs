@@ -17,6 +17,28 @@ const MAX_SHADOW_CROSSINGS: usize = 64;
 /// The primitive index reported for a camera ray that hit nothing.
 pub const NO_HIT: u32 = u32::MAX;
 
+/// Lights whose last blocker a [`TraceState`] remembers (the others go without).
+const CACHED_LIGHTS: usize = 8;
+
+/// What one worker keeps between the rays it traces: its ray counts, and per light the
+/// opaque primitive that last blocked a shadow ray (see [`Integrator::visibility`]). The
+/// cache only saves work, never changes a value, so images do not depend on which worker
+/// traced which pixel.
+#[derive(Clone, Debug)]
+pub struct TraceState {
+    pub counts: RayCounts,
+    blockers: [u32; CACHED_LIGHTS],
+}
+
+impl Default for TraceState {
+    fn default() -> Self {
+        TraceState {
+            counts: RayCounts::default(),
+            blockers: [NO_HIT; CACHED_LIGHTS],
+        }
+    }
+}
+
 pub struct Integrator<'a> {
     pub scene: &'a RenderScene,
     pub max_depth: u32,
@@ -40,9 +62,9 @@ impl Integrator<'_> {
     /// Radiance arriving along `ray` (unit direction). `weight` is the ray's share of the
     /// pixel, `depth` the number of bounces so far.
     #[inline]
-    pub fn trace(&self, ray: &Ray, depth: u32, weight: f32, counts: &mut RayCounts) -> Vec3A {
+    pub fn trace(&self, ray: &Ray, depth: u32, weight: f32, st: &mut TraceState) -> Vec3A {
         match self.scene.closest(ray, f32::INFINITY) {
-            Some((prim, hit)) => self.shade(ray, prim, &hit, depth, weight, counts),
+            Some((prim, hit)) => self.shade(ray, prim, &hit, depth, weight, st),
             None => self.scene.background,
         }
     }
@@ -50,9 +72,9 @@ impl Integrator<'_> {
     /// Radiance along a camera ray and the primitive it hit ([`NO_HIT`] for the background),
     /// which adaptive sampling compares between neighbouring pixels. The uniform path keeps
     /// calling [`Integrator::trace`].
-    pub fn trace_primary(&self, ray: &Ray, counts: &mut RayCounts) -> (Vec3A, u32) {
+    pub fn trace_primary(&self, ray: &Ray, st: &mut TraceState) -> (Vec3A, u32) {
         match self.scene.closest(ray, f32::INFINITY) {
-            Some((prim, hit)) => (self.shade(ray, prim, &hit, 0, 1.0, counts), prim),
+            Some((prim, hit)) => (self.shade(ray, prim, &hit, 0, 1.0, st), prim),
             None => (self.scene.background, NO_HIT),
         }
     }
@@ -66,17 +88,16 @@ impl Integrator<'_> {
         hit: &SurfaceHit,
         depth: u32,
         weight: f32,
-        counts: &mut RayCounts,
+        st: &mut TraceState,
     ) -> Vec3A {
         let scene = self.scene;
         let mat = &scene.materials[scene.material_of(prim) as usize];
         let entering = hit.normal.dot(ray.dir) < 0.0;
         // Shading normal faces the incoming ray; the geometric one decides inside/outside.
         let n = if entering { hit.normal } else { -hit.normal };
-        let local = self.local(mat, hit, n, -ray.dir, counts);
         let (rho, alpha) = (mat.reflectivity, mat.opacity);
         if rho == 0.0 && alpha == 1.0 {
-            return local;
+            return self.local(mat, hit, n, -ray.dir, st);
         }
 
         // c = α·((1−ρ)·c_local + ρ·c_r) + (1−α)·(F·c_r + (1−F)·c_t)
@@ -93,20 +114,27 @@ impl Integrator<'_> {
         }
         let w_reflect = alpha * rho + (1.0 - alpha) * fresnel_f;
         let w_refract = (1.0 - alpha) * (1.0 - fresnel_f);
-        let mut c = local * (alpha * (1.0 - rho));
+        // A perfect mirror or clear glass shows none of its local colour: its shadow rays
+        // would be multiplied by zero.
+        let w_local = alpha * (1.0 - rho);
+        let mut c = if w_local == 0.0 {
+            Vec3A::ZERO
+        } else {
+            self.local(mat, hit, n, -ray.dir, st) * w_local
+        };
         let can_recurse = depth < self.max_depth;
         let worth =
             |w: f32| can_recurse && w > 0.0 && weight * w * scene.max_radiance >= NEGLIGIBLE;
         if worth(w_reflect) {
             let dir = reflect(ray.dir, n);
-            counts.reflected += 1;
+            st.counts.reflected += 1;
             let r = hit.spawn_ray(dir);
-            c += self.trace(&r, depth + 1, weight * w_reflect, counts) * w_reflect;
+            c += self.trace(&r, depth + 1, weight * w_reflect, st) * w_reflect;
         }
         if let Some(dir) = refracted.filter(|_| worth(w_refract)) {
-            counts.refracted += 1;
+            st.counts.refracted += 1;
             let r = hit.spawn_ray(dir);
-            c += self.trace(&r, depth + 1, weight * w_refract, counts) * w_refract;
+            c += self.trace(&r, depth + 1, weight * w_refract, st) * w_refract;
         }
         c
     }
@@ -119,11 +147,13 @@ impl Integrator<'_> {
         hit: &SurfaceHit,
         n: Vec3A,
         v: Vec3A,
-        counts: &mut RayCounts,
+        st: &mut TraceState,
     ) -> Vec3A {
         let scene = self.scene;
         let mut c = mat.ka * scene.ambient;
-        for light in &scene.lights {
+        // `ks·spec` is exactly zero without a specular colour (spec is at most 1 for m ≥ 0).
+        let specular = mat.ks != Vec3A::ZERO || mat.m < 0.0 || mat.m.is_nan();
+        for (k, light) in scene.lights.iter().enumerate() {
             let to_light = light.position - hit.point;
             let dist = to_light.length();
             if dist == 0.0 {
@@ -134,14 +164,29 @@ impl Integrator<'_> {
             if n_dot_l <= 0.0 {
                 continue;
             }
-            counts.shadow += 1;
-            let vis = self.visibility(hit, l, dist);
+            let spec = if specular {
+                let r_dot_v = reflect(-l, n).dot(v);
+                // powf(0, m) is 0 for every positive m: no call for the unlit half.
+                if r_dot_v > 0.0 || mat.m <= 0.0 {
+                    r_dot_v.max(0.0).powf(mat.m)
+                } else {
+                    0.0
+                }
+            } else {
+                0.0
+            };
+            let unshadowed = mat.kd * n_dot_l + mat.ks * spec;
+            // Nothing to shadow (glass has no diffuse term, so only its highlights count):
+            // adding zero changes no value, so the shadow ray is not traced.
+            if unshadowed == Vec3A::ZERO {
+                continue;
+            }
+            st.counts.shadow += 1;
+            let vis = self.visibility(hit, l, dist, st.blockers.get_mut(k));
             if vis == 0.0 {
                 continue;
             }
-            let r = reflect(-l, n);
-            let spec = r.dot(v).max(0.0).powf(mat.m);
-            c += light.intensity * vis * (mat.kd * n_dot_l + mat.ks * spec);
+            c += light.intensity * vis * unshadowed;
         }
         c
     }
@@ -150,23 +195,42 @@ impl Integrator<'_> {
     /// (1 − α) for every transparent surface crossed (shadow rays are not refracted). Any-hit
     /// either way: the first opaque blocker ends the query, and crossings of transparent
     /// objects multiply in whatever order the hierarchy offers them.
-    fn visibility(&self, hit: &SurfaceHit, l: Vec3A, dist: f32) -> f32 {
+    ///
+    /// `blocker` is this light's entry of the worker's [`TraceState`]: the opaque primitive
+    /// that last blocked a shadow ray towards it. Neighbouring points mostly lie in the same
+    /// shadow, so that one is tried first; an opaque hit means no light whatever else the ray
+    /// crosses, so the answer is the same as without the cache.
+    fn visibility(
+        &self,
+        hit: &SurfaceHit,
+        l: Vec3A,
+        dist: f32,
+        mut blocker: Option<&mut u32>,
+    ) -> f32 {
         let scene = self.scene;
         let ray = hit.spawn_ray(l);
         let light = hit.point + l * dist;
         let remaining = (light - ray.origin).dot(l);
-        if !scene.any_transparent {
-            return if scene.occluded(&ray, remaining) {
-                0.0
-            } else {
-                1.0
-            };
+        if let Some(&mut b) = blocker.as_deref_mut() {
+            if b != NO_HIT && scene.hit(b, &ray, remaining).is_some() {
+                return 0.0;
+            }
+        }
+        // Most shadow rays meet nothing at all; the plain any-hit query (packed spheres four
+        // at a time) says so for them. Only a ray that meets something needs the walk below,
+        // which tells glass from opaque and names the blocker for the next ray.
+        if !scene.occluded(&ray, remaining) {
+            return 1.0;
         }
         let mut transmit = 1.0f32;
         let blocked = scene.any_candidate(&ray, remaining, |i| {
             let opacity = scene.materials[scene.material_of(i) as usize].opacity;
             if opacity >= 1.0 {
-                return scene.hit(i, &ray, remaining).is_some();
+                let hit = scene.hit(i, &ray, remaining).is_some();
+                if let Some(b) = blocker.as_deref_mut().filter(|_| hit) {
+                    *b = i;
+                }
+                return hit;
             }
             // Count this object's crossings along the segment, stepping past each one.
             let mut segment = ray;
@@ -187,7 +251,8 @@ impl Integrator<'_> {
             }
             false
         });
-        if blocked {
+        // Without glass, what `occluded` met was opaque, whether or not the walk named it.
+        if blocked || !scene.any_transparent {
             0.0
         } else {
             transmit

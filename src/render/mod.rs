@@ -12,7 +12,7 @@ use crate::scene::{Camera, RenderJob, Scene};
 use camera::{sample_offsets, CameraError, CameraRays};
 use compile::RenderScene;
 use glam::{DVec3, Vec3, Vec3A};
-use integrator::{Integrator, NO_HIT};
+use integrator::{Integrator, TraceState, NO_HIT};
 use rayon::prelude::*;
 use std::path::PathBuf;
 
@@ -231,21 +231,21 @@ fn render_uniform(
         .par_iter()
         .map(|&(x0, y0)| {
             let (x1, y1) = ((x0 + TILE).min(width), (y0 + TILE).min(height));
-            let mut counts = RayCounts::default();
+            let mut st = TraceState::default();
             let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
             for y in y0..y1 {
                 for x in x0..x1 {
                     let mut sum = Vec3A::ZERO;
                     for &(dx, dy) in &offsets {
                         let ray = camera.ray(x as f32 + dx, y as f32 + dy);
-                        sum += integrator.trace(&ray, 0, 1.0, &mut counts);
+                        sum += integrator.trace(&ray, 0, 1.0, &mut st);
                     }
-                    counts.primary += offsets.len() as u64;
+                    st.counts.primary += offsets.len() as u64;
                     out.push(Vec3::from(sum * inv_spp));
                 }
             }
             on_tile(out.len() as u64);
-            (out, counts)
+            (out, st.counts)
         })
         .collect();
     let mut pixels = vec![Vec3::ZERO; (width * height) as usize];
@@ -298,13 +298,13 @@ fn render_adaptive(
         .par_chunks_mut(w)
         .enumerate()
         .map(|(y, row)| {
-            let mut counts = RayCounts::default();
+            let mut st = TraceState::default();
             for (x, px) in row.iter_mut().enumerate() {
                 let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
-                *px = integrator.trace_primary(&ray, &mut counts);
+                *px = integrator.trace_primary(&ray, &mut st);
             }
-            counts.primary += row.len() as u64;
-            counts
+            st.counts.primary += row.len() as u64;
+            st.counts
         })
         .reduce(RayCounts::default, add_counts);
 
@@ -331,7 +331,7 @@ fn render_adaptive(
         .par_chunks_mut(w)
         .enumerate()
         .map(|(y, row)| {
-            let mut counts = RayCounts::default();
+            let mut st = TraceState::default();
             for (x, out) in row.iter_mut().enumerate() {
                 let Some(contrast) = edge_contrast(x, y).filter(|_| max_spp > 1) else {
                     *out = Vec3::from(base[y * w + x].0);
@@ -343,17 +343,17 @@ fn render_adaptive(
                 while m.n < max_spp {
                     let (dx, dy) = pattern.sample(m.n);
                     let ray = camera.ray(x as f32 + dx, y as f32 + dy);
-                    m.add(integrator.trace(&ray, 0, 1.0, &mut counts));
+                    m.add(integrator.trace(&ray, 0, 1.0, &mut st));
                     // Checked at powers of two only: there every prefix is a full net.
                     if m.n >= at_least && m.n.is_power_of_two() && m.error() <= error {
                         break;
                     }
                 }
-                counts.primary += m.n as u64;
+                st.counts.primary += m.n as u64;
                 *out = Vec3::from(m.mean());
             }
             on_tile(row.len() as u64);
-            counts
+            st.counts
         })
         .reduce(RayCounts::default, add_counts);
     (pixels, add_counts(base_counts, refine_counts))

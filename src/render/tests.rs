@@ -326,3 +326,88 @@ fn a_world_space_sphere_costs_at_most_100_bytes() {
     // Not vacuous: the packed sphere alone is 16 bytes, its material 4.
     assert!(per_sphere >= 20.0, "{per_sphere:.1} bytes per sphere");
 }
+
+#[test]
+fn shadow_rays_are_traced_only_where_light_can_change_the_colour() {
+    // Ambient-only materials (Kd = Ks = 0): a light adds exactly zero, so no shadow ray.
+    let shadow_rays = |kd: f32, ks: f32| {
+        let mut scene = base_scene();
+        for m in &mut scene.materials {
+            m.kd = Vec3::splat(kd);
+            m.ks = Vec3::splat(ks);
+        }
+        let cam = Camera::default_with_fov("c", 60.0);
+        let rendered = render_job(
+            &job(scene, cam, 32, 32),
+            &RenderSettings::default(),
+            &|_| {},
+        );
+        rendered.unwrap().rays.shadow
+    };
+    assert_eq!(shadow_rays(0.0, 0.0), 0);
+    // A highlight alone needs its shadow ray, but only on the side where R·V > 0.
+    let specular_only = shadow_rays(0.0, 0.5);
+    let diffuse = shadow_rays(0.5, 0.0);
+    assert!(specular_only > 0, "{specular_only}");
+    assert!(specular_only < diffuse, "{specular_only} vs {diffuse}");
+}
+
+#[test]
+fn an_opaque_blocker_above_glass_casts_a_full_shadow() {
+    // As in the test above, but an opaque slab between the glass and the light: whatever
+    // order the crossings come in, the floor point sees no light, only ambient.
+    let floor = Material::phong(
+        "floor",
+        Vec3::splat(0.2),
+        Vec3::new(0.6, 0.4, 0.2),
+        Vec3::ZERO,
+        1.0,
+    );
+    let mut veil = material("veil", 0.0, [0.0; 3], 0.0, 1.0);
+    veil.opacity = 0.5;
+    let slab = material("slab", 0.0, [0.5; 3], 0.0, 1.0);
+    let scene = Scene {
+        materials: vec![floor, veil, slab],
+        instances: vec![
+            instance(
+                Geometry::Box {
+                    p1: DVec3::new(-10.0, -1.0, -10.0),
+                    p2: DVec3::new(10.0, 0.0, 10.0),
+                },
+                0,
+            ),
+            sphere([0.0, 3.0, 0.0], 1.0, 1),
+            sphere([0.0, 6.0, 0.0], 0.5, 1),
+            instance(
+                Geometry::Box {
+                    p1: DVec3::new(-1.0, 7.0, -1.0),
+                    p2: DVec3::new(1.0, 7.5, 1.0),
+                },
+                2,
+            ),
+        ]
+        .into(),
+        lights: vec![Light {
+            name: "l".into(),
+            position: DVec3::new(0.0, 10.0, 0.0),
+            intensity: Vec3::splat(2.0),
+        }],
+        ambient: Vec3::splat(0.5),
+        background: Vec3::ZERO,
+        ..Scene::default()
+    };
+    let cam = Camera {
+        name: "c".into(),
+        fov_x_deg: 10.0,
+        eye: DVec3::new(0.0, 1.0, 5.0),
+        dir: DVec3::new(0.0, -1.0, -5.0),
+        up: DVec3::Y,
+    };
+    let img = render(&job(scene, cam, 3, 3));
+    let expected = Vec3::splat(0.2 * 0.5);
+    assert!(
+        (img.pixels[4] - expected).abs().max_element() < 1e-6,
+        "{:?} vs {expected:?}",
+        img.pixels[4]
+    );
+}
