@@ -136,6 +136,16 @@ pub const DEFAULT_MAX_INPUT: u64 = 1 << 30;
 /// less per triangle, about 5 GB; triangle indices also stay far inside the `u32` range.
 pub const MAX_MESH_TRIANGLES: usize = 50_000_000;
 
+/// Shapes a composite must expand to for it to be kept once and instanced where it is listed
+/// (when it is listed more than once): below this, the flattened copies cost less than the
+/// per-ray work of entering an instance.
+pub const INSTANCE_MIN_SHAPES: u64 = 16;
+
+/// Shapes the flattened tree of an instanced scene may number: each is still told apart by a
+/// 32-bit depth-first number (hits, adaptive sampling). Larger trees are flattened and meet
+/// the memory budget.
+pub const INSTANCE_MAX_FLAT: u64 = 1 << 31;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,6 +2,7 @@
 //! there, with the composite tree flattened into instances.
 
 use super::definitions::{Definitions, Object, ObjectKind};
+use super::instancing::{Building, Plan};
 use super::transforms::{finite_transform, Snapshot, Space};
 use super::{At, Builder};
 use crate::diag::Diagnostic;
@@ -9,7 +10,9 @@ use crate::diag::Severity;
 use crate::limits::MAX_WALK;
 use crate::limits::{self, DEFAULT_IMAGE_SIZE, MAX_NESTING};
 use crate::math::Transform;
-use crate::scene::{Camera, Geometry, Instance, Light, Names, RenderJob, Scene, NO_NAME};
+use crate::scene::{
+    Camera, Geometry, Instance, Instanced, Light, Names, RenderJob, Scene, NO_NAME,
+};
 use crate::sdf::ast::{CameraDef, NameRef, Statement, StatementKind};
 use crate::sdf::default_output;
 use crate::util::human_bytes;
@@ -39,8 +42,13 @@ impl Builder<'_> {
             }
         }
         let roots = roots(d);
+        let plan = self.instancing_plan(d, &roots);
         let shapes = {
-            let expansion = expansion(d, &roots, &moved);
+            let expansion = if plan.is_active() {
+                self.stored_expansion(d, &roots, &moved, &plan)
+            } else {
+                expansion(d, &roots, &moved)
+            };
             let tree = Tree {
                 roots: &roots,
                 expansion: &expansion,
@@ -48,7 +56,7 @@ impl Builder<'_> {
             self.expansion_fits(d, &tree, snapshots.len() as u64)
         };
         // The counts are freed before the instances are made.
-        let flat = self.flatten_tree(d, &roots, shapes, &moved);
+        let flat = self.flatten_tree(d, &roots, shapes, &moved, plan);
         let mut jobs = Vec::new();
         for (render, snapshot) in &snapshots {
             let job = match render {
@@ -179,6 +187,7 @@ impl Builder<'_> {
                 }
             })
             .collect();
+        let own = |i: usize| snapshot.get(&(Space::Object, d.objects[i].name));
         Scene {
             materials: d.materials.clone(),
             instances: flat.instances.clone(),
@@ -187,6 +196,13 @@ impl Builder<'_> {
             lights,
             ambient: d.ambient,
             background: d.background,
+            instanced: flat.instanced.clone(),
+            local_transforms: flat
+                .local
+                .iter()
+                .map(|&i| own(i).copied().unwrap_or_default())
+                .collect(),
+            ..Scene::default()
         }
     }
 
@@ -198,12 +214,14 @@ impl Builder<'_> {
         roots: &[usize],
         shapes: Option<u64>,
         moved: &[bool],
+        plan: Plan,
     ) -> Flat {
         let mut flat = Flatten {
             instances: Vec::new(),
             slots: Vec::new(),
             names: Names::default(),
             name_ids: vec![NO_NAME; d.objects.len()],
+            inst: Building::new(plan, d.objects.len()),
         };
         if let Some(shapes) = shapes {
             flat.instances
@@ -214,17 +232,20 @@ impl Builder<'_> {
             }
         }
         flat.instances.shrink_to_fit();
+        let (instanced, local) = flat.inst.finish();
         Flat {
             instances: Arc::new(flat.instances),
             slots: flat.slots,
             names: Arc::new(flat.names),
+            instanced,
+            local,
         }
     }
 
     /// Appends the instances below object `i`, listed in transform slot `slot` under path
     /// node `path`. `stack` holds the composites being expanded, to stop at cycles.
     #[allow(clippy::too_many_arguments)]
-    fn flatten<'s>(
+    pub(super) fn flatten<'s>(
         &mut self,
         d: &Definitions<'s>,
         moved: &[bool],
@@ -280,6 +301,7 @@ impl Builder<'_> {
                     object,
                     parent: path,
                 });
+                out.inst.leaf();
             }
             ObjectKind::Composite { children } => {
                 if let Some(pos) = stack.iter().position(|&s| s == name) {
@@ -306,6 +328,9 @@ impl Builder<'_> {
                 }
                 let id = out.name_id(i, object);
                 let node = out.names.add_path(path, id);
+                if self.use_prototype(d, moved, i, slot, node, stack, out) {
+                    return;
+                }
                 stack.push(name);
                 for &child in children {
                     if let Some(&c) = d.object_index.get(child) {
@@ -325,15 +350,19 @@ struct Flat {
     /// it is listed in, and the object whose own transform it adds.
     slots: Vec<(u32, usize)>,
     names: Arc<Names>,
+    /// The composites kept once, and the object of each of their transform slots.
+    instanced: Arc<Instanced>,
+    local: Vec<usize>,
 }
 
 /// A [`Flat`] being made.
-struct Flatten {
-    instances: Vec<Instance>,
-    slots: Vec<(u32, usize)>,
+pub(super) struct Flatten {
+    pub(super) instances: Vec<Instance>,
+    pub(super) slots: Vec<(u32, usize)>,
     names: Names,
     /// Object index → its id in `names`, once recorded.
     name_ids: Vec<u32>,
+    pub(super) inst: Building,
 }
 
 impl Flatten {
@@ -356,12 +385,12 @@ pub(super) struct Tree<'t> {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(super) struct Expansion {
     /// Instances made (shapes with a material).
-    shapes: u64,
+    pub(super) shapes: u64,
     /// Objects visited on the way, shapes and composites (composites holding nothing cost
     /// walking time too).
-    nodes: u64,
+    pub(super) nodes: u64,
     /// Transform slots made on the way (visits of objects a transform statement moves).
-    slots: u64,
+    pub(super) slots: u64,
 }
 
 /// The roots of the composite tree, in definition order: the composite `root` if there is

@@ -7,6 +7,7 @@
 //! instances, so a shape listed in two composites is drawn twice.
 
 mod definitions;
+mod instancing;
 mod jobs;
 mod references;
 mod transforms;
