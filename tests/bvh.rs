@@ -269,7 +269,11 @@ fn loaded_scene(text: &str) -> Scene {
     let loaded = anim::scene::load_str(
         text,
         std::path::Path::new("scene.sdf"),
-        &anim::sdf::LoadOptions::default(),
+        // A small budget: the composites are then worth instancing.
+        &anim::sdf::LoadOptions {
+            max_memory: 1 << 20,
+            ..anim::sdf::LoadOptions::default()
+        },
     )
     .unwrap_or_else(|d| panic!("{d:?}"));
     loaded.jobs[0].scene.clone()

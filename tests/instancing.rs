@@ -100,6 +100,7 @@ fn a_chain_doubling_twenty_times_checks_and_renders_within_a_small_budget() {
     // The same chain with nothing to instance (a material that lets light through turns
     // instancing off) is refused under that budget: the count is what instancing changed.
     let glass = "define material glass 0 0 0 0.1 0.1 0.1 0.9 0.9 0.9 50 0 0.5 1.5\n";
+    let text = text.replace("sphere s 0 0 0 1 m1", "sphere s 0 0 0 1 glass");
     let flat = write(dir.path(), "flat.sdf", &format!("{glass}{text}"));
     let (ok, stderr) = run(
         &[
@@ -141,8 +142,12 @@ fn shared_composites_render_the_bytes_of_their_flattened_rewrite() {
         };
         let shared = format!("{MATERIALS}{view}{shared}");
         let flattened = format!("{MATERIALS}{view}{flattened}");
-        // Adaptive sampling (the default) and uniform 4 spp: both compare what pixels hit.
-        for args in [&[][..], &["--spp", "4"][..]] {
+        // Adaptive sampling (the default) and uniform 4 spp: both compare what pixels hit. A
+        // small budget makes the composites worth instancing.
+        for args in [
+            &["--max-memory", "1M"][..],
+            &["--max-memory", "1M", "--spp", "4"][..],
+        ] {
             let a = render_bytes(dir.path(), "shared.sdf", &shared, args);
             let b = render_bytes(dir.path(), "flattened.sdf", &flattened, args);
             assert!(a == b, "case {k} {args:?}: the images differ");

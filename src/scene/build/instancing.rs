@@ -5,7 +5,9 @@
 use super::definitions::{Definitions, ObjectKind};
 use super::jobs::{Expansion, Flatten};
 use super::Builder;
-use crate::limits::{INSTANCE_MAX_FLAT, INSTANCE_MIN_SHAPES, MAX_NESTING};
+use crate::limits::{
+    scene_memory, INSTANCE_BUDGET_SHARE, INSTANCE_MAX_FLAT, INSTANCE_MIN_SHAPES, MAX_NESTING,
+};
 use crate::scene::{Geometry, Instanced, Prototype, Use};
 use std::sync::Arc;
 
@@ -89,24 +91,29 @@ impl Builder<'_> {
     /// Decides which composites become prototypes: those listed more than once (counting
     /// every listing in the composites the scene reaches) that expand to at least
     /// [`INSTANCE_MIN_SHAPES`] shapes and hold no unbounded shape (a plane). Nothing is
-    /// instanced in a file with a material that lets light through (shadow rays multiply
-    /// its crossings in the order the hierarchy offers them, which instancing would change),
-    /// or whose flattened tree is too big to number ([`INSTANCE_MAX_FLAT`]).
+    /// instanced when the flattened tree would take no more than a small share of the memory
+    /// budget ([`INSTANCE_BUDGET_SHARE`]), in a scene drawing a material that lets light through
+    /// (shadow rays multiply its crossings in the order the hierarchy offers them, which
+    /// instancing would change), or when the flattened tree is too big to number
+    /// ([`INSTANCE_MAX_FLAT`]).
     pub(super) fn instancing_plan(&self, d: &Definitions, roots: &[usize]) -> Plan {
         let n = d.objects.len();
-        if d.materials.iter().any(|m| m.opacity < 1.0) {
-            return Plan::default();
-        }
         let order = post_order(d, roots);
         let mut counts = vec![Counts::default(); n];
         let mut done = vec![false; n];
+        let mut transparent = false;
         for &i in &order {
             let c = match &d.objects[i].kind {
-                ObjectKind::Shape { geometry, material } => Counts {
-                    shapes: u64::from(material.is_some()),
-                    height: 0,
-                    unbounded: matches!(geometry, Geometry::Plane { .. }),
-                },
+                ObjectKind::Shape { geometry, material } => {
+                    transparent |= material
+                        .and_then(|m| d.materials.get(m))
+                        .is_some_and(|m| m.opacity < 1.0);
+                    Counts {
+                        shapes: u64::from(material.is_some()),
+                        height: 0,
+                        unbounded: matches!(geometry, Geometry::Plane { .. }),
+                    }
+                }
                 ObjectKind::Composite { .. } => {
                     let mut c = Counts {
                         shapes: 0,
@@ -127,7 +134,10 @@ impl Builder<'_> {
         let total = roots
             .iter()
             .fold(0u64, |t, &r| t.saturating_add(counts[r].shapes));
-        if total > INSTANCE_MAX_FLAT {
+        if transparent
+            || total > INSTANCE_MAX_FLAT
+            || scene_memory(total) <= self.opts.max_memory / INSTANCE_BUDGET_SHARE
+        {
             return Plan::default();
         }
         let mut listed = vec![0u32; n];
@@ -332,5 +342,100 @@ impl Building {
             shapes: t.next,
         };
         (Arc::new(instanced), self.local_objects)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::math::Transform;
+    use crate::scene::{load_str, Scene};
+    use crate::sdf::LoadOptions;
+    use glam::DVec3;
+    use std::fmt::Write;
+    use std::path::Path;
+
+    /// A file whose composite `part` (`n` spheres in material `mat`, `extra` appended to it)
+    /// is listed by two moved wrappers.
+    fn file(n: usize, mat: &str, extra: &str) -> String {
+        let mut t = String::from(
+            "define material red 0.1 0 0 0.8 0 0 0.2 0.2 0.2 10\n\
+             define material glass 0 0 0 0.1 0.1 0.1 0.5 0.5 0.5 50 0 0.5 1.5\n",
+        );
+        let mut names = Vec::new();
+        for i in 0..n {
+            writeln!(t, "define shape sphere s{i} {i} 0 -10 0.4 {mat}").unwrap();
+            names.push(format!("s{i}"));
+        }
+        writeln!(t, "{extra}").unwrap();
+        if !extra.is_empty() {
+            names.push("extra".to_string());
+        }
+        writeln!(t, "define shape composite part {}", names.join(" ")).unwrap();
+        t.push_str(
+            "define shape composite w1 part\ndefine shape composite w2 part\n\
+             transform w1 rotate 30 0 1 0\ntransform w2 scale 0.5\ntransform w2 translate 1 2 3\n\
+             define shape composite root w1 w2\n",
+        );
+        t
+    }
+
+    fn scene(text: &str, max_memory: u64) -> Scene {
+        let opts = LoadOptions {
+            max_memory,
+            ..LoadOptions::default()
+        };
+        let loaded = load_str(text, Path::new("t.sdf"), &opts).unwrap();
+        loaded.jobs[0].scene.clone()
+    }
+
+    #[test]
+    fn a_composite_listed_twice_is_instanced_only_when_it_pays() {
+        // 32 flattened spheres take 16 KiB, more than 1/64 of 64 KiB.
+        let small = 1 << 16;
+        let s = scene(&file(16, "red", ""), small);
+        assert!(s.has_prototypes());
+        assert_eq!(s.instances.len(), 0);
+        assert_eq!(s.instanced.prototypes.len(), 1);
+        assert_eq!(s.instanced.prototypes[0].leaves.len(), 16);
+        assert_eq!(s.shape_count(), 32);
+        // Too small to be worth it, or the budget is large: flattened.
+        assert!(!scene(&file(15, "red", ""), small).has_prototypes());
+        assert!(!scene(&file(16, "red", ""), 1 << 30).has_prototypes());
+        // Unbounded shapes and materials that let light through keep it flat.
+        let plane = "define shape plane extra 0 -1 0 0 1 0 red";
+        assert!(!scene(&file(16, "red", plane), small).has_prototypes());
+        assert!(!scene(&file(16, "glass", ""), small).has_prototypes());
+    }
+
+    #[test]
+    fn instanced_shapes_get_the_flattened_transforms_after_moves() {
+        let text = file(
+            20,
+            "red",
+            "define shape box extra 0 0 0 1 2 3 red\ntransform extra rotate 10 1 1 0",
+        );
+        let mut inst = scene(&text, 1 << 16);
+        let mut flat = scene(&text, 1 << 30);
+        assert!(inst.has_prototypes() && !flat.has_prototypes());
+        let moves = [
+            Transform::translate(DVec3::new(-0.3, 7.0, 1e3)),
+            Transform::rotate(13.0, DVec3::new(1.0, 2.0, 3.0)).unwrap(),
+        ];
+        for round in 0..=moves.len() {
+            let a = inst.flattened();
+            assert_eq!(a.len(), flat.instances.len());
+            for ((i, t), f) in a.iter().zip(flat.instances.iter()) {
+                assert_eq!(i.geometry, f.geometry);
+                // Named by the path of the composite's first use: the object is the same.
+                let object = |name: String| name.rsplit('/').next().map(str::to_string);
+                assert_eq!(object(inst.instance_name(i)), object(flat.instance_name(f)));
+                // Bit for bit, as the flattening composes them.
+                assert_eq!(t, flat.transform_of(f), "round {round}");
+            }
+            if let Some(m) = moves.get(round) {
+                inst.transform_all(m);
+                flat.transform_all(m);
+            }
+        }
     }
 }
