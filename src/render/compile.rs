@@ -315,15 +315,16 @@ impl RenderScene {
             }
         }
         let lanes = SphereRay::new(ray);
+        let mut won = None;
         self.bvh.closest_leaves(ray, t_best, |leaf, t_max| {
-            self.closest_in_leaf(&lanes, ray, leaf, t_max, &mut best)
+            self.closest_in_leaf(&lanes, ray, leaf, t_max, &mut best, &mut won)
         });
         let Best { id: i, t, hit, .. } = best?;
         let surface = match (self.kind.get(i as usize).copied(), hit) {
             (Some(SPHERE), _) => sphere_surface(&self.sphere(i as usize).hit_at(ray, t)),
             (Some(o), Some(h)) => self.objects[o as usize].surface(&h),
             (None, Some(h)) => {
-                let p = self.instanced(i)?;
+                let p = won?;
                 match p.world_sphere() {
                     Some(s) => sphere_surface(&s.hit_at(ray, t)),
                     None => p.surface(&h),
@@ -343,6 +344,7 @@ impl RenderScene {
         leaf: &[u32],
         mut t_max: f32,
         best: &mut Option<Best>,
+        won: &mut Option<Primitive>,
     ) -> f32 {
         let first = leaf[0] as usize;
         // A hit as close as the kept one is found too, to be judged by its number.
@@ -368,7 +370,7 @@ impl RenderScene {
                     }
                     u if is_use(u) => {
                         if let Some(inst) = &self.instances {
-                            inst.closest(u & !USE, ray, &mut t_max, best);
+                            inst.closest(u & !USE, ray, &mut t_max, best, won);
                         }
                     }
                     o => {

@@ -152,6 +152,29 @@ impl Instances {
         self.scene.instanced.uses.len()
     }
 
+    /// The shape numbered `flat` in the flattened tree, unplaced.
+    fn leaf(&self, flat: u32) -> Option<&Instance> {
+        let inst = &self.scene.instanced;
+        let k = inst
+            .uses
+            .partition_point(|u| u.offset <= flat)
+            .checked_sub(1)?;
+        let mut u = &inst.uses[k];
+        let mut rest = flat - u.offset;
+        loop {
+            let p = inst.prototypes.get(u.prototype as usize)?;
+            if let Ok(i) = p.offsets.binary_search(&rest) {
+                return p.leaves.get(i);
+            }
+            let k = p
+                .uses
+                .partition_point(|n| n.offset <= rest)
+                .checked_sub(1)?;
+            u = &p.uses[k];
+            rest -= u.offset;
+        }
+    }
+
     /// The shape numbered `flat` in the flattened tree, placed in the world.
     fn decode(&self, flat: u32) -> Option<(&Instance, Transform)> {
         let inst = &self.scene.instanced;
@@ -189,8 +212,8 @@ impl Instances {
     /// The material of the primitive with id `id`.
     pub fn material(&self, id: u32) -> u32 {
         id.checked_sub(self.first_id)
-            .and_then(|f| self.decode(f))
-            .map_or(0, |(leaf, _)| leaf.material as u32)
+            .and_then(|f| self.leaf(f))
+            .map_or(0, |leaf| leaf.material as u32)
     }
 
     /// The ray in a prototype's frame (`world` is the frame, moves included), for culling.
@@ -266,8 +289,16 @@ impl Instances {
         }
     }
 
-    /// The closest hit through top-level use `k`, ties broken by depth-first number.
-    pub fn closest(&self, k: u32, ray: &Ray, t_max: &mut f32, best: &mut Option<Best>) {
+    /// The closest hit through top-level use `k`, ties broken by depth-first number; `won`
+    /// keeps the placed primitive of an instanced winner (for its surface).
+    pub fn closest(
+        &self,
+        k: u32,
+        ray: &Ray,
+        t_max: &mut f32,
+        best: &mut Option<Best>,
+        won: &mut Option<Primitive>,
+    ) {
         let u = &self.scene.instanced.uses[k as usize];
         let t_cell = std::cell::Cell::new(*t_max);
         let mut found = *best;
@@ -290,6 +321,7 @@ impl Instances {
                             key,
                             hit: Some(h),
                         });
+                        *won = Some(prim.clone());
                     }
                 }
                 true
