@@ -145,8 +145,8 @@ pub const INSTANCE_MIN_SHAPES: u64 = 16;
 /// (1/64) of the memory budget (`--max-memory`): instancing trades work per ray (entering a
 /// use, placing its shapes) for memory, which is worth it only when memory is at stake.
 /// Measured (BENCHMARKS.md §13): a chain of composites doubling 16 times, 65 536 spheres,
-/// renders 13× slower instanced (a tenth of the memory), while 1000 uses of a 1000-sphere
-/// composite render faster instanced than flattened.
+/// renders 9× slower instanced (with 1/65 of the memory), while 1000 uses of a 1000-sphere
+/// composite render faster instanced than flattened (with 1/26 of the memory).
 pub const INSTANCE_BUDGET_SHARE: u64 = 64;
 
 /// Shapes the flattened tree of an instanced scene may number: each is still told apart by a
