@@ -134,7 +134,10 @@ impl Builder<'_> {
         let total = roots
             .iter()
             .fold(0u64, |t, &r| t.saturating_add(counts[r].shapes));
+        // A tree deeper than the nesting limit is refused by the flattening, as before.
+        let deepest = roots.iter().map(|&r| counts[r].height).max().unwrap_or(0);
         if transparent
+            || deepest as usize > MAX_NESTING
             || total > INSTANCE_MAX_FLAT
             || scene_memory(total) <= self.opts.max_memory / INSTANCE_BUDGET_SHARE
         {
