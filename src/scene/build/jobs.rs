@@ -2,9 +2,8 @@
 //! there, with the composite tree flattened into instances.
 
 use super::definitions::{Definitions, Object, ObjectKind};
-use super::instancing::{Building, Plan};
 use super::transforms::{finite_transform, Snapshot, Space};
-use super::{At, Builder};
+use super::{At, Builder, Building, Plan};
 use crate::diag::Diagnostic;
 use crate::diag::Severity;
 use crate::limits::MAX_WALK;

@@ -16,6 +16,7 @@ use crate::diag::{suggest, Diagnostic, Loc, Severity};
 use crate::scene::RenderJob;
 use crate::sdf::ast::{NameRef, Statement};
 use crate::sdf::{LoadOptions, Omissions};
+use instancing::{Building, Plan};
 use std::collections::HashSet;
 use std::path::Path;
 
