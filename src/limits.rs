@@ -138,6 +138,24 @@ pub const DEFAULT_MAX_INPUT: u64 = 1 << 30;
 /// less per triangle, about 5 GB; triangle indices also stay far inside the `u32` range.
 pub const MAX_MESH_TRIANGLES: usize = 50_000_000;
 
+/// Shapes a composite must expand to for it to be kept once and instanced where it is listed
+/// (when it is listed more than once): below this, the flattened copies cost less than the
+/// per-ray work of entering an instance.
+pub const INSTANCE_MIN_SHAPES: u64 = 16;
+
+/// Composites are instanced only when the flattened tree would take more than this share
+/// (1/64) of the memory budget (`--max-memory`): instancing trades work per ray (entering a
+/// use, placing its shapes) for memory, which is worth it only when memory is at stake.
+/// Measured (BENCHMARKS.md §13): a chain of composites doubling 16 times, 65 536 spheres,
+/// renders 9× slower instanced (with 1/65 of the memory), while 1000 uses of a 1000-sphere
+/// composite render faster instanced than flattened (with 1/26 of the memory).
+pub const INSTANCE_BUDGET_SHARE: u64 = 64;
+
+/// Shapes the flattened tree of an instanced scene may number: each is still told apart by a
+/// 32-bit depth-first number (hits, adaptive sampling). Larger trees are flattened and meet
+/// the memory budget.
+pub const INSTANCE_MAX_FLAT: u64 = 1 << 31;
+
 #[cfg(test)]
 mod tests {
     use super::*;

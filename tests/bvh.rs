@@ -260,3 +260,134 @@ fn render_scene_equals_brute_force_on_mixed_scenes() {
         assert!(n < 2000 || hits > 1000, "{hits} hits");
     }
 }
+
+#[path = "common/composites.rs"]
+mod composites;
+
+/// The render scene of a file's first job.
+fn loaded_scene(text: &str) -> Scene {
+    let loaded = anim::scene::load_str(
+        text,
+        std::path::Path::new("scene.sdf"),
+        // A small budget: the composites are then worth instancing.
+        &anim::sdf::LoadOptions {
+            max_memory: 1 << 20,
+            ..anim::sdf::LoadOptions::default()
+        },
+    )
+    .unwrap_or_else(|d| panic!("{d:?}"));
+    loaded.jobs[0].scene.clone()
+}
+
+/// The nearest hit over primitives in the flattened tree's order, as the render scene
+/// resolves ties: unbounded primitives first, then the first in the tree.
+fn brute_in_tree_order(prims: &[Primitive], ray: &Ray, t_limit: f32) -> Option<(usize, f32)> {
+    let mut best: Option<(usize, f32)> = None;
+    for bounded in [false, true] {
+        for (k, p) in prims.iter().enumerate() {
+            if p.is_bounded() != bounded {
+                continue;
+            }
+            let t_max = best.map_or(t_limit, |(_, t)| t);
+            if let Some(h) = p.hit(ray, t_max) {
+                best = Some((k, h.t));
+            }
+        }
+    }
+    best
+}
+
+/// Instancing differential: a scene with shared and nested-shared composites, transforms and
+/// exact ties, loaded as written (instanced) and with every use copied (flattened), must give
+/// the same closest hits to the bit (distance, point, normal, material, the same winner of
+/// ties), the same any-hit answers, and ids that tell the same primitives apart; both agree
+/// with testing every primitive of the flattened tree in its order.
+#[test]
+fn instanced_render_scene_equals_flattened_and_brute_force() {
+    for seed in [1, 2, 3] {
+        let tree = composites::mixed(seed);
+        let instanced = loaded_scene(&format!("{}{}", composites::MATERIALS, tree.shared()));
+        let flat = loaded_scene(&format!("{}{}", composites::MATERIALS, tree.flattened()));
+        assert!(instanced.has_prototypes() && !flat.has_prototypes());
+        assert!(instanced.instances.len() < flat.instances.len() / 2);
+        // The same shapes with bit-identical world transforms, in the same order.
+        let expanded = instanced.flattened();
+        assert_eq!(expanded.len(), flat.instances.len());
+        assert_eq!(instanced.shape_count(), flat.instances.len() as u64);
+        for ((inst, xf), f) in expanded.iter().zip(flat.instances.iter()) {
+            assert_eq!((&inst.geometry, inst.material), (&f.geometry, f.material));
+            assert_eq!(xf, flat.transform_of(f));
+        }
+        let prims: Vec<Primitive> = flat
+            .instances
+            .iter()
+            .map(|i| Primitive::new(&i.geometry, flat.transform_of(i), i.material as u32).unwrap())
+            .collect();
+        let (a, dropped_a) = RenderScene::compile(&instanced);
+        let (b, dropped_b) = RenderScene::compile(&flat);
+        assert!(dropped_a.is_empty() && dropped_b.is_empty());
+        assert!(a.instance_uses() > 0);
+        let mut rng = Rng(seed.wrapping_mul(0x9E3779B97F4A7C15));
+        let (mut hits, mut ties) = (0, 0);
+        let mut same_id = std::collections::HashMap::new();
+        let mut same_id_back = std::collections::HashMap::new();
+        for i in 0..6000 {
+            let o = rng.vec(100.0) - DVec3::new(50.0, 30.0, 20.0);
+            let target = rng.vec(1.0) * DVec3::new(70.0, 50.0, 60.0) - DVec3::new(40.0, 25.0, 80.0);
+            let mut dir = (target - o).normalize();
+            if i % 5 == 0 {
+                dir = DVec3::ZERO;
+                dir[i / 5 % 3] = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            }
+            let ray = Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(dir.as_vec3()));
+            let t_limit = t_limit_of(i);
+            let brute = brute_in_tree_order(&prims, &ray, t_limit);
+            let (ha, hb) = (a.closest(&ray, t_limit), b.closest(&ray, t_limit));
+            let bits = |h: &Option<(u32, anim::render::primitive::SurfaceHit)>, s: &RenderScene| {
+                h.map(|(id, h)| {
+                    (
+                        h.t.to_bits(),
+                        h.point.to_array().map(f32::to_bits),
+                        h.normal.to_array().map(f32::to_bits),
+                        s.material_of(id),
+                    )
+                })
+            };
+            assert_eq!(bits(&ha, &a), bits(&hb, &b), "seed {seed} ray {i}");
+            assert_eq!(
+                brute.map(|(k, t)| (t.to_bits(), prims[k].material)),
+                hb.map(|(id, h)| (h.t.to_bits(), b.material_of(id))),
+                "seed {seed} ray {i}"
+            );
+            if let (Some((k, t)), Some((ida, _)), Some((idb, _))) = (brute, ha, hb) {
+                hits += 1;
+                let tied = prims
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, p)| j != k && p.hit(&ray, t_limit).is_some_and(|h| h.t == t))
+                    .count();
+                ties += usize::from(tied > 0);
+                assert_eq!(
+                    *same_id.entry(ida).or_insert(idb),
+                    idb,
+                    "seed {seed} ray {i}"
+                );
+                assert_eq!(
+                    *same_id_back.entry(idb).or_insert(ida),
+                    ida,
+                    "seed {seed} ray {i}"
+                );
+                let again = a.intersect(ida, &ray, t_limit).unwrap();
+                assert_eq!(again.t.to_bits(), t.to_bits());
+            }
+            let blocked = brute.is_some();
+            assert_eq!(a.occluded(&ray, t_limit), blocked, "seed {seed} ray {i}");
+            assert_eq!(b.occluded(&ray, t_limit), blocked, "seed {seed} ray {i}");
+            let any = a.any_candidate(&ray, t_limit, |id| a.hit(id, &ray, t_limit).is_some());
+            assert_eq!(any, blocked, "seed {seed} ray {i}");
+        }
+        // Not vacuous: many rays meet something, and some meet two surfaces at once.
+        assert!(hits > 1500, "seed {seed}: {hits} hits");
+        assert!(ties > 20, "seed {seed}: {ties} ties");
+    }
+}

@@ -1,12 +1,15 @@
 //! Compiles a scene description into the flat render scene that the integrator touches per
 //! ray: primitives in one array, a BVH over the bounded ones, materials in f32 SIMD form.
 
+mod instance;
+
 use super::primitive::{Primitive, SurfaceHit};
 use crate::accel::Bvh;
 use crate::math::Ray;
 use crate::scene::{Material, Scene};
 use crate::shape::{Shape, ShapeHit, Sphere, SphereRay};
 use glam::{Vec3A, Vec4};
+use instance::{Best, Instances};
 
 #[derive(Clone, Debug)]
 pub struct ShadeMaterial {
@@ -45,6 +48,8 @@ pub struct PointLight {
 
 /// `RenderScene::kind` of a primitive that is a packed world-space sphere.
 const SPHERE: u32 = u32::MAX;
+/// `RenderScene::kind` of a top-level use of a prototype: this bit, and the use's index.
+const USE: u32 = 1 << 31;
 /// Spheres tested at once.
 const LANES: usize = 4;
 
@@ -61,6 +66,13 @@ pub struct RenderScene {
     /// sphere test hits), then `LANES - 1` NaN entries so a leaf can always load four.
     spheres: Vec<Vec4>,
     objects: Vec<Primitive>,
+    /// Per primitive: its depth-first number in the flattened composite tree, which breaks
+    /// ties between equally close hits (the first in the tree wins), whatever order the
+    /// hierarchy offers them in.
+    key: Vec<u32>,
+    /// The scene's instanced composites. Their shapes have ids from `len()` on: `len()` plus
+    /// their depth-first number.
+    instances: Option<Box<Instances>>,
     bvh: Bvh,
     /// The first primitive without finite bounds (planes); these are tested on every ray.
     unbounded: u32,
@@ -91,13 +103,16 @@ impl RenderScene {
         let mut bounds = Vec::with_capacity(n);
         let mut objects = Vec::new();
         let mut dropped = Vec::new();
-        for inst in scene.instances.iter() {
+        let mut key = Vec::with_capacity(n);
+        let offsets = &scene.instanced.offsets;
+        for (index, inst) in scene.instances.iter().enumerate() {
             match Primitive::new(
                 &inst.geometry,
                 scene.transform_of(inst),
                 inst.material as u32,
             ) {
                 Ok(p) => {
+                    key.push(offsets.get(index).copied().unwrap_or(index as u32));
                     bounds.push(p.bounds);
                     material.push(p.material);
                     if let Some(s) = p.world_sphere() {
@@ -115,6 +130,19 @@ impl RenderScene {
                 }),
             }
         }
+        let instances = scene.has_prototypes().then(|| {
+            let first_id = (material.len() + scene.instanced.uses.len()) as u32;
+            Box::new(Instances::new(scene, first_id))
+        });
+        if let Some(inst) = &instances {
+            for (k, (b, u)) in inst.use_bounds().zip(&scene.instanced.uses).enumerate() {
+                bounds.push(b);
+                material.push(0);
+                kind.push(USE | k as u32);
+                spheres.push(Vec4::NAN);
+                key.push(u.offset);
+            }
+        }
         let (bounded, unbounded): (Vec<u32>, Vec<u32>) =
             (0..material.len() as u32).partition(|&i| bounds[i as usize].is_finite());
         let mut bvh = Bvh::build(&bounds, bounded);
@@ -123,7 +151,7 @@ impl RenderScene {
         let first_unbounded = order.len() as u32;
         order.extend(unbounded);
         let permute = |v: &[u32]| order.iter().map(|&i| v[i as usize]).collect::<Vec<u32>>();
-        let (material, kind) = (permute(&material), permute(&kind));
+        let (material, kind, key) = (permute(&material), permute(&kind), permute(&key));
         let mut spheres: Vec<Vec4> = order.iter().map(|&i| spheres[i as usize]).collect();
         spheres.resize(order.len() + LANES - 1, Vec4::NAN);
         drop(order);
@@ -140,7 +168,17 @@ impl RenderScene {
         let ambient: Vec3A = scene.ambient.into();
         let background: Vec3A = scene.background.into();
         let mut used = vec![false; materials.len()];
-        for &m in &material {
+        let prototype_materials = scene
+            .instanced
+            .prototypes
+            .iter()
+            .flat_map(|p| p.leaves.iter().map(|l| l.material as u32));
+        let top_materials = material
+            .iter()
+            .zip(&kind)
+            .filter(|&(_, &k)| !is_use(k))
+            .map(|(&m, _)| m);
+        for m in top_materials.chain(prototype_materials) {
             if let Some(u) = used.get_mut(m as usize) {
                 *u = true;
             }
@@ -165,6 +203,8 @@ impl RenderScene {
             kind,
             spheres,
             objects,
+            key,
+            instances,
             bvh,
             unbounded: first_unbounded,
             materials,
@@ -189,15 +229,24 @@ impl RenderScene {
     /// The material of primitive `i`.
     #[inline(always)]
     pub fn material_of(&self, i: u32) -> u32 {
-        self.material[i as usize]
+        match self.material.get(i as usize) {
+            Some(&m) => m,
+            None => self.instances.as_ref().map_or(0, |inst| inst.material(i)),
+        }
+    }
+
+    /// Instanced primitive `i` (an id from `len()` on), placed.
+    fn instanced(&self, i: u32) -> Option<Primitive> {
+        self.instances.as_ref()?.primitive(i)
     }
 
     /// The object-space shape of primitive `i`, or `None` for a packed world-space sphere
     /// (for tools that report by kind of shape).
     pub fn object_shape(&self, i: u32) -> Option<&Shape> {
-        match self.kind[i as usize] {
-            SPHERE => None,
-            k => Some(&self.objects[k as usize].shape),
+        match self.kind.get(i as usize).copied() {
+            Some(SPHERE) | None => None,
+            Some(k) if is_use(k) => None,
+            Some(k) => Some(&self.objects[k as usize].shape),
         }
     }
 
@@ -220,52 +269,73 @@ impl RenderScene {
     /// Distance to primitive `i` along the ray, if it is hit with `0 < t < t_max`.
     #[inline(always)]
     pub fn hit(&self, i: u32, ray: &Ray, t_max: f32) -> Option<f32> {
-        match self.kind[i as usize] {
-            SPHERE => self.sphere(i as usize).intersect(ray, t_max).map(|h| h.t),
-            k => self.objects[k as usize].hit(ray, t_max).map(|h| h.t),
+        match self.kind.get(i as usize).copied() {
+            Some(SPHERE) => self.sphere(i as usize).intersect(ray, t_max).map(|h| h.t),
+            Some(k) if !is_use(k) => self.objects[k as usize].hit(ray, t_max).map(|h| h.t),
+            _ => self.instanced(i)?.hit(ray, t_max).map(|h| h.t),
         }
     }
 
     /// Primitive `i`'s hit with `0 < t < t_max`, in world space.
     #[inline]
     pub fn intersect(&self, i: u32, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
-        match self.kind[i as usize] {
-            SPHERE => self
+        match self.kind.get(i as usize).copied() {
+            Some(SPHERE) => self
                 .sphere(i as usize)
                 .intersect(ray, t_max)
                 .map(|h| sphere_surface(&h)),
-            k => self.objects[k as usize].intersect(ray, t_max),
+            Some(k) if !is_use(k) => self.objects[k as usize].intersect(ray, t_max),
+            _ => {
+                let p = self.instanced(i)?;
+                let h = p.hit(ray, t_max)?;
+                Some(match p.world_sphere() {
+                    Some(s) => sphere_surface(&s.hit_at(ray, h.t)),
+                    None => p.surface(&h),
+                })
+            }
         }
     }
 
-    /// Nearest surface along the ray with `t < t_max`.
+    /// Nearest surface along the ray with `t < t_max`. Of equally close hits, an unbounded
+    /// primitive's wins (the first of them), else the first in the flattened tree's order.
     #[inline]
     pub fn closest(&self, ray: &Ray, t_max: f32) -> Option<(u32, SurfaceHit)> {
-        // The winner's object-space hit, kept for its surface (spheres recompute theirs).
-        let mut best: Option<(u32, f32, Option<ShapeHit>)> = None;
+        // The winner's object-space hit is kept for its surface (spheres recompute theirs).
+        let mut best: Option<Best> = None;
         let mut t_best = t_max;
         for i in self.unbounded..self.len() as u32 {
             if let Some(h) = self.shape_hit(i, ray, t_best) {
                 t_best = h.t;
-                best = Some((i, h.t, Some(h)));
+                best = Some(Best {
+                    id: i,
+                    t: h.t,
+                    key: 0,
+                    hit: Some(h),
+                });
             }
         }
         let lanes = SphereRay::new(ray);
-        // Primitives in the order the hierarchy offers them, a strictly closer hit replacing
-        // the kept one: of equally close hits the first offered wins.
+        let mut won = None;
         self.bvh.closest_leaves(ray, t_best, |leaf, t_max| {
-            self.closest_in_leaf(&lanes, ray, leaf, t_max, &mut best)
+            self.closest_in_leaf(&lanes, ray, leaf, t_max, &mut best, &mut won)
         });
-        let (i, t, hit) = best?;
-        let surface = match (self.kind[i as usize], hit) {
-            (SPHERE, _) => sphere_surface(&self.sphere(i as usize).hit_at(ray, t)),
-            (o, Some(h)) => self.objects[o as usize].surface(&h),
+        let Best { id: i, t, hit, .. } = best?;
+        let surface = match (self.kind.get(i as usize).copied(), hit) {
+            (Some(SPHERE), _) => sphere_surface(&self.sphere(i as usize).hit_at(ray, t)),
+            (Some(o), Some(h)) => self.objects[o as usize].surface(&h),
+            (None, Some(h)) => {
+                let p = won?;
+                match p.world_sphere() {
+                    Some(s) => sphere_surface(&s.hit_at(ray, t)),
+                    None => p.surface(&h),
+                }
+            }
             (_, None) => unreachable!("objects keep their hit"),
         };
         Some((i, surface))
     }
 
-    /// Tests one leaf's primitives in their order (see `closest`); returns the new `t_max`.
+    /// Tests one leaf's primitives (see `closest`); returns the new `t_max`.
     #[inline(always)]
     fn closest_in_leaf(
         &self,
@@ -273,9 +343,12 @@ impl RenderScene {
         ray: &Ray,
         leaf: &[u32],
         mut t_max: f32,
-        best: &mut Option<(u32, f32, Option<ShapeHit>)>,
+        best: &mut Option<Best>,
+        won: &mut Option<Primitive>,
     ) -> f32 {
         let first = leaf[0] as usize;
+        // A hit as close as the kept one is found too, to be judged by its number.
+        let limit = t_max.next_up();
         for start in (first..first + leaf.len()).step_by(LANES) {
             // Tested when the first sphere comes up, so leaves of other kinds skip it.
             let mut four = None;
@@ -284,16 +357,33 @@ impl RenderScene {
                 match self.kind[i] {
                     SPHERE => {
                         let (mask, t) = *four
-                            .get_or_insert_with(|| lanes.hit4(self.four_spheres(start), t_max));
-                        if mask & (1 << k) != 0 && t[k] < t_max {
+                            .get_or_insert_with(|| lanes.hit4(self.four_spheres(start), limit));
+                        if mask & (1 << k) != 0 && Best::loses_to(best, t_max, t[k], self.key[i]) {
                             t_max = t[k];
-                            *best = Some((i as u32, t_max, None));
+                            *best = Some(Best {
+                                id: i as u32,
+                                t: t_max,
+                                key: self.key[i],
+                                hit: None,
+                            });
+                        }
+                    }
+                    u if is_use(u) => {
+                        if let Some(inst) = &self.instances {
+                            inst.closest(u & !USE, ray, &mut t_max, best, won);
                         }
                     }
                     o => {
-                        if let Some(h) = self.objects[o as usize].hit(ray, t_max) {
-                            t_max = h.t;
-                            *best = Some((i as u32, t_max, Some(h)));
+                        if let Some(h) = self.objects[o as usize].hit(ray, t_max.next_up()) {
+                            if Best::loses_to(best, t_max, h.t, self.key[i]) {
+                                t_max = h.t;
+                                *best = Some(Best {
+                                    id: i as u32,
+                                    t: t_max,
+                                    key: self.key[i],
+                                    hit: Some(h),
+                                });
+                            }
                         }
                     }
                 }
@@ -306,6 +396,7 @@ impl RenderScene {
     fn shape_hit(&self, i: u32, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
         match self.kind[i as usize] {
             SPHERE => self.sphere(i as usize).intersect(ray, t_max),
+            k if is_use(k) => None,
             k => self.objects[k as usize].hit(ray, t_max),
         }
     }
@@ -325,9 +416,14 @@ impl RenderScene {
                 // Other kinds hold NaN, which no sphere test hits.
                 (kinds.contains(&SPHERE)
                     && lanes.hit4(self.four_spheres(start), t_max).0 & ((1 << live) - 1) != 0)
-                    || kinds
-                        .iter()
-                        .any(|&k| k != SPHERE && self.objects[k as usize].hit(ray, t_max).is_some())
+                    || kinds.iter().any(|&k| match k {
+                        SPHERE => false,
+                        u if is_use(u) => self
+                            .instances
+                            .as_ref()
+                            .is_some_and(|inst| inst.occluded(u & !USE, ray, t_max)),
+                        o => self.objects[o as usize].hit(ray, t_max).is_some(),
+                    })
             })
         })
     }
@@ -336,7 +432,14 @@ impl RenderScene {
     /// order, until it returns true (then true).
     #[inline]
     pub fn any_candidate(&self, ray: &Ray, t_max: f32, mut stop: impl FnMut(u32) -> bool) -> bool {
-        (self.unbounded..self.len() as u32).any(&mut stop) || self.bvh.any(ray, t_max, stop)
+        (self.unbounded..self.len() as u32).any(&mut stop)
+            || self.bvh.any(ray, t_max, |i| match self.kind[i as usize] {
+                u if is_use(u) => self
+                    .instances
+                    .as_ref()
+                    .is_some_and(|inst| inst.any(u & !USE, ray, t_max, &mut stop)),
+                _ => stop(i),
+            })
     }
 
     /// Bytes the scene's geometry holds (primitives and hierarchy, not materials or lights).
@@ -345,8 +448,24 @@ impl RenderScene {
             + self.kind.capacity() * 4
             + self.spheres.capacity() * std::mem::size_of::<Vec4>()
             + self.objects.capacity() * std::mem::size_of::<Primitive>()
+            + self.key.capacity() * 4
             + self.bvh.memory_bytes()
+            + self
+                .instances
+                .as_ref()
+                .map_or(0, |inst| inst.memory_bytes())
     }
+
+    /// Top-level uses of prototypes (each stands for all the shapes of its composite).
+    pub fn instance_uses(&self) -> usize {
+        self.instances.as_ref().map_or(0, |inst| inst.uses())
+    }
+}
+
+/// Whether a `kind` is a top-level use of a prototype.
+#[inline(always)]
+fn is_use(kind: u32) -> bool {
+    kind != SPHERE && kind & USE != 0
 }
 
 /// What `Primitive::surface` makes of a world-space hit: the normal renormalised.

@@ -4,6 +4,7 @@
 //! render scene.
 
 mod build;
+mod instancing;
 mod load;
 pub mod probe;
 #[cfg(test)]
@@ -12,6 +13,7 @@ mod scale_tests;
 mod tests;
 
 pub use crate::shape::Geometry;
+pub use instancing::{Instanced, Placed, Prototype, Use};
 pub use load::{build, load_file, load_str, read_input, Loaded};
 
 use crate::diag::Loc;
@@ -201,6 +203,17 @@ pub struct Scene {
     pub lights: Vec<Light>,
     pub ambient: Vec3,
     pub background: Vec3,
+    /// Composites kept once and drawn by their uses (see [`Instanced`]); shared by the jobs.
+    pub instanced: Arc<Instanced>,
+    /// The transforms the statements give the objects moved inside prototypes, by the
+    /// index in `Prototype::slots`.
+    pub local_transforms: Vec<Transform>,
+    /// The transforms [`Scene::transform_all`] applied, in order: applied last to the shapes
+    /// of prototypes, as to every slot of `transforms`.
+    pub moves: Vec<Transform>,
+    /// `transforms` before the first of `moves`, kept when the scene has prototypes (their
+    /// uses are placed from it).
+    pub unmoved: Vec<Transform>,
 }
 
 impl Scene {
@@ -215,6 +228,12 @@ impl Scene {
     pub fn transform_all(&mut self, t: &Transform) {
         if self.transforms.is_empty() {
             self.transforms.push(Transform::IDENTITY);
+        }
+        if self.has_prototypes() {
+            if self.moves.is_empty() {
+                self.unmoved = self.transforms.clone();
+            }
+            self.moves.push(*t);
         }
         for m in &mut self.transforms {
             *m = t.then_after(m);

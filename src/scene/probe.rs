@@ -313,8 +313,12 @@ fn primary_rays(cam: &Camera, width: u32, height: u32) -> Option<Vec<Ray>> {
 pub fn blank_image(job: &RenderJob) -> Option<Blank> {
     let scene = &job.scene;
     let blank = |reason: String| Some(Blank { reason });
-    if scene.instances.is_empty() {
+    if scene.shape_count() == 0 {
         return blank("the scene has no shapes at all: the image is only the background".into());
+    }
+    if scene.has_prototypes() {
+        // Composites drawn in many places: too many shapes to probe one by one.
+        return None;
     }
     let rays = primary_rays(&job.camera, job.width, job.height)?;
     // Counted before the shapes are placed, so that a huge scene costs no memory here.

@@ -489,22 +489,22 @@ fn composite_cycles_and_explosions_are_errors_not_hangs() {
     );
 
     let mut text = format!("{MATERIAL}define shape sphere s0 0 0 0 1 m\n");
-    for k in 1..=25 {
+    for k in 1..=33 {
         text.push_str(&format!(
             "define shape composite s{k} s{prev} s{prev}\n",
             prev = k - 1
         ));
     }
     text.push_str("define camera c 60\nrender c o.png 1 1\n");
-    // 2^25 shapes: refused from its counts under a budget of 1 GiB, on any machine.
+    // 2^33 shapes, too many to instance: refused from its counts under a budget of 1 GiB.
     let opts = LoadOptions {
         max_memory: 1 << 30,
         ..LoadOptions::default()
     };
     let ds = load_str(&text, Path::new("scene.sdf"), &opts).unwrap_err();
     let want = format!(
-        "the composite tree expands to 33554432 shapes, which need about {} of memory, more than the 1.0 GiB allowed (`s25` is the largest part)",
-        crate::util::human_bytes(crate::limits::scene_memory(1 << 25))
+        "the composite tree expands to 8589934592 shapes, which need about {} of memory, more than the 1.0 GiB allowed (`s33` is the largest part)",
+        crate::util::human_bytes(crate::limits::scene_memory(1 << 33))
     );
     assert!(ds.iter().any(|d| d.message == want), "{ds:?}");
 }

@@ -165,6 +165,9 @@ impl Builder<'_> {
             instances: Arc::new(instances),
             slots: Vec::new(),
             names: Arc::new(names),
+            // A flat file has no composites, so nothing is kept once.
+            instanced: Arc::default(),
+            local: Vec::new(),
         };
         self.jobs_of(&d, &snapshots, &flat)
     }

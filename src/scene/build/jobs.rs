@@ -3,13 +3,15 @@
 
 use super::definitions::{Definitions, Object, ObjectKind};
 use super::transforms::{finite_transform, Snapshot, Space};
-use super::{At, Builder};
+use super::{At, Builder, Building, Plan};
 use crate::diag::Diagnostic;
 use crate::diag::Severity;
 use crate::limits::MAX_WALK;
 use crate::limits::{self, DEFAULT_IMAGE_SIZE, MAX_NESTING};
 use crate::math::Transform;
-use crate::scene::{Camera, Geometry, Instance, Light, Names, RenderJob, Scene, NO_NAME};
+use crate::scene::{
+    Camera, Geometry, Instance, Instanced, Light, Names, RenderJob, Scene, NO_NAME,
+};
 use crate::sdf::ast::{CameraDef, NameRef, Statement, StatementKind};
 use crate::sdf::default_output;
 use crate::util::human_bytes;
@@ -39,8 +41,13 @@ impl Builder<'_> {
             }
         }
         let roots = roots(d);
+        let plan = self.instancing_plan(d, &roots);
         let shapes = {
-            let expansion = expansion(d, &roots, &moved);
+            let expansion = if plan.is_active() {
+                self.stored_expansion(d, &roots, &moved, &plan)
+            } else {
+                expansion(d, &roots, &moved)
+            };
             let tree = Tree {
                 roots: &roots,
                 expansion: &expansion,
@@ -48,7 +55,7 @@ impl Builder<'_> {
             self.expansion_fits(d, &tree, snapshots.len() as u64)
         };
         // The counts are freed before the instances are made.
-        let flat = self.flatten_tree(d, &roots, shapes, &moved);
+        let flat = self.flatten_tree(d, &roots, shapes, &moved, plan);
         self.jobs_of(d, &snapshots, &flat)
     }
 
@@ -190,6 +197,7 @@ impl Builder<'_> {
                 }
             })
             .collect();
+        let own = |i: usize| snapshot.get(&(Space::Object, d.objects[i].name));
         Scene {
             materials: d.materials.clone(),
             instances: flat.instances.clone(),
@@ -198,6 +206,13 @@ impl Builder<'_> {
             lights,
             ambient: d.ambient,
             background: d.background,
+            instanced: flat.instanced.clone(),
+            local_transforms: flat
+                .local
+                .iter()
+                .map(|&i| own(i).copied().unwrap_or_default())
+                .collect(),
+            ..Scene::default()
         }
     }
 
@@ -209,12 +224,14 @@ impl Builder<'_> {
         roots: &[usize],
         shapes: Option<u64>,
         moved: &[bool],
+        plan: Plan,
     ) -> Flat {
         let mut flat = Flatten {
             instances: Vec::new(),
             slots: Vec::new(),
             names: Names::default(),
             name_ids: vec![NO_NAME; d.objects.len()],
+            inst: Building::new(plan, d.objects.len()),
         };
         if let Some(shapes) = shapes {
             flat.instances
@@ -225,17 +242,20 @@ impl Builder<'_> {
             }
         }
         flat.instances.shrink_to_fit();
+        let (instanced, local) = flat.inst.finish();
         Flat {
             instances: Arc::new(flat.instances),
             slots: flat.slots,
             names: Arc::new(flat.names),
+            instanced,
+            local,
         }
     }
 
     /// Appends the instances below object `i`, listed in transform slot `slot` under path
     /// node `path`. `stack` holds the composites being expanded, to stop at cycles.
     #[allow(clippy::too_many_arguments)]
-    fn flatten<'s>(
+    pub(super) fn flatten<'s>(
         &mut self,
         d: &Definitions<'s>,
         moved: &[bool],
@@ -283,6 +303,7 @@ impl Builder<'_> {
                     object,
                     parent: path,
                 });
+                out.inst.leaf();
             }
             ObjectKind::Composite { children } => {
                 if let Some(pos) = stack.iter().position(|&s| s == name) {
@@ -309,6 +330,9 @@ impl Builder<'_> {
                 }
                 let id = out.name_id(i, object);
                 let node = out.names.add_path(path, id);
+                if self.use_prototype(d, moved, i, slot, node, stack, out) {
+                    return;
+                }
                 stack.push(name);
                 for &child in children {
                     if let Some(&c) = d.object_index.get(child) {
@@ -340,15 +364,19 @@ pub(super) struct Flat {
     /// it is listed in, and the object whose own transform it adds.
     pub(super) slots: Vec<(u32, usize)>,
     pub(super) names: Arc<Names>,
+    /// The composites kept once, and the object of each of their transform slots.
+    pub(super) instanced: Arc<Instanced>,
+    pub(super) local: Vec<usize>,
 }
 
 /// A [`Flat`] being made.
-struct Flatten {
-    instances: Vec<Instance>,
-    slots: Vec<(u32, usize)>,
+pub(super) struct Flatten {
+    pub(super) instances: Vec<Instance>,
+    pub(super) slots: Vec<(u32, usize)>,
     names: Names,
     /// Object index → its id in `names`, once recorded.
     name_ids: Vec<u32>,
+    pub(super) inst: Building,
 }
 
 impl Flatten {

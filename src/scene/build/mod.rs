@@ -8,6 +8,7 @@
 
 mod definitions;
 mod flat;
+mod instancing;
 mod jobs;
 mod references;
 mod transforms;
@@ -16,6 +17,7 @@ use crate::diag::{suggest, Diagnostic, Loc, Severity};
 use crate::scene::RenderJob;
 use crate::sdf::ast::{FlatShapes, NameRef, Statement};
 use crate::sdf::{LoadOptions, Omissions};
+use instancing::{Building, Plan};
 use std::collections::HashSet;
 use std::path::Path;
 

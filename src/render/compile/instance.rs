@@ -1,0 +1,379 @@
+//! The prototypes of a scene's instanced composites, compiled: one hierarchy each, over its
+//! shapes and nested uses in its own frame, entered by a use's transform.
+//!
+//! The hierarchies only cull. A shape they offer is placed with the world transform the
+//! flattened tree gives it (`Scene::prototype_world`, composed top-down as the flattening
+//! does) and tested with the world ray as the flattened scene's primitive would be, so its
+//! hits are the same floats. Culling happens on a ray moved into the prototype's frame, whose
+//! rounding differs from the world ray's; boxes and distances are widened by
+//! [`CULL_MARGIN`] so that it never drops a shape the world test would hit.
+
+use crate::accel::Bvh;
+use crate::math::{Aabb, Ray, Transform};
+use crate::render::primitive::Primitive;
+use crate::scene::{Instance, Prototype, Scene, Use};
+use crate::shape::ShapeHit;
+use glam::Vec3A;
+
+/// Relative widening of the culling boxes and distances of prototypes (far beyond the f32
+/// rounding of a ray moved into a prototype's frame).
+const CULL_MARGIN: f32 = 1e-3;
+
+/// The closest hit so far: the id of what was hit, its distance, the depth-first number
+/// that breaks ties (0 for unbounded primitives, which keep their ties), and the
+/// object-space hit of a primitive that is not a packed sphere.
+#[derive(Clone, Copy, Debug)]
+pub struct Best {
+    pub id: u32,
+    pub t: f32,
+    pub key: u32,
+    pub hit: Option<ShapeHit>,
+}
+
+impl Best {
+    /// Whether a hit at `t` numbered `key` wins over this one: closer, or as close and
+    /// earlier in the flattened tree.
+    #[inline(always)]
+    pub fn loses_to(best: &Option<Best>, t_max: f32, t: f32, key: u32) -> bool {
+        t < t_max || (t == t_max && best.is_some_and(|b| key < b.key))
+    }
+}
+
+#[derive(Clone, Debug)]
+struct Compiled {
+    /// Over the entries: leaf `e` for `e < leaves`, then nested use `e - leaves`.
+    bvh: Bvh,
+    /// Of everything in it, in its frame, widened.
+    bounds: Aabb,
+}
+
+/// The instanced part of a render scene.
+#[derive(Clone, Debug)]
+pub struct Instances {
+    /// The scene's prototypes and transforms (its flat instances are not kept here).
+    scene: Scene,
+    compiled: Vec<Compiled>,
+    /// Per top-level use: its frame as the flattening composed it.
+    frames: Vec<Transform>,
+    /// Ids of instanced shapes are `first_id` + their depth-first number.
+    first_id: u32,
+}
+
+fn widen(b: Aabb) -> Aabb {
+    if b.is_empty() || !b.is_finite() {
+        return b;
+    }
+    let margin = (b.extent() + b.min.abs().max(b.max.abs())) * CULL_MARGIN + Vec3A::splat(1e-30);
+    Aabb::new(b.min - margin, b.max + margin)
+}
+
+/// `b` mapped by `t`, widened.
+fn transformed(b: &Aabb, t: &Transform) -> Aabb {
+    if b.is_empty() {
+        return *b;
+    }
+    widen(Aabb::from_points(b.corners().map(|c| {
+        Vec3A::from(t.world_from_object.transform_point3(c.as_dvec3()).as_vec3())
+    })))
+}
+
+/// The distance limit of a culling traversal for hits closer than `t`.
+#[inline]
+fn cull_limit(t: f32) -> f32 {
+    t + t.abs() * CULL_MARGIN
+}
+
+impl Instances {
+    /// Compiles the prototypes of `scene` (nested ones come first in its list); `first_id`
+    /// is the render scene's primitive count.
+    pub fn new(scene: &Scene, first_id: u32) -> Instances {
+        let stub = Scene {
+            instanced: scene.instanced.clone(),
+            local_transforms: scene.local_transforms.clone(),
+            moves: scene.moves.clone(),
+            ..Scene::default()
+        };
+        let mut compiled: Vec<Compiled> = Vec::with_capacity(stub.instanced.prototypes.len());
+        for p in &stub.instanced.prototypes {
+            let mut bounds: Vec<Aabb> = p
+                .leaves
+                .iter()
+                .map(|leaf| {
+                    let rel = stub.prototype_world(p, &Transform::IDENTITY, leaf.transform);
+                    Primitive::new(&leaf.geometry, &rel, leaf.material as u32)
+                        .map_or(Aabb::EMPTY, |prim| widen(prim.bounds))
+                })
+                .collect();
+            for u in &p.uses {
+                let rel = stub.prototype_world(p, &Transform::IDENTITY, u.slot);
+                let inner = compiled
+                    .get(u.prototype as usize)
+                    .map_or(Aabb::EMPTY, |c| c.bounds);
+                bounds.push(transformed(&inner, &rel));
+            }
+            let all = bounds.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
+            let entries = (0..bounds.len() as u32).filter(|&e| !bounds[e as usize].is_empty());
+            compiled.push(Compiled {
+                bvh: Bvh::build(&bounds, entries),
+                bounds: all,
+            });
+        }
+        let frames = stub
+            .instanced
+            .uses
+            .iter()
+            .map(|u| scene.use_frame(u))
+            .collect();
+        Instances {
+            scene: stub,
+            compiled,
+            frames,
+            first_id,
+        }
+    }
+
+    /// The top-level uses and their world bounds (moves included), widened.
+    pub fn use_bounds(&self) -> impl Iterator<Item = Aabb> + '_ {
+        self.scene
+            .instanced
+            .uses
+            .iter()
+            .zip(&self.frames)
+            .map(|(u, f)| {
+                let inner = self
+                    .compiled
+                    .get(u.prototype as usize)
+                    .map_or(Aabb::EMPTY, |c| c.bounds);
+                transformed(&inner, &self.scene.moved(*f))
+            })
+    }
+
+    pub fn uses(&self) -> usize {
+        self.scene.instanced.uses.len()
+    }
+
+    /// The shape numbered `flat` in the flattened tree, unplaced.
+    fn leaf(&self, flat: u32) -> Option<&Instance> {
+        let inst = &self.scene.instanced;
+        let k = inst
+            .uses
+            .partition_point(|u| u.offset <= flat)
+            .checked_sub(1)?;
+        let mut u = &inst.uses[k];
+        let mut rest = flat - u.offset;
+        loop {
+            let p = inst.prototypes.get(u.prototype as usize)?;
+            if let Ok(i) = p.offsets.binary_search(&rest) {
+                return p.leaves.get(i);
+            }
+            let k = p
+                .uses
+                .partition_point(|n| n.offset <= rest)
+                .checked_sub(1)?;
+            u = &p.uses[k];
+            rest -= u.offset;
+        }
+    }
+
+    /// The shape numbered `flat` in the flattened tree, placed in the world.
+    fn decode(&self, flat: u32) -> Option<(&Instance, Transform)> {
+        let inst = &self.scene.instanced;
+        let k = inst
+            .uses
+            .partition_point(|u| u.offset <= flat)
+            .checked_sub(1)?;
+        let mut u = &inst.uses[k];
+        let mut frame = self.frames[k];
+        let mut rest = flat - u.offset;
+        loop {
+            let p = inst.prototypes.get(u.prototype as usize)?;
+            if let Ok(i) = p.offsets.binary_search(&rest) {
+                let leaf = &p.leaves[i];
+                let world = self.scene.prototype_world(p, &frame, leaf.transform);
+                return Some((leaf, self.scene.moved(world)));
+            }
+            let k = p
+                .uses
+                .partition_point(|n| n.offset <= rest)
+                .checked_sub(1)?;
+            let nested = &p.uses[k];
+            frame = self.scene.prototype_world(p, &frame, nested.slot);
+            rest -= nested.offset;
+            u = nested;
+        }
+    }
+
+    /// The primitive with id `id` (at least `first_id`), placed.
+    pub fn primitive(&self, id: u32) -> Option<Primitive> {
+        let (leaf, world) = self.decode(id.checked_sub(self.first_id)?)?;
+        Primitive::new(&leaf.geometry, &world, leaf.material as u32).ok()
+    }
+
+    /// The material of the primitive with id `id`.
+    pub fn material(&self, id: u32) -> u32 {
+        id.checked_sub(self.first_id)
+            .and_then(|f| self.leaf(f))
+            .map_or(0, |leaf| leaf.material as u32)
+    }
+
+    /// The ray in a prototype's frame (`world` is the frame, moves included), for culling.
+    fn local_ray(world: &Transform, ray: &Ray) -> Ray {
+        let m = &world.object_from_world;
+        let o = m.transform_point3(ray.origin.as_dvec3());
+        let d = m.transform_vector3(ray.dir.as_dvec3());
+        Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(d.as_vec3()))
+    }
+
+    /// Visits, through top-level use `u`, every shape the ray may meet before `limit()`:
+    /// `shape(id, primitive)` for each, as long as it returns true.
+    fn visit(
+        &self,
+        u: &Use,
+        frame: &Transform,
+        base: u32,
+        ray: &Ray,
+        limit: &dyn Fn() -> f32,
+        shape: &mut dyn FnMut(u32, &Primitive) -> bool,
+    ) -> bool {
+        let inst = &self.scene.instanced;
+        let (Some(p), Some(c)) = (
+            inst.prototypes.get(u.prototype as usize),
+            self.compiled.get(u.prototype as usize),
+        ) else {
+            return true;
+        };
+        let local = Self::local_ray(&self.scene.moved(*frame), ray);
+        let mut go_on = true;
+        c.bvh
+            .closest_leaves(&local, cull_limit(limit()), |leaf, _| {
+                for &e in leaf {
+                    if !self.entry(p, e, frame, base, ray, limit, shape) {
+                        go_on = false;
+                        // Beyond every box: the traversal ends.
+                        return f32::NEG_INFINITY;
+                    }
+                }
+                cull_limit(limit())
+            });
+        go_on
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn entry(
+        &self,
+        p: &Prototype,
+        e: u32,
+        frame: &Transform,
+        base: u32,
+        ray: &Ray,
+        limit: &dyn Fn() -> f32,
+        shape: &mut dyn FnMut(u32, &Primitive) -> bool,
+    ) -> bool {
+        let e = e as usize;
+        if let Some(leaf) = p.leaves.get(e) {
+            let world = self.scene.prototype_world(p, frame, leaf.transform);
+            let flat = base + p.offsets[e];
+            match Primitive::new(
+                &leaf.geometry,
+                &self.scene.moved(world),
+                leaf.material as u32,
+            ) {
+                Ok(prim) => shape(self.first_id + flat, &prim),
+                Err(_) => true,
+            }
+        } else if let Some(nested) = p.uses.get(e - p.leaves.len()) {
+            let inner = self.scene.prototype_world(p, frame, nested.slot);
+            self.visit(nested, &inner, base + nested.offset, ray, limit, shape)
+        } else {
+            true
+        }
+    }
+
+    /// The closest hit through top-level use `k`, ties broken by depth-first number; `won`
+    /// keeps the placed primitive of an instanced winner (for its surface).
+    pub fn closest(
+        &self,
+        k: u32,
+        ray: &Ray,
+        t_max: &mut f32,
+        best: &mut Option<Best>,
+        won: &mut Option<Primitive>,
+    ) {
+        let u = &self.scene.instanced.uses[k as usize];
+        let t_cell = std::cell::Cell::new(*t_max);
+        let mut found = *best;
+        let first_id = self.first_id;
+        self.visit(
+            u,
+            &self.frames[k as usize],
+            u.offset,
+            ray,
+            &|| t_cell.get(),
+            &mut |id, prim| {
+                let t_now = t_cell.get();
+                if let Some(h) = prim.hit(ray, t_now.next_up()) {
+                    let key = id - first_id;
+                    if Best::loses_to(&found, t_now, h.t, key) {
+                        t_cell.set(h.t);
+                        found = Some(Best {
+                            id,
+                            t: h.t,
+                            key,
+                            hit: Some(h),
+                        });
+                        *won = Some(prim.clone());
+                    }
+                }
+                true
+            },
+        );
+        *t_max = t_cell.get();
+        *best = found;
+    }
+
+    /// Offers every instanced shape through top-level use `k` that the ray may meet before
+    /// `t_max` to `stop`, until it returns true (then true).
+    pub fn any(&self, k: u32, ray: &Ray, t_max: f32, stop: &mut dyn FnMut(u32) -> bool) -> bool {
+        let u = &self.scene.instanced.uses[k as usize];
+        let mut stopped = false;
+        self.visit(
+            u,
+            &self.frames[k as usize],
+            u.offset,
+            ray,
+            &|| t_max,
+            &mut |id, _| {
+                stopped = stop(id);
+                !stopped
+            },
+        );
+        stopped
+    }
+
+    /// Whether some instanced shape through top-level use `k` lies on the ray before `t_max`.
+    pub fn occluded(&self, k: u32, ray: &Ray, t_max: f32) -> bool {
+        let u = &self.scene.instanced.uses[k as usize];
+        let mut hit = false;
+        self.visit(
+            u,
+            &self.frames[k as usize],
+            u.offset,
+            ray,
+            &|| t_max,
+            &mut |_, prim| {
+                hit = prim.hit(ray, t_max).is_some();
+                !hit
+            },
+        );
+        hit
+    }
+
+    /// Bytes held by the compiled prototypes.
+    pub fn memory_bytes(&self) -> usize {
+        self.compiled
+            .iter()
+            .map(|c| c.bvh.memory_bytes())
+            .sum::<usize>()
+            + self.frames.capacity() * std::mem::size_of::<Transform>()
+    }
+}
