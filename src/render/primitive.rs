@@ -133,6 +133,31 @@ fn lift_off(normal: Vec3A, point: Vec3A, faces: &[(Vec3A, f32)], error: f32, per
     lift
 }
 
+/// How rays leave a cone's apex: outwards along the reported normal (its half-space holds
+/// the cone), inwards along `axis`, the world image of the object axis into
+/// the solid (an affine map keeps it inside the image of the cone, where the world normal,
+/// under a shear, can point out through the side), far enough to clear every generator's
+/// plane by the error bound `error + per·s`. Moving by `s` along `axis / |axis|` moves the
+/// object point `s / |axis|` along the unit object axis, `sin · s / |axis|` from each
+/// generator's object plane; a plane of object normal `n` is `|N·n| ≤ ‖N‖_F` times nearer in
+/// world space (`N` = `normal_norm`'s matrix; see `world_faces`).
+fn apex_lift(axis: Vec3A, sin: f32, normal_norm: f32, error: f32, per: f32) -> Lift {
+    let len = axis.length();
+    let clearance = (sin / (len * normal_norm)).max(MIN_CLEARANCE);
+    Lift {
+        outward_min: error / (1.0 - per),
+        inward: axis / len,
+        inward_min: error / (clearance - per).max(MIN_CLEARANCE),
+    }
+}
+
+/// How a primitive's shape space maps to the world, for `Primitive::clear_of_apex`:
+/// shape-space directions to the world, and the Frobenius norm of the normal matrix.
+struct Placement<'a> {
+    to_world: &'a dyn Fn(Vec3A) -> Vec3A,
+    normal_norm: f32,
+}
+
 /// `near`'s faces in world space: unit normals (mapped by `to_world`, which for a plane
 /// `n · x = c` of unit `n` gives the world plane's normal with length 1 / (world distance per
 /// object distance)) and the point's world distances from them.
@@ -373,12 +398,17 @@ impl Primitive {
         let (point, normal, lift) = match &self.object {
             None => {
                 let normal = hit.normal.normalize_or_zero();
-                let lift = if near.len == 0 {
+                let lift = if near.len == 0 && near.apex.is_none() {
                     Lift::normal(normal)
                 } else {
                     let (error, per) = world_space_error(hit.point);
                     let faces = world_faces(&near, |n| n);
-                    lift_off(normal, hit.point, &faces[..near.len], error, per)
+                    let lift = lift_off(normal, hit.point, &faces[..near.len], error, per);
+                    let space = Placement {
+                        to_world: &|v| v,
+                        normal_norm: 1.0,
+                    };
+                    self.clear_of_apex(&near, lift, (error, per), &space)
                 };
                 (hit.point, normal, lift)
             }
@@ -388,6 +418,15 @@ impl Primitive {
                 let (error, per) = o.error(hit.point, point);
                 let faces = world_faces(&near, |n| o.normal_to_world * n);
                 let lift = lift_off(normal, point, &faces[..near.len], error, per);
+                let m = &o.normal_to_world;
+                let space = Placement {
+                    to_world: &|v| o.world_from_object.matrix3 * v,
+                    normal_norm: (m.x_axis.length_squared()
+                        + m.y_axis.length_squared()
+                        + m.z_axis.length_squared())
+                    .sqrt(),
+                };
+                let lift = self.clear_of_apex(&near, lift, (error, per), &space);
                 (point, normal, lift)
             }
         };
@@ -396,6 +435,22 @@ impl Primitive {
             point,
             normal,
             lift,
+        }
+    }
+
+    /// `lift`, or at a cone's apex the lift along its axis (`apex_lift`).
+    fn clear_of_apex(
+        &self,
+        near: &NearFaces,
+        lift: Lift,
+        (error, per): (f32, f32),
+        space: &Placement,
+    ) -> Lift {
+        match near.apex {
+            Some((axis, sin)) => {
+                apex_lift((space.to_world)(axis), sin, space.normal_norm, error, per)
+            }
+            None => lift,
         }
     }
 

@@ -164,16 +164,25 @@ impl Cone {
 
 impl Cone {
     /// The side and the base around `point` (in the cone's space), with its distances from
-    /// them; both at 0 on the base rim, where `intersect` snaps hits; nothing at the apex,
-    /// whose normal, the axis, already clears the whole cone. See `Cylinder::faces_near`.
+    /// them; both at 0 on the base rim, where `intersect` snaps hits. At the apex, where hits
+    /// are snapped too, no face but the axis into the solid, which clears every generator by
+    /// sin(half-angle) per unit moved (`NearFaces::apex`). See `Cylinder::faces_near`.
     pub fn faces_near(&self, point: Vec3A) -> NearFaces {
         let local = self.frame.point_to_local(point.as_dvec3());
         let (r, h, k) = (self.radius as f64, self.frame.height, self.slope);
         let rho = (local.x * local.x + local.y * local.y).sqrt();
-        if rho == 0.0 {
-            return NearFaces::default();
-        }
         let norm = (1.0 + k * k).sqrt();
+        if rho == 0.0 {
+            // The apex is at local z = 0, the base at z = h; the base's centre is one face.
+            let apex = (local.z < 0.5 * h).then(|| {
+                let inward: Vec3A = self.frame.vector_to_world(DVec3::Z).as_vec3().into();
+                (inward, (k / norm) as f32)
+            });
+            return NearFaces {
+                apex,
+                ..NearFaces::default()
+            };
+        }
         let side = DVec3::new(local.x / rho, local.y / rho, -k) / norm;
         // Distance from the generator's line ρ = k·z in the point's half-plane.
         let to_side = (k * local.z - rho) / norm;

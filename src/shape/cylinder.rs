@@ -122,6 +122,7 @@ impl AxisFrame {
                 normals: [normals[0], normals[1], Vec3A::ZERO],
                 distances: [to_side.max(0.0) as f32, to_cap as f32, 0.0],
                 len: 2,
+                apex: None,
             }
         }
     }

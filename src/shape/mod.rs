@@ -39,6 +39,12 @@ pub struct NearFaces {
     pub normals: [Vec3A; 3],
     pub distances: [f32; 3],
     pub len: usize,
+    /// At a cone's apex (no faces listed): the unit direction into the solid along the axis
+    /// and the sine of the half-angle, the clearance from every generator's plane per unit
+    /// moved along it. The reported normal, the axis, is that direction only in the cone's
+    /// own space: a shear maps normals and directions differently, and the world normal can
+    /// leave a narrow cone through its side.
+    pub apex: Option<(Vec3A, f32)>,
 }
 
 impl NearFaces {
@@ -48,6 +54,7 @@ impl NearFaces {
             normals: [normals[0], normals[1], Vec3A::ZERO],
             distances: [0.0; 3],
             len: 2,
+            apex: None,
         }
     }
 
