@@ -42,9 +42,10 @@ pub struct SceneArgs {
     /// makes every material of the file plausible (one warning says which was taken).
     #[arg(long, value_name = "LIST", default_value = "auto", value_parser = parse_material_fields, value_delimiter = ',')]
     pub material_fields: Vec<Option<MaterialField>>,
-    /// How a transform statement composes with earlier ones: `world` (M ← T·M, the
-    /// default) or `local` (M ← M·T).
-    #[arg(long, value_enum, default_value = "world")]
+    /// How a transform statement composes with earlier ones: `world` (M ← T·M), `local`
+    /// (M ← M·T), or `auto`: world, unless the file's images would be blank that way and not
+    /// the other way (one warning says so).
+    #[arg(long, value_enum, default_value = "auto")]
     pub transform_order: TransformOrderArg,
     /// Largest scene file read, in bytes; larger files are refused unread.
     #[arg(long, value_name = "BYTES", default_value_t = limits::DEFAULT_MAX_INPUT)]
@@ -238,6 +239,7 @@ impl BenchArgs {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum TransformOrderArg {
+    Auto,
     World,
     Local,
 }
@@ -385,9 +387,10 @@ impl SceneArgs {
                 MaterialLayout::Fields(self.material_fields.iter().flatten().copied().collect())
             },
             transform_order: match self.transform_order {
-                TransformOrderArg::World => TransformOrder::World,
+                TransformOrderArg::Auto | TransformOrderArg::World => TransformOrder::World,
                 TransformOrderArg::Local => TransformOrder::Local,
             },
+            infer_transform_order: self.transform_order == TransformOrderArg::Auto,
             max_input: self.max_input,
             max_memory: self.max_memory(),
         }

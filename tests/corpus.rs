@@ -151,8 +151,10 @@ fn corpus_summary_counts() {
     let mut files = Vec::new();
     common::files_below(&dir, &mut files);
     files.retain(|f| f.file_name().is_some_and(|n| n != "MANIFEST.tsv"));
+    // The command line's defaults: both the material layout and the transform order inferred.
     let opts = LoadOptions {
         material_fields: anim::sdf::MaterialLayout::Auto,
+        infer_transform_order: true,
         ..LoadOptions::default()
     };
     // [renders, blank, rejected] over all files, then over the distinct ones.
@@ -177,7 +179,7 @@ fn corpus_summary_counts() {
     assert!(silent.is_empty(), "blank without a reason: {silent:?}");
     assert_eq!(
         (distinct, all),
-        ([69, 12, 2], [128, 21, 5]),
+        ([73, 8, 2], [136, 13, 5]),
         "[renders, blank, rejected] of the distinct files, then of all files"
     );
 }

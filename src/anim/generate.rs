@@ -454,11 +454,12 @@ impl<'a> Generator<'a> {
         let mut text = String::new();
         let _ = writeln!(
             text,
-            "# Frame {i} of {} (t = {} s at {} fps), generated from {} by anim {}.",
+            "# Frame {i} of {} (t = {} s at {} fps), generated from {} {} {}.",
             anim.frames,
             tidy(anim.time(i)),
             anim.fps,
             self.spec_name,
+            crate::sdf::GENERATED_FRAME_SIGNATURE,
             env!("CARGO_PKG_VERSION")
         );
         let _ = writeln!(

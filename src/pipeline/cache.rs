@@ -187,6 +187,7 @@ mod tests {
             strict,
             material_fields,
             transform_order,
+            infer_transform_order,
             // The input limit decides whether a file is read at all, never what it renders.
             max_input: _,
             // The memory budget decides whether a scene is built at all, never what it
@@ -288,6 +289,13 @@ mod tests {
                         TransformOrder::World => TransformOrder::Local,
                         TransformOrder::Local => TransformOrder::World,
                     },
+                    ..load.clone()
+                },
+            ),
+            (
+                base.clone(),
+                LoadOptions {
+                    infer_transform_order: !infer_transform_order,
                     ..load.clone()
                 },
             ),

@@ -1,11 +1,12 @@
 //! Loading a scene file: the reader's statements built into render jobs.
 
 use super::build::build_jobs;
+use super::probe;
 use super::RenderJob;
 use crate::diag::{Diagnostic, Severity};
 use crate::limits::MAX_DIAGNOSTICS;
-use crate::sdf::ast::Statement;
-use crate::sdf::{self, finish_diagnostics, LoadOptions};
+use crate::sdf::ast::{Statement, StatementKind};
+use crate::sdf::{self, finish_diagnostics, LoadOptions, TransformOrder};
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::io::Read;
@@ -134,19 +135,140 @@ fn finish_load<'t>(
     opts: &LoadOptions,
     text: impl FnOnce() -> Option<Cow<'t, str>>,
 ) -> Result<Loaded, Vec<Diagnostic>> {
-    let (jobs, built) = build_jobs(
+    let (mut jobs, mut built) = build_jobs(
         &parsed.statements,
         parsed.shapes,
         path,
         opts,
         Some(&parsed.omissions),
     );
+    // The text is asked for at most once: here when the transform order is in question (a
+    // generated frame says what it means), else by `conclude` for quoting.
+    let mut text = Some(text);
+    let mut text_read = None;
+    if may_need_other_order(&parsed.statements, &jobs, &built, opts) {
+        let t = text.take().and_then(|read| read());
+        if !t.as_deref().is_some_and(sdf::is_generated_frame) {
+            if let Some(other) =
+                read_in_other_order(&parsed.statements, &parsed.omissions, &jobs, path, opts)
+            {
+                (jobs, built) = other;
+            }
+        }
+        text_read = Some(t);
+    }
     // The statements are no longer needed once the jobs hold the scenes: freed before the
     // images are made.
     drop(parsed.statements);
     let mut diagnostics = parsed.diagnostics;
     diagnostics.extend(built);
+    let text = move || match text_read {
+        Some(t) => t,
+        None => text.and_then(|read| read()),
+    };
     conclude(jobs, finish_diagnostics(diagnostics, opts), path, text)
+}
+
+/// Whether the transform order of the file is worth trying the other way
+/// (`--transform-order auto`, docs/scene-language.md §7): some object has several transform
+/// operations (with one, the orders agree), and an image would be blank.
+fn may_need_other_order(
+    statements: &[Statement],
+    jobs: &[RenderJob],
+    built: &[Diagnostic],
+    opts: &LoadOptions,
+) -> bool {
+    if !opts.infer_transform_order || opts.strict || built.iter().any(Diagnostic::is_error) {
+        return false;
+    }
+    let mut ops: HashMap<&str, usize> = HashMap::new();
+    let composed = statements.iter().any(|s| match &s.kind {
+        StatementKind::Transform { target, ops: these } => {
+            let n = ops.entry(target.name.as_str()).or_insert(0);
+            *n += these.len();
+            *n > 1
+        }
+        _ => false,
+    });
+    composed && jobs.iter().any(|job| probe::blank_image(job).is_some())
+}
+
+/// The jobs and diagnostics of the file read in the other transform order, with a warning
+/// that says so, when that order leaves fewer images blank and none blank that was not: the
+/// file was written for a loader that composes transforms the other way.
+fn read_in_other_order(
+    statements: &[Statement],
+    omissions: &sdf::Omissions,
+    jobs: &[RenderJob],
+    path: &Path,
+    opts: &LoadOptions,
+) -> Option<(Vec<RenderJob>, Vec<Diagnostic>)> {
+    let other = match opts.transform_order {
+        TransformOrder::World => TransformOrder::Local,
+        TransformOrder::Local => TransformOrder::World,
+    };
+    let other_opts = LoadOptions {
+        transform_order: other,
+        infer_transform_order: false,
+        ..opts.clone()
+    };
+    let (other_jobs, mut built) = build_jobs(
+        statements,
+        Default::default(),
+        path,
+        &other_opts,
+        Some(omissions),
+    );
+    if other_jobs.len() != jobs.len() || built.iter().any(Diagnostic::is_error) {
+        return None;
+    }
+    let blank: Vec<Option<probe::Blank>> = jobs.iter().map(probe::blank_image).collect();
+    let other_blank: Vec<bool> = other_jobs
+        .iter()
+        .map(|job| probe::blank_image(job).is_some())
+        .collect();
+    let newly_blank = blank
+        .iter()
+        .zip(&other_blank)
+        .any(|(was, now)| was.is_none() && *now);
+    let shown = |b: &mut dyn Iterator<Item = bool>| b.filter(|blank| !blank).count();
+    if newly_blank
+        || shown(&mut other_blank.iter().copied()) <= shown(&mut blank.iter().map(Option::is_some))
+    {
+        return None;
+    }
+    let (job, reason) = jobs
+        .iter()
+        .zip(&blank)
+        .find_map(|(job, b)| b.as_ref().map(|b| (job, &b.reason)))?;
+    let at = statements
+        .iter()
+        .find(|s| matches!(s.kind, StatementKind::Transform { .. }))
+        .map_or_else(|| job.loc.clone(), |s| Some(s.loc.clone()))?;
+    let (written, taken) = match other {
+        TransformOrder::Local => ("M ← T·M", "M ← M·T"),
+        TransformOrder::World => ("M ← M·T", "M ← T·M"),
+    };
+    built.push(
+        Diagnostic::new(
+            Severity::Warning,
+            at,
+            format!(
+                "transforms composed as {taken}, each applied before the ones written above it: \
+                 composed as {written} the image `{}` shows nothing: {reason}",
+                job.output.display()
+            ),
+        )
+        .with_help(format!(
+            "this is how loaders that compose the other way read the file; pass \
+             `--transform-order {}` to read it as {written}",
+            match opts.transform_order {
+                TransformOrder::World => "world",
+                TransformOrder::Local => "local",
+            }
+        )),
+    );
+    Some((other_jobs, built))
 }
 
 /// `Err` with the diagnostics when one is an error. They are capped first, then the kept
@@ -234,4 +356,72 @@ fn cap(mut diagnostics: Vec<Diagnostic>, path: &Path) -> Vec<Diagnostic> {
         .with_severity(severity),
     );
     diagnostics
+}
+
+#[cfg(test)]
+mod order_tests {
+    use super::*;
+
+    /// The assignment's extended example: its camera looks away from the scene when each
+    /// transform applies after the ones above it.
+    const EXTENDED: &str = "define material red 1 0 0 1 0 0 1 0 0 10
+define shape box rbottom -100 -80 -200 100 80 -100 red
+define shape sphere bsphere 0 0 -100 50 red
+define light sun 500 800 0 1.0 1.0 1.0 10
+ambient 0.1 0.1 0.1
+define camera eye 60.0
+transform eye rotate -45 0 1 0
+transform eye translate 100 0 100
+render eye image.ppm 48 32
+";
+
+    fn load(text: &str, infer: bool) -> Loaded {
+        let opts = LoadOptions {
+            infer_transform_order: infer,
+            ..LoadOptions::default()
+        };
+        load_str(text, Path::new("x.sdf"), &opts).expect("loads")
+    }
+
+    fn blank(loaded: &Loaded) -> bool {
+        probe::blank_image(&loaded.jobs[0]).is_some()
+    }
+
+    fn warned(loaded: &Loaded) -> bool {
+        loaded
+            .diagnostics
+            .iter()
+            .any(|d| d.message.contains("transforms composed as M ← M·T"))
+    }
+
+    #[test]
+    fn a_file_blank_in_the_standard_order_is_read_the_other_way() {
+        let standard = load(EXTENDED, false);
+        assert!(blank(&standard) && !warned(&standard));
+        let inferred = load(EXTENDED, true);
+        assert!(!blank(&inferred) && warned(&inferred));
+    }
+
+    #[test]
+    fn a_file_that_shows_something_keeps_the_standard_order() {
+        // Two operations on the camera, so the orders differ, but it sees the scene as written.
+        let text = EXTENDED.replace(
+            "transform eye rotate -45 0 1 0\ntransform eye translate 100 0 100",
+            "transform eye rotate 10 0 1 0\ntransform eye translate 0 0 300",
+        );
+        assert_ne!(text, EXTENDED);
+        let loaded = load(&text, true);
+        assert!(!warned(&loaded));
+    }
+
+    #[test]
+    fn generated_frames_are_never_read_the_other_way() {
+        let text = format!(
+            "# Frame 3 of 120 (t = 0.125 s at 24 fps), generated from orbit.ron {} 0.1.0.\n{EXTENDED}",
+            sdf::GENERATED_FRAME_SIGNATURE
+        );
+        assert!(sdf::is_generated_frame(&text));
+        let loaded = load(&text, true);
+        assert!(blank(&loaded) && !warned(&loaded));
+    }
 }

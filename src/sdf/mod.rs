@@ -39,6 +39,19 @@ pub enum TransformOrder {
     Local,
 }
 
+/// What `anim generate` writes after the frame header's first words: a frame file states
+/// exactly what it means, so nothing about it is inferred.
+pub const GENERATED_FRAME_SIGNATURE: &str = "by anim";
+
+/// Whether `text` is a frame written by `anim generate`: its first line is the generator's
+/// header comment, `# Frame ... generated from SPEC by anim VERSION.`
+pub fn is_generated_frame(text: &str) -> bool {
+    let first = text.lines().next().unwrap_or("");
+    first.starts_with("# Frame ")
+        && first.contains("generated from")
+        && first.contains(GENERATED_FRAME_SIGNATURE)
+}
+
 /// How the numbers after `m` in material lines are read (`--material-fields`).
 #[derive(Clone, Debug, PartialEq)]
 pub enum MaterialLayout {
@@ -74,6 +87,10 @@ pub struct LoadOptions {
     pub strict: bool,
     pub material_fields: MaterialLayout,
     pub transform_order: TransformOrder,
+    /// Whether a file whose images would be blank in `transform_order` but not in the other
+    /// order is read in the other one (`--transform-order auto`, docs/scene-language.md §7).
+    /// Never for generated frames (see [`is_generated_frame`]) or under `strict`.
+    pub infer_transform_order: bool,
     /// Largest input file read, in bytes (`--max-input`); larger files are refused unread.
     pub max_input: u64,
     /// Memory the scene may take, in bytes (`--max-memory`): a scene whose shapes would need
@@ -89,6 +106,7 @@ impl Default for LoadOptions {
             // the command line's default, for files written by hand.
             material_fields: MaterialLayout::standard(),
             transform_order: TransformOrder::World,
+            infer_transform_order: false,
             max_input: crate::limits::DEFAULT_MAX_INPUT,
             max_memory: crate::limits::default_memory_budget(),
         }
