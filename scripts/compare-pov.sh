@@ -40,7 +40,9 @@ shading() { # NAME W H
     povray -D +WT2 -A File_Gamma=1.0 +W$2 +H$3 +FH +O"$1_$c.hdr" "$1_$c.pov" 2>/dev/null
   done
   python3 "$tools/povtonemap.py" "$1_r.hdr" "$1_g.hdr" "$1_b.hdr" -o "$1_pov.png"
-  "$anim" render "$1.sdf" --spp 1 --out out -q
+  # The converter composes transforms in the standard order (M <- T*M); anim is told the
+  # same, as by default it would read a file that shows nothing that way the other way.
+  "$anim" render "$1.sdf" --spp 1 --transform-order world --out out -q
   echo "shading $1:"
   python3 "$tools/imgcmp.py" "$1_pov.png" "out/$1.ppm" --tol 1
 }
@@ -49,7 +51,7 @@ geometry() { # NAME W H
   python3 "$tools/sdf2pov.py" "$1.sdf" --shading id --ids ids.json -o "$1_id.pov"
   povray -D +WT2 -A File_Gamma=1.0 +W$2 +H$3 +FN +O"$1_povid.png" "$1_id.pov" 2>/dev/null
   python3 "$tools/sdf2id.py" "$1.sdf" -o "$1_id.sdf"
-  "$anim" render "$1_id.sdf" --spp 1 --out out -q
+  "$anim" render "$1_id.sdf" --spp 1 --transform-order world --out out -q
   echo "geometry $1:"
   python3 "$tools/imgcmp.py" "out/$1.ppm" "$1_povid.png" --ids ids.json > ids.txt
   head -2 ids.txt
