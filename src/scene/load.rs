@@ -231,10 +231,9 @@ fn read_in_other_order(
         .iter()
         .zip(&other_blank)
         .any(|(was, now)| was.is_none() && *now);
-    let shown = |b: &mut dyn Iterator<Item = bool>| b.filter(|blank| !blank).count();
-    if newly_blank
-        || shown(&mut other_blank.iter().copied()) <= shown(&mut blank.iter().map(Option::is_some))
-    {
+    let shown_before = blank.iter().filter(|b| b.is_none()).count();
+    let shown_after = other_blank.iter().filter(|&&b| !b).count();
+    if newly_blank || shown_after <= shown_before {
         return None;
     }
     let (job, reason) = jobs
