@@ -394,10 +394,13 @@ impl Primitive {
     /// `quadric_apex_and_rims_are_watertight`).
     #[inline]
     pub fn surface(&self, hit: &ShapeHit) -> SurfaceHit {
-        let near = self.shape.faces_near(hit);
+        let mut near = self.shape.faces_near(hit);
         let (point, normal, lift) = match &self.object {
             None => {
                 let normal = hit.normal.normalize_or_zero();
+                if near.apex.is_none() {
+                    near.apex = self.thin_tip(hit.point, hit.point, Lift::normal(normal), |v| v);
+                }
                 let lift = if near.len == 0 && near.apex.is_none() {
                     Lift::normal(normal)
                 } else {
@@ -418,6 +421,10 @@ impl Primitive {
                 let (error, per) = o.error(hit.point, point);
                 let faces = world_faces(&near, |n| o.normal_to_world * n);
                 let lift = lift_off(normal, point, &faces[..near.len], error, per);
+                if near.apex.is_none() {
+                    near.apex =
+                        self.thin_tip(hit.point, point, lift, |v| o.object_from_world.matrix3 * v);
+                }
                 let m = &o.normal_to_world;
                 let space = Placement {
                     to_world: &|v| o.world_from_object.matrix3 * v,
@@ -436,6 +443,23 @@ impl Primitive {
             normal,
             lift,
         }
+    }
+
+    /// The apex's way out for a hit at shape-space point `at` (world point `world`) next to a
+    /// cone's apex, where the inward move `lift` makes (mapped to shape space by `to_shape`)
+    /// would cross the thin tip (`Shape::apex_escape_near`).
+    fn thin_tip(
+        &self,
+        at: Vec3A,
+        world: Vec3A,
+        lift: Lift,
+        to_shape: impl Fn(Vec3A) -> Vec3A,
+    ) -> Option<(Vec3A, f32)> {
+        if !matches!(self.shape, Shape::Cone(_)) {
+            return None;
+        }
+        let step = -lift.inward * relative_offset(world).max(lift.inward_min);
+        self.shape.apex_escape_near(at, to_shape(step))
     }
 
     /// `lift`, or at a cone's apex the lift along its axis (`apex_lift`).

@@ -174,12 +174,8 @@ impl Cone {
         let norm = (1.0 + k * k).sqrt();
         if rho == 0.0 {
             // The apex is at local z = 0, the base at z = h; the base's centre is one face.
-            let apex = (local.z < 0.5 * h).then(|| {
-                let inward: Vec3A = self.frame.vector_to_world(DVec3::Z).as_vec3().into();
-                (inward, (k / norm) as f32)
-            });
             return NearFaces {
-                apex,
+                apex: (local.z < 0.5 * h).then(|| self.apex_escape()),
                 ..NearFaces::default()
             };
         }
@@ -188,6 +184,27 @@ impl Cone {
         let to_side = (k * local.z - rho) / norm;
         self.frame
             .faces_near(local, h, r, r.min(h), side, to_side, 1.0)
+    }
+
+    /// The unit axis into the solid and the sine of the half-angle (`NearFaces::apex`).
+    fn apex_escape(&self) -> (Vec3A, f32) {
+        let k = self.slope;
+        let inward: Vec3A = self.frame.vector_to_world(DVec3::Z).as_vec3().into();
+        (inward, (k / (1.0 + k * k).sqrt()) as f32)
+    }
+
+    /// The apex escape for a side point `point` (in the cone's space) so close to the apex
+    /// that the inward move `step` would carry it half way to the axis or beyond: the solid
+    /// there is thinner than the hit's error bound, and a move along the normal could come
+    /// out through the opposite side. A move along the axis cannot: the cone only widens that
+    /// way, and the point's own generator recedes by sin(half-angle) per unit moved.
+    pub fn apex_escape_near(&self, point: Vec3A, step: Vec3A) -> Option<(Vec3A, f32)> {
+        let from = self.frame.point_to_local(point.as_dvec3());
+        let to = self.frame.point_to_local((point + step).as_dvec3());
+        let rho = from.x.hypot(from.y);
+        let (dx, dy) = (from.x / rho, from.y / rho);
+        let still_out = to.x * dx + to.y * dy;
+        (from.z < 0.5 * self.frame.height && still_out < 0.5 * rho).then(|| self.apex_escape())
     }
 }
 
@@ -459,6 +476,27 @@ mod tests {
             let p = c.base + (u * a.cos() + v * a.sin()) * 0.7;
             assert!(p.cmpge(b.min).all() && p.cmple(b.max).all(), "{p:?} {b:?}");
         }
+    }
+
+    #[test]
+    fn a_move_across_the_thin_tip_takes_the_axis_instead() {
+        // Radius 1 at y = 0, apex at y = 2: the side point at height 2 − 2e-4 lies 1e-4 from
+        // the axis, along +x.
+        let c = unit();
+        let near_tip = Vec3A::new(1e-4, 2.0 - 2e-4, 0.0);
+        let inward = Vec3A::new(-1.0, 0.5, 0.0).normalize();
+        let (axis, sin) = c
+            .apex_escape_near(near_tip, inward * 1e-4)
+            .expect("a move of 1e-4 towards the axis crosses half of it");
+        assert!(close(axis, Vec3A::new(0.0, -1.0, 0.0)));
+        assert!(
+            (sin - 1.0 / 5f32.sqrt()).abs() < 1e-6,
+            "half-angle atan(1/2): {sin}"
+        );
+        // A move a tenth as long, or the same move far from the apex, stays on its side.
+        assert_eq!(c.apex_escape_near(near_tip, inward * 1e-5), None);
+        let low = Vec3A::new(0.5, 1.0, 0.0);
+        assert_eq!(c.apex_escape_near(low, inward * 1e-4), None);
     }
 
     #[test]

@@ -112,6 +112,15 @@ impl Shape {
         }
     }
 
+    /// At a cone's side next to its apex, where moving by `step` into the solid would take a
+    /// point half way to the axis or beyond, the apex's way out (`Cone::apex_escape_near`).
+    pub fn apex_escape_near(&self, point: Vec3A, step: Vec3A) -> Option<(Vec3A, f32)> {
+        match self {
+            Shape::Cone(c) => c.apex_escape_near(point, step),
+            _ => None,
+        }
+    }
+
     pub fn bounds(&self) -> Aabb {
         match self {
             Shape::Sphere(s) => s.bounds(),

@@ -162,7 +162,9 @@ proptest! {
                 };
                 for side in [1.0, -1.0, 1.0, -1.0] {
                     let dir = v32(rng.hemisphere(hit.normal.as_dvec3() * side));
-                    let what = || format!("{kind:?} seed {seed}, at {point:?} (object space)");
+                    let what = || {
+                        format!("{kind:?} seed {seed}, at {point:?} (object space) of {:?}", obj.geometry)
+                    };
                     spawn_and_check(&target, &hit, dir, 1.0, &mut stats, &what);
                 }
             }

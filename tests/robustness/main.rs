@@ -446,6 +446,8 @@ struct Stats {
     rays: u64,
     outward: u64,
     inward_checked: u64,
+    /// Inward rays whose far side lies within the lift (see `spawn_and_check`): no claim.
+    within_lift: u64,
     failures: u64,
     messages: Vec<String>,
     /// Smallest (reported t) / (exact exit t) over checked inward rays.
@@ -558,6 +560,20 @@ fn spawn_and_check(
         return;
     };
     if t_ref <= FAR_SIDE * target.size {
+        return;
+    }
+    // Nor when the far side passes closer to the spawned origin, measured across it, than the
+    // origin was lifted off the hit: the lift is the hit's error bound, so a wall that thin
+    // (next to a slender cone's apex) lies within it, on either side as far as f32 can tell.
+    let n_world = target
+        .xf
+        .object_from_world
+        .transpose()
+        .transform_vector3(n_ref)
+        .normalize();
+    let across = t_ref * ray.dir.as_dvec3().normalize().dot(n_world).abs();
+    if across <= (ray.origin - p).as_dvec3().length() {
+        stats.within_lift += 1;
         return;
     }
     stats.inward_checked += 1;

@@ -62,11 +62,12 @@ fn check_reintersection(kind: Kind, seed: u64) {
     let stats = reintersection(kind, seed, 2000, 250, 1.0);
     eprintln!(
         "re-intersection {kind:?}: {} rays ({} outward/planar, {} inward checked against the \
-         exact exit), {} failures; exit t / exact ≥ {:.6}; |exit t error| ≤ {:.2e} of the \
+         exact exit, {} with the far side within the lift), {} failures; exit t / exact ≥ {:.6}; |exit t error| ≤ {:.2e} of the \
          size ({:.2e} with grazing exits); {:.2?}",
         stats.rays,
         stats.outward,
         stats.inward_checked,
+        stats.within_lift,
         stats.failures,
         stats.min_exit_ratio,
         stats.max_exit_error,
