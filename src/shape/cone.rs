@@ -194,17 +194,16 @@ impl Cone {
     }
 
     /// The apex escape for a side point `point` (in the cone's space) so close to the apex
-    /// that the inward move `step` would carry it half way to the axis or beyond: the solid
-    /// there is thinner than the hit's error bound, and a move along the normal could come
-    /// out through the opposite side. A move along the axis cannot: the cone only widens that
-    /// way, and the point's own generator recedes by sin(half-angle) per unit moved.
+    /// that the inward move `step` is as long as half the distance to the axis: the solid
+    /// there is no thicker than the hit's error bound, and a move into the tangent plane
+    /// (which a shear turns largely sideways) can come out through the curved side or the
+    /// opposite one. A move along the axis cannot: the cone only widens that way, and the
+    /// point's own generator recedes by sin(half-angle) per unit moved.
     pub fn apex_escape_near(&self, point: Vec3A, step: Vec3A) -> Option<(Vec3A, f32)> {
-        let from = self.frame.point_to_local(point.as_dvec3());
-        let to = self.frame.point_to_local((point + step).as_dvec3());
-        let rho = from.x.hypot(from.y);
-        let (dx, dy) = (from.x / rho, from.y / rho);
-        let still_out = to.x * dx + to.y * dy;
-        (from.z < 0.5 * self.frame.height && still_out < 0.5 * rho).then(|| self.apex_escape())
+        let local = self.frame.point_to_local(point.as_dvec3());
+        let rho = local.x.hypot(local.y);
+        let thin = step.as_dvec3().length() >= 0.5 * rho;
+        (local.z < 0.5 * self.frame.height && thin).then(|| self.apex_escape())
     }
 }
 
@@ -487,12 +486,14 @@ mod tests {
         let inward = Vec3A::new(-1.0, 0.5, 0.0).normalize();
         let (axis, sin) = c
             .apex_escape_near(near_tip, inward * 1e-4)
-            .expect("a move of 1e-4 towards the axis crosses half of it");
+            .expect("a move of 1e-4 is as long as the tip is wide");
         assert!(close(axis, Vec3A::new(0.0, -1.0, 0.0)));
         assert!(
             (sin - 1.0 / 5f32.sqrt()).abs() < 1e-6,
             "half-angle atan(1/2): {sin}"
         );
+        let sideways = Vec3A::new(0.0, 0.0, 1e-4);
+        assert!(c.apex_escape_near(near_tip, sideways).is_some());
         // A move a tenth as long, or the same move far from the apex, stays on its side.
         assert_eq!(c.apex_escape_near(near_tip, inward * 1e-5), None);
         let low = Vec3A::new(0.5, 1.0, 0.0);

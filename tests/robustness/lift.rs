@@ -111,7 +111,8 @@ fn axis() -> impl Strategy<Value = DVec3> {
 
 proptest! {
     #![proptest_config(ProptestConfig {
-        cases: 600,
+        // PROPTEST_CASES raises it for a soak.
+        cases: ProptestConfig::default().cases.max(600),
         failure_persistence: Some(Box::new(
             proptest::test_runner::FileFailurePersistence::WithSource("proptest-regressions"),
         )),
