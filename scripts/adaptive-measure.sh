@@ -9,8 +9,9 @@
 # default /work/shared/tools), OUT (work directory, default /tmp/adaptive-measure),
 # REUSE_REF=1 to keep reference renders from an earlier run, SIZE (default "640 360"),
 # QUICK=1 for the adaptive run alone, SCENES (default: the mirror-glass bench, its moved
-# variant and the showcase), TURNS (default 3: the default run, the LADDER runs and POV-Ray
-# alternate this many times; the median CPU time of each is printed), LADDER (';'-separated
+# variant and the showcase), TURNS (default 3: every run, the default, the LADDER runs and
+# uniform 4 and 16 spp, alternates with the others and with POV-Ray this many times; the
+# median CPU time of each is printed), LADDER (';'-separated
 # anim flag sets measured in the same turns, to trace the time/RMSE curve around the default;
 # default "--error 2.5;--error 3;--error 4;--error 64;--spp 1"; empty for none).
 set -euo pipefail
