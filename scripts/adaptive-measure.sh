@@ -9,8 +9,11 @@
 # default /work/shared/tools), OUT (work directory, default /tmp/adaptive-measure),
 # REUSE_REF=1 to keep reference renders from an earlier run, SIZE (default "640 360"),
 # QUICK=1 for the adaptive run alone, SCENES (default: the mirror-glass bench, its moved
-# variant and the showcase), TURNS (default 3: the default run and POV-Ray alternate this many
-# times; the median CPU time of each is printed).
+# variant and the showcase), TURNS (default 3: every run, the default, the LADDER runs and
+# uniform 4 and 16 spp, alternates with the others and with POV-Ray this many times; the
+# median CPU time of each is printed), LADDER (';'-separated
+# anim flag sets measured in the same turns, to trace the time/RMSE curve around the default;
+# default "--error 2.5;--error 3;--error 4;--error 64;--spp 1"; empty for none).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ANIM=${ANIM:-target/release/anim}
@@ -18,6 +21,7 @@ TOOLS=${TOOLS:-/work/shared/tools}
 OUT=${OUT:-/tmp/adaptive-measure}
 TURNS=${TURNS:-3}
 read -r W H <<<"${SIZE:-640 360}"
+IFS=';' read -r -a LADDER <<<"${LADDER---error 2.5;--error 3;--error 4;--error 64;--spp 1}"
 mkdir -p "$OUT"
 
 # A held-out stand-in for the mirror-and-glass room, so that tuning is not to one file: the
@@ -77,8 +81,17 @@ for scene in "${SCENES[@]}"; do
     render "$base-ref" "$scene" --spp 256 >/dev/null
   fi
   ref=$OUT/$base-ref/$png
-  runs=("default:$*")
-  [[ ${QUICK:-0} == 1 ]] || runs+=("uniform 4:--spp 4" "uniform 16:--spp 16")
+  # Every run takes turns with the others and POV-Ray, the default first.
+  turned=("default:$*")
+  ladder_runs=0
+  if [[ ${QUICK:-0} != 1 ]]; then
+    for flags in "${LADDER[@]}"; do
+      [[ -n $flags ]] || continue
+      turned+=("${flags//[- ]/}:$flags")
+      ladder_runs=$((ladder_runs + 1))
+    done
+    turned+=("uniform 4:--spp 4" "uniform 16:--spp 16")
+  fi
   pov=$OUT/$base-pov
   with_pov=0
   if [[ ${QUICK:-0} != 1 ]] && command -v povray >/dev/null; then
@@ -86,31 +99,43 @@ for scene in "${SCENES[@]}"; do
     mkdir -p "$pov"
     python3 "$TOOLS/sdf2pov.py" "$scene" -o "$pov/scene.pov"
   fi
+  # cpus[i] holds run i's CPU seconds, one word per turn; every run and POV-Ray alternate, so
+  # that all of them see the same machine load.
+  cpus=()
   pov_cpu=()
-  for run in "${runs[@]}"; do
+  for ((turn = 0; turn < TURNS; turn++)); do
+    for i in "${!turned[@]}"; do
+      run=${turned[$i]}
+      label=${run%%:*}
+      # shellcheck disable=SC2086  # the flags are words on purpose
+      cpus[i]+=" $(render "$base-${label// /-}" "$scene" ${run#*:})"
+    done
+    if [[ $with_pov == 1 ]]; then
+      /usr/bin/time -f '%U %S' -o "$pov/time" povray -D +WT2 File_Gamma=1.0 +W"$W" +H"$H" \
+        +A0.1 +AM2 +R3 +FN +O"$pov/pov.png" "$pov/scene.pov" >"$pov/log" 2>&1
+      pov_cpu+=("$(cpu_of "$pov/time")")
+    fi
+  done
+  for i in "${!turned[@]}"; do
+    run=${turned[$i]}
     label=${run%%:*}
     flags=${run#*:}
     dir="$base-${label// /-}"
-    # The default run takes turns with POV-Ray, so that both see the same machine load.
-    turns=1
-    [[ $label == default ]] && turns=$TURNS
-    cpus=()
-    for ((turn = 0; turn < turns; turn++)); do
-      # shellcheck disable=SC2086  # the flags are words on purpose
-      cpus+=("$(render "$dir" "$scene" $flags)")
-      if [[ $label == default && $with_pov == 1 ]]; then
-        /usr/bin/time -f '%U %S' -o "$pov/time" povray -D +WT2 File_Gamma=1.0 +W"$W" +H"$H" \
-          +A0.1 +AM2 +R3 +FN +O"$pov/pov.png" "$pov/scene.pov" >"$pov/log" 2>&1
-        pov_cpu+=("$(cpu_of "$pov/time")")
-      fi
-    done
-    printf '%-18s %-28s %8s %8s %8s\n' "$base" "anim $label ${flags:+($flags)}" \
-      "$(median "${cpus[@]}")" "$(rmse "$OUT/$dir/$png" "$ref")" "$(mean_spp "$OUT/$dir/log")"
+    if ((i > 0 && i <= ladder_runs)); then
+      label=$flags
+    else
+      label="$label${flags:+ ($flags)}"
+    fi
+    # shellcheck disable=SC2086  # one word per turn
+    printf '%-18s %-28s %8s %8s %8s\n' "$base" "anim $label" \
+      "$(median ${cpus[$i]})" "$(rmse "$OUT/$dir/$png" "$ref")" "$(mean_spp "$OUT/$dir/log")"
   done
   if [[ $with_pov == 1 ]]; then
     # No RMSE: POV-Ray reflects and refracts by its own model (no Fresnel), so its image
     # is a different one, and only its time is comparable.
-    printf '%-18s %-28s %8s %8s %8s\n' "$base" "povray +A0.1 +AM2 +R3" \
-      "$(median "${pov_cpu[@]}")" "-" "-"
+    pov_median=$(median "${pov_cpu[@]}")
+    printf '%-18s %-28s %8s %8s %8s\n' "$base" "povray +A0.1 +AM2 +R3" "$pov_median" "-" "-"
+    printf '%-18s %-28s %8s %8s %8s\n' "$base" "(one third of povray)" \
+      "$(awk -v t="$pov_median" 'BEGIN {printf "%.2f", t / 3}')" "-" "-"
   fi
 done
