@@ -309,6 +309,39 @@ mod tests {
         assert!(still.is_empty(), "{still:?}");
     }
 
+    fn pose() -> impl proptest::strategy::Strategy<Value = TrackPose> {
+        use proptest::prelude::*;
+        let v = |r: std::ops::Range<f64>| prop::array::uniform3(r).prop_map(DVec3::from);
+        (v(-50.0..50.0), -1000.0f64..1000.0, v(0.05..20.0)).prop_map(|(t, d, s)| TrackPose {
+            translate: tidy3(t),
+            degrees: tidy(d),
+            scale: tidy3(s),
+        })
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn every_delta_takes_one_pose_to_the_other(
+            from in pose(),
+            to in pose(),
+            pivot in proptest::array::uniform3(-20.0f64..20.0),
+            axis in proptest::array::uniform3(-1.0f64..1.0),
+        ) {
+            let axis = DVec3::from(axis);
+            proptest::prop_assume!(axis.length() > 1e-2);
+            let pivot = DVec3::from(pivot);
+            let composed = matrix(&delta_ops(&from, &to, pivot, axis))
+                .then_after(&matrix(&from.ops(pivot, axis)));
+            let direct = matrix(&to.ops(pivot, axis));
+            // The printed numbers keep 12 digits: relative to the largest entry involved.
+            let size = direct.world_from_object.abs().to_cols_array().iter().copied().fold(1.0, f64::max);
+            proptest::prop_assert!(composed.world_from_object.abs_diff_eq(direct.world_from_object, 1e-8 * size));
+            let simplified = simplify(delta_ops(&from, &to, pivot, axis));
+            proptest::prop_assert!(matrix(&simplified).then_after(&matrix(&from.ops(pivot, axis)))
+                .world_from_object.abs_diff_eq(direct.world_from_object, 1e-8 * size));
+        }
+    }
+
     #[test]
     fn inverse_ops_undo_ops() {
         let ops = [
