@@ -212,7 +212,7 @@ fn located(s: &Statement, lines: &[&str], message: String) -> Diagnostic {
         ..s.loc.clone()
     };
     let d = Diagnostic::new(Severity::Error, loc, message);
-    match lines.get(s.loc.line as usize - 1) {
+    match lines.get((s.loc.line as usize).saturating_sub(1)) {
         Some(text) => d.with_source(*text, span.map_or(1, |sp| sp.width)),
         None => d,
     }
