@@ -156,6 +156,27 @@ pub const INSTANCE_BUDGET_SHARE: u64 = 64;
 /// the memory budget.
 pub const INSTANCE_MAX_FLAT: u64 = 1 << 31;
 
+/// The shutter rule of a keyframe spec in words, for messages.
+pub const SHUTTER_RULE: &str =
+    "0 (no motion blur) or a fraction of the frame interval greater than 0 and at most 1";
+
+/// A keyframe spec's `shutter`: 0 (an instant), or the open fraction of the frame interval.
+pub fn shutter_is_valid(s: f64) -> bool {
+    s == 0.0 || (s > 0.0 && s <= 1.0)
+}
+
+/// Most degrees a thing may turn between two `motion` instants of a blurred frame: closer
+/// instants make an interpolating reader follow the arc rather than its chord (a point 1 away
+/// from the axis strays at most 1 − cos 5° = 0.4 % from the arc between them).
+pub const MOTION_KEY_DEGREES: f64 = 10.0;
+
+/// Steps at which a keyed angle is sampled to measure how far it turns during an exposure.
+pub const MOTION_TURN_SAMPLES: usize = 32;
+
+/// Most steps one exposure is cut into (so a spin of thousands of degrees per frame still
+/// writes a bounded file).
+pub const MOTION_MAX_STEPS: usize = 256;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -15,13 +15,14 @@
 //! after the base file's: translate −p, scale S, rotate R, translate p + T.
 
 use super::orbit;
+use super::shutter::{self, TrackPose};
 use super::spec::{Animation, SceneNames, Source, TargetKind, Track};
 use super::tidy::{tidy, tidy3};
 use crate::diag::{Diagnostic, Loc};
 use crate::limits;
 use crate::math::Transform;
 use crate::scene::Geometry;
-use crate::sdf::ast::{NameRef, RenderDef, Statement, StatementKind, TransformOp};
+use crate::sdf::ast::{MotionDef, NameRef, RenderDef, Statement, StatementKind, TransformOp};
 use glam::{DVec3, Vec3};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -267,7 +268,12 @@ impl<'a> Generator<'a> {
     /// The statements of frame `i`.
     pub fn frame_statements(&self, i: usize) -> Result<Vec<Statement>, Vec<Diagnostic>> {
         let anim = self.anim;
-        let t = anim.time(i);
+        // A blurred frame states the scene at the middle of its exposure (see `shutter`).
+        let t = if anim.shutter > 0.0 {
+            anim.shutter_time(i, 0.5)
+        } else {
+            anim.time(i)
+        };
         let when = || format!("at frame {i} (t = {} s)", tidy(t));
         let mut out: Vec<Statement> = self.base.statements.clone();
 
@@ -324,6 +330,11 @@ impl<'a> Generator<'a> {
                     ops: vec![op],
                 }));
             }
+        }
+
+        if anim.shutter > 0.0 {
+            let moving = self.exposure_motion(i, t)?;
+            out.extend(moving);
         }
 
         out.push(self.statement(StatementKind::Render(RenderDef {
@@ -393,23 +404,19 @@ impl<'a> Generator<'a> {
         t: f64,
         when: &dyn Fn() -> String,
     ) -> Result<Vec<TransformOp>, Vec<Diagnostic>> {
-        let translate = tidy3(
-            track
-                .translate
-                .as_ref()
-                .and_then(|c| c.at(t))
-                .unwrap_or(DVec3::ZERO),
-        );
-        let degrees = tidy(track.rotate.as_ref().and_then(|c| c.at(t)).unwrap_or(0.0));
-        let scale = tidy3(
-            track
-                .scale
-                .as_ref()
-                .and_then(|c| c.at(t))
-                .unwrap_or(DVec3::ONE),
-        );
+        Ok(self.pose(track, t, when)?.ops(pivot, track.axis))
+    }
+
+    /// Where `track` puts its target at time `t`; an error if its scale is 0 there.
+    fn pose(
+        &self,
+        track: &Track,
+        t: f64,
+        when: &dyn Fn() -> String,
+    ) -> Result<TrackPose, Vec<Diagnostic>> {
+        let pose = TrackPose::at(track, t);
         if let Some(ch) = &track.scale {
-            if scale.cmpeq(DVec3::ZERO).any() {
+            if pose.scale.cmpeq(DVec3::ZERO).any() {
                 return Err(vec![self.src.error(
                     &[&ch.path],
                     format!(
@@ -420,31 +427,107 @@ impl<'a> Generator<'a> {
                 )]);
             }
         }
-        let mut ops = Vec::new();
-        let turns = degrees != 0.0;
-        let scales = scale != DVec3::ONE;
-        if turns || scales {
-            let p = tidy3(pivot);
-            if p != DVec3::ZERO {
-                ops.push(TransformOp::Translate(-p));
+        Ok(pose)
+    }
+
+    /// The `motion` lines of frame `i`, whose statements stand at `mid`, the middle of its
+    /// exposure (see `shutter`): for each thing that moves during the exposure, its motion
+    /// at evenly spread instants.
+    fn exposure_motion(&self, i: usize, mid: f64) -> Result<Vec<Statement>, Vec<Diagnostic>> {
+        let anim = self.anim;
+        let steps = shutter::steps(anim, i);
+        let instants: Vec<(f64, f64)> = (0..=steps)
+            .map(|j| {
+                let u = j as f64 / steps as f64;
+                (tidy(u), anim.shutter_time(i, u))
+            })
+            .collect();
+        let mut out = Vec::new();
+        let mut add = |target: &str, deltas: Vec<Vec<TransformOp>>| {
+            if deltas.iter().all(Vec::is_empty) {
+                return;
             }
-            if scales {
-                ops.push(TransformOp::Scale(scale));
+            for (&(u, _), ops) in instants.iter().zip(deltas) {
+                out.push(self.statement(StatementKind::Motion(MotionDef {
+                    target: NameRef {
+                        name: target.to_string(),
+                        loc: self.loc(),
+                    },
+                    at: u,
+                    ops,
+                })));
             }
-            if turns {
-                ops.push(TransformOp::Rotate {
-                    degrees,
-                    axis: track.axis,
-                });
-            }
-            let back = tidy3(p + translate);
-            if back != DVec3::ZERO {
-                ops.push(TransformOp::Translate(back));
-            }
-        } else if translate != DVec3::ZERO {
-            ops.push(TransformOp::Translate(translate));
+        };
+        if let Some(o) = &anim.orbit {
+            let pose = |t: f64| {
+                orbit::pose_at(o, t, anim.duration()).ok_or_else(|| {
+                    vec![self.src.error(
+                        &["orbit.look_at", "orbit"],
+                        format!(
+                            "at frame {i} (t = {} s) the orbiting camera would look straight up or down",
+                            tidy(t)
+                        ),
+                    )]
+                })
+            };
+            let centre = pose(mid)?;
+            let deltas = instants
+                .iter()
+                .map(|&(_, t)| Ok(shutter::camera_delta_ops(&centre, &pose(t)?)))
+                .collect::<Result<_, Vec<Diagnostic>>>()?;
+            add(&anim.camera, deltas);
         }
-        Ok(ops)
+        // Tracks on one target compose (each applies after the one before), so a target's
+        // motion undoes all of them at the middle and applies all of them at the instant.
+        let mut targets: Vec<&str> = Vec::new();
+        for t in &anim.tracks {
+            if !targets.contains(&t.target.as_str()) {
+                targets.push(&t.target);
+            }
+        }
+        let when = || format!("during frame {i}");
+        for target in targets {
+            let tracks: Vec<(&Track, DVec3)> = anim
+                .tracks
+                .iter()
+                .zip(self.pivots.iter().copied())
+                .filter(|(t, _)| t.target == target)
+                .filter(|(t, _)| t.translate.is_some() || t.rotate.is_some() || t.scale.is_some())
+                .collect();
+            let poses_at = |t: f64| -> Result<Vec<TrackPose>, Vec<Diagnostic>> {
+                tracks
+                    .iter()
+                    .map(|(tr, _)| self.pose(tr, t, &when))
+                    .collect()
+            };
+            let centre = poses_at(mid)?;
+            let poses: Vec<Vec<TrackPose>> = instants
+                .iter()
+                .map(|&(_, t)| poses_at(t))
+                .collect::<Result<_, _>>()?;
+            if poses.iter().all(|p| *p == centre) {
+                continue;
+            }
+            let deltas = poses
+                .iter()
+                .map(|at| match tracks.as_slice() {
+                    [(track, pivot)] => shutter::delta_ops(&centre[0], &at[0], *pivot, track.axis),
+                    _ => {
+                        let placed = |ps: &[TrackPose]| -> Vec<TransformOp> {
+                            ps.iter()
+                                .zip(&tracks)
+                                .flat_map(|(p, (tr, pivot))| p.ops(*pivot, tr.axis))
+                                .collect()
+                        };
+                        let mut ops = shutter::inverse_ops(&placed(&centre));
+                        ops.extend(placed(at));
+                        shutter::simplify(ops)
+                    }
+                })
+                .collect();
+            add(target, deltas);
+        }
+        Ok(out)
     }
 
     /// The complete SDF text of frame `i`.
@@ -462,6 +545,15 @@ impl<'a> Generator<'a> {
             crate::sdf::GENERATED_FRAME_SIGNATURE,
             env!("CARGO_PKG_VERSION")
         );
+        if anim.shutter > 0.0 {
+            let _ = writeln!(
+                text,
+                "# Shutter open from t = {} to {} s: the statements give the scene at t = {} s, the motion lines where moving things are meanwhile.",
+                tidy(anim.shutter_time(i, 0.0)),
+                tidy(anim.shutter_time(i, 1.0)),
+                tidy(anim.shutter_time(i, 0.5))
+            );
+        }
         let _ = writeln!(
             text,
             "# Edit the spec and run `anim generate` again rather than this file."

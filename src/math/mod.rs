@@ -1,6 +1,7 @@
 //! Rays, bounding boxes, transforms and the one place where secondary rays are offset.
 
 pub(crate) mod aabb;
+pub mod motion;
 mod transform;
 
 pub use aabb::{Aabb, SLAB_WIDEN};

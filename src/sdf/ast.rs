@@ -355,6 +355,8 @@ pub enum StatementKind {
         ops: Vec<TransformOp>,
     },
     Render(RenderDef),
+    /// A thing's motion while the shutter is open (docs/scene-language.md §10).
+    Motion(MotionDef),
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -410,6 +412,15 @@ pub enum TransformOp {
         axis: DVec3,
     },
     Scale(DVec3),
+}
+
+/// `motion <target> <u> [ops]`: at the fraction `u` of the exposure, `target` is placed by
+/// its transforms followed by `ops` (docs/scene-language.md §10).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MotionDef {
+    pub target: NameRef,
+    pub at: f64,
+    pub ops: Vec<TransformOp>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -532,16 +543,11 @@ impl fmt::Display for StatementKind {
             ),
             StatementKind::Transform { target, ops } => {
                 write!(f, "transform {}", target.name)?;
-                for op in ops {
-                    match op {
-                        TransformOp::Translate(v) => write!(f, " translate {}", v3(*v))?,
-                        TransformOp::Rotate { degrees, axis } => {
-                            write!(f, " rotate {} {}", Num(*degrees), v3(*axis))?
-                        }
-                        TransformOp::Scale(s) => write!(f, " scale {}", v3(*s))?,
-                    }
-                }
-                Ok(())
+                write_ops(f, ops)
+            }
+            StatementKind::Motion(m) => {
+                write!(f, "motion {} {}", m.target.name, Num(m.at))?;
+                write_ops(f, &m.ops)
             }
             StatementKind::Render(r) => {
                 write!(
@@ -556,6 +562,20 @@ impl fmt::Display for StatementKind {
             }
         }
     }
+}
+
+/// Transform operations in canonical form, each after a space.
+fn write_ops(f: &mut fmt::Formatter<'_>, ops: &[TransformOp]) -> fmt::Result {
+    for op in ops {
+        match op {
+            TransformOp::Translate(v) => write!(f, " translate {}", v3(*v))?,
+            TransformOp::Rotate { degrees, axis } => {
+                write!(f, " rotate {} {}", Num(*degrees), v3(*axis))?
+            }
+            TransformOp::Scale(s) => write!(f, " scale {}", v3(*s))?,
+        }
+    }
+    Ok(())
 }
 
 impl fmt::Display for Statement {

@@ -139,6 +139,8 @@ pub struct Animation {
     pub ambient: Option<Channel<DVec3>>,
     pub background: Option<Channel<DVec3>>,
     pub tracks: Vec<Track>,
+    /// The fraction of each frame's interval the shutter stays open (0: an instant).
+    pub shutter: f64,
 }
 
 impl Animation {
@@ -155,6 +157,16 @@ impl Animation {
     /// Time of frame `i` in seconds.
     pub fn time(&self, i: usize) -> f64 {
         i as f64 / self.fps as f64
+    }
+
+    /// How long the shutter stays open, in seconds.
+    pub fn exposure(&self) -> f64 {
+        self.shutter / self.fps as f64
+    }
+
+    /// The time `u` of the way through frame `i`'s exposure (0 at shutter open, 1 at close).
+    pub fn shutter_time(&self, i: usize, u: f64) -> f64 {
+        self.time(i) + u * self.exposure()
     }
 }
 

@@ -35,6 +35,10 @@ pub struct SpecFile {
     /// Default for every track's `looping`.
     #[serde(default)]
     pub looping: bool,
+    /// The fraction of each frame's interval the shutter stays open, from the frame's time
+    /// (0: no motion blur). Read as any number so that a bad value gets a located message.
+    #[serde(default)]
+    pub shutter: f64,
     /// Circle the camera around a point, always looking at it.
     #[serde(default)]
     pub orbit: Option<OrbitSpec>,

@@ -36,6 +36,7 @@ pub fn validate(
     let output = c.output(spec);
     let camera = c.camera(spec.camera.as_deref(), names);
     let orbit = spec.orbit.as_ref().map(|o| c.orbit(o));
+    let shutter = c.shutter(spec.shutter);
     let ambient = c.channel(
         &spec.ambient,
         "ambient",
@@ -70,6 +71,7 @@ pub fn validate(
             ambient,
             background,
             tracks,
+            shutter,
         }),
         _ => Err(c.errors),
     }
@@ -142,6 +144,18 @@ impl Checker<'_> {
             ),
         );
         24
+    }
+
+    /// The shutter fraction; 0 (no blur) when it is wrong, so that checking can go on.
+    fn shutter(&mut self, shutter: f64) -> f64 {
+        if limits::shutter_is_valid(shutter) {
+            return shutter;
+        }
+        self.err(
+            &["shutter"],
+            format!("shutter must be {}, not {shutter}", limits::SHUTTER_RULE),
+        );
+        0.0
     }
 
     /// The number of frames; a usable stand-in when the length is wrong.

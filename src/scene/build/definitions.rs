@@ -5,7 +5,7 @@ use super::{At, Builder};
 use crate::limits::{clamp_fraction, fov_is_valid, FOV_RULE};
 use crate::scene::{Geometry, Material};
 use crate::sdf::ast::{
-    CameraDef, LightDef, MaterialDef, NameRef, Statement, StatementKind, TransformOp,
+    CameraDef, LightDef, MaterialDef, MotionDef, NameRef, Statement, StatementKind, TransformOp,
 };
 use crate::sdf::repair;
 use crate::shape::geometry::{is_zero, parallel};
@@ -148,7 +148,9 @@ impl Builder<'_> {
                 StatementKind::Ambient(rgb) => ambient_set = Some(*rgb),
                 StatementKind::AmbientAdd(rgb) => ambient_added += *rgb,
                 StatementKind::Background(rgb) => d.background = *rgb,
-                StatementKind::Transform { .. } | StatementKind::Render(_) => {}
+                StatementKind::Transform { .. }
+                | StatementKind::Render(_)
+                | StatementKind::Motion(_) => {}
             }
         }
         d.ambient = ambient_set.unwrap_or(Vec3::ZERO) + ambient_added;
@@ -341,10 +343,13 @@ pub(super) fn finite_statement(kind: &StatementKind) -> bool {
         StatementKind::Camera(cam) => {
             cam.fov_x_deg.is_finite() && v(&cam.eye) && v(&cam.dir) && v(&cam.up)
         }
-        StatementKind::Transform { ops, .. } => ops.iter().all(|op| match op {
-            TransformOp::Translate(t) | TransformOp::Scale(t) => v(t),
-            TransformOp::Rotate { degrees, axis } => degrees.is_finite() && v(axis),
-        }),
+        StatementKind::Motion(m) if !m.at.is_finite() => false,
+        StatementKind::Transform { ops, .. } | StatementKind::Motion(MotionDef { ops, .. }) => {
+            ops.iter().all(|op| match op {
+                TransformOp::Translate(t) | TransformOp::Scale(t) => v(t),
+                TransformOp::Rotate { degrees, axis } => degrees.is_finite() && v(axis),
+            })
+        }
         StatementKind::Composite { .. } | StatementKind::Render(_) => true,
     }
 }

@@ -11,6 +11,7 @@ mod camera;
 mod layout;
 mod light;
 mod material;
+mod motion;
 mod render;
 mod resolve;
 mod shape;
@@ -154,6 +155,7 @@ pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions, flat: bool) -> 
     p.resolve_camera_role(text);
     p.prune_skipped_references();
     p.drop_transforms_of_commented_definitions(text, &commented);
+    p.resolve_motion(text);
     Parsed {
         statements: p.statements,
         shapes: p.shapes,
@@ -369,7 +371,9 @@ impl Parser<'_> {
         let first_width = Self::place(line, At::Tok(0)).1;
         match &kind {
             StatementKind::Material(m) => self.shapes.define_material(&m.name),
-            StatementKind::Composite { .. } | StatementKind::Transform { .. } => {
+            StatementKind::Composite { .. }
+            | StatementKind::Transform { .. }
+            | StatementKind::Motion(_) => {
                 self.flat = false;
             }
             _ => {}
@@ -520,6 +524,7 @@ impl Parser<'_> {
             "camera" => self.camera(line, 1),
             "ambient" => self.ambient(line, 1),
             "background" => self.background(line, 1),
+            "motion" => self.motion(line),
             other => {
                 let help = if other.starts_with("<<<<<<<")
                     || other.starts_with("=======")
