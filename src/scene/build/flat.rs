@@ -109,15 +109,19 @@ impl Builder<'_> {
                 }
             }
         }
+        // What is drawn: neither superseded, nor of a material that cannot be resolved, nor
+        // degenerate (each tested once here).
+        let mut keep = superseded;
         for (k, s) in shapes.iter().enumerate() {
-            if superseded[k] {
+            if keep[k] {
+                keep[k] = false;
                 continue;
             }
             first_root.get_or_insert(k);
             total.nodes += 1;
-            if resolved[shapes.material_of(s)].is_some() && degeneracy(&s.geometry).is_none() {
-                total.shapes += 1;
-            }
+            keep[k] =
+                resolved[shapes.material_of(s)].is_some() && degeneracy(&s.geometry).is_none();
+            total.shapes += u64::from(keep[k]);
         }
         let snapshots = self.snapshots(statements, &d);
         let fits = match first_root.and_then(|k| shapes.get(k)) {
@@ -136,19 +140,22 @@ impl Builder<'_> {
         let mut instances = Vec::new();
         let mut names = Names::default();
         if let Some(count) = fits {
-            instances.reserve_exact(usize::try_from(count).unwrap_or(0));
+            let count = usize::try_from(count).unwrap_or(0);
+            instances.reserve_exact(count);
+            names.reserve(count, shapes.names_len());
+            let file = shapes.file().map(|f| names.file_id(f));
             let mut k = 0;
             for chunk in shapes.take_chunks() {
                 for s in chunk {
-                    let keep = !superseded[k];
                     k += 1;
-                    let Some(material) = resolved[shapes.material_of(&s)] else {
-                        continue;
-                    };
-                    if !keep || degeneracy(&s.geometry).is_some() {
+                    if !keep[k - 1] {
                         continue;
                     }
-                    let object = names.add_object(shapes.name(&s), &shapes.loc(&s));
+                    let (Some(material), Some(file)) = (resolved[shapes.material_of(&s)], file)
+                    else {
+                        continue;
+                    };
+                    let object = names.add_object_in(shapes.name(&s), file, s.line(), s.col());
                     instances.push(Instance {
                         geometry: placed_geometry(s.geometry),
                         material,
@@ -159,7 +166,7 @@ impl Builder<'_> {
                 }
             }
         }
-        drop(superseded);
+        drop(keep);
         drop(shapes);
         let flat = Flat {
             instances: Arc::new(instances),
