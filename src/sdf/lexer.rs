@@ -83,15 +83,19 @@ fn scan_line<'t>(rest: &'t str, tokens: &mut Vec<Token<'t>>) -> (usize, usize) {
     tokens.clear();
     let bytes = rest.as_bytes();
     let class = |i: usize| bytes.get(i).map_or(END, |&b| BYTE_CLASS[usize::from(b)]);
+    // The end of the run of bytes of class `c` from `from` (at most the end of the text):
+    // a search over the slice, which compiles to a tighter loop than testing `class(i)`.
+    let run = |from: usize, c: u8| {
+        bytes
+            .get(from..)
+            .and_then(|tail| tail.iter().position(|&b| BYTE_CLASS[usize::from(b)] != c))
+            .map_or(bytes.len(), |n| from + n)
+    };
     let mut i = 0;
     loop {
-        while class(i) == SPACE {
-            i += 1;
-        }
+        i = run(i, SPACE);
         let start = i;
-        while class(i) == WORD {
-            i += 1;
-        }
+        i = run(i, WORD);
         if i > start && tokens.len() < crate::limits::MAX_TOKENS_PER_LINE {
             // Past the cap the rest is not kept (see `overlong`, by which the line is
             // reported).
@@ -377,29 +381,28 @@ fn short_decimal(s: &str) -> Option<f64> {
         b'+' => (false, &b[1..]),
         _ => (false, b),
     };
-    let mut mantissa: u64 = 0;
-    let mut count = 0;
-    let mut fraction: Option<usize> = None;
-    for &c in digits {
-        match c {
-            b'0'..=b'9' => {
-                if count == 15 {
-                    return None;
-                }
-                mantissa = mantissa * 10 + u64::from(c - b'0');
-                count += 1;
-                if let Some(f) = &mut fraction {
-                    *f += 1;
-                }
-            }
-            b'.' if fraction.is_none() => fraction = Some(0),
-            _ => return None,
-        }
-    }
-    if count == 0 {
+    // At most 15 digits and a point.
+    if digits.len() > 16 {
         return None;
     }
-    let v = mantissa as f64 / EXACT_POWERS_OF_TEN[fraction.unwrap_or(0)];
+    let mut mantissa: u64 = 0;
+    let mut point: Option<usize> = None;
+    for (k, &c) in digits.iter().enumerate() {
+        let d = c.wrapping_sub(b'0');
+        if d < 10 {
+            mantissa = mantissa * 10 + u64::from(d);
+        } else if c == b'.' && point.is_none() {
+            point = Some(k);
+        } else {
+            return None;
+        }
+    }
+    let count = digits.len() - usize::from(point.is_some());
+    if count == 0 || count > 15 {
+        return None;
+    }
+    let fraction = point.map_or(0, |p| digits.len() - 1 - p);
+    let v = mantissa as f64 / EXACT_POWERS_OF_TEN[fraction];
     if v > MAX_MAGNITUDE {
         return None;
     }
