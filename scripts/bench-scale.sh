@@ -19,7 +19,7 @@ if [ ${#counts[@]} -eq 0 ]; then
     counts=(1000 10000 100000 1000000)
 fi
 if [ "${READER:-0}" = 1 ]; then
-    cargo test --release --test scale -- --ignored --nocapture --test-threads 1 two_million 2>&1 |
+    cargo test --release --test scale -- --ignored --nocapture --test-threads 1 lines_a_second 2>&1 |
         grep -E "^(reader|loader):|panicked|FAILED" || true
 fi
 dir=$(mktemp -d)

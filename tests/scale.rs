@@ -122,11 +122,13 @@ fn random_spheres(n: usize) -> String {
 /// The whole front end of `anim render` before the hierarchy is built: reading the file
 /// from disk, tokenizing, parsing and building the scene (`anim::scene::load_file`, with the
 /// command line's default options), on a flat file of a million random spheres, in lines per
-/// CPU-second of the loading thread. A measurement, run by scripts/bench-scale.sh with
-/// `READER=1`: `cargo test --release --test scale -- --ignored --nocapture the_loader_loads`.
+/// CPU-second of the loading thread; it fails below 1.5 M lines/s (BENCHMARKS.md §10: about
+/// 2 M measured, 1 M before the reader took flat lines directly). A measurement, run by
+/// scripts/bench-scale.sh with `READER=1`:
+/// `cargo test --release --test scale -- --ignored --nocapture the_loader_loads`.
 #[test]
 #[ignore]
-fn the_loader_loads_two_million_lines_a_second() {
+fn the_loader_loads_one_and_a_half_million_lines_a_second() {
     let n = 1_000_000;
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("spheres.sdf");
@@ -152,7 +154,7 @@ fn the_loader_loads_two_million_lines_a_second() {
         "loader: {lines} lines in {best:.3} CPU-s (best of 5): {:.2} M lines/s",
         rate / 1e6
     );
-    assert!(rate >= 2e6, "{:.2} M lines/s", rate / 1e6);
+    assert!(rate >= 1.5e6, "{:.2} M lines/s", rate / 1e6);
 }
 
 /// The reader alone (`anim::sdf::parse_source`, no scene building) on a flat file of a million
