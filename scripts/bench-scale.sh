@@ -7,7 +7,9 @@
 # Usage: scripts/bench-scale.sh [ANIM_BINARY] [COUNTS...]
 # Default binary: target/release/anim; default counts: 1000 10000 100000 1000000.
 # With READER=1, first the reader alone (the source tree's `anim::sdf::parse_source`, no scene
-# building) on a million-sphere file, in lines per CPU-second: an ignored test of tests/scale.rs.
+# building) and then the whole loader (`anim::scene::load_file`: reading the file, parsing and
+# building the scene) on a million-sphere file, in lines per CPU-second: two ignored tests of
+# tests/scale.rs.
 set -euo pipefail
 
 bin=${1:-target/release/anim}
@@ -17,8 +19,8 @@ if [ ${#counts[@]} -eq 0 ]; then
     counts=(1000 10000 100000 1000000)
 fi
 if [ "${READER:-0}" = 1 ]; then
-    cargo test --release --test scale -- --ignored --nocapture the_reader_reads 2>&1 |
-        grep -E '^reader:|panicked|FAILED' || true
+    cargo test --release --test scale -- --ignored --nocapture --test-threads 1 lines_a_second 2>&1 |
+        grep -E "^(reader|loader):|panicked|FAILED" || true
 fi
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT

@@ -121,21 +121,39 @@ struct PathNode {
 impl Names {
     /// Records an object's name and location; its id.
     pub fn add_object(&mut self, name: &str, loc: &Loc) -> u32 {
-        let file = match self.files.iter().rposition(|f| Arc::ptr_eq(f, &loc.file)) {
+        let file = self.file_id(&loc.file);
+        self.add_object_in(name, file, loc.line, loc.col)
+    }
+
+    /// The id of `file` among the files of the objects, recorded if new.
+    pub fn file_id(&mut self, file: &Arc<Path>) -> u32 {
+        let i = match self.files.iter().rposition(|f| Arc::ptr_eq(f, file)) {
             Some(i) => i,
             None => {
-                self.files.push(loc.file.clone());
+                self.files.push(file.clone());
                 self.files.len() - 1
             }
         };
+        i as u32
+    }
+
+    /// Records an object's name and location, in file `file` (from [`Names::file_id`]); its
+    /// id.
+    pub fn add_object_in(&mut self, name: &str, file: u32, line: u32, col: u32) -> u32 {
         self.text.push_str(name);
         self.objects.push(ObjectName {
             end: u32::try_from(self.text.len()).unwrap_or(u32::MAX),
-            file: file as u32,
-            line: loc.line,
-            col: loc.col,
+            file,
+            line,
+            col,
         });
         (self.objects.len() - 1) as u32
+    }
+
+    /// Room for `objects` more objects whose names take `bytes` bytes together.
+    pub fn reserve(&mut self, objects: usize, bytes: usize) {
+        self.objects.reserve_exact(objects);
+        self.text.reserve_exact(bytes);
     }
 
     /// Records composite `object` listed under path node `parent`; the new path node's id.

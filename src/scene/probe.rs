@@ -321,13 +321,16 @@ pub fn blank_image(job: &RenderJob) -> Option<Blank> {
         return None;
     }
     let rays = primary_rays(&job.camera, job.width, job.height)?;
-    // Counted before the shapes are placed, so that a huge scene costs no memory here.
-    let placeable = scene
+    // Counted before the shapes are placed, so that a huge scene costs no memory here; the
+    // count stops as soon as it is over the budget.
+    let most = PROBE_BUDGET / rays.len().max(1);
+    let over = scene
         .instances
         .iter()
         .filter(|i| scene.materials.get(i.material).is_some() && shape_of(&i.geometry).is_some())
-        .count();
-    if placeable.saturating_mul(rays.len()) > PROBE_BUDGET {
+        .nth(most)
+        .is_some();
+    if over {
         // Scenes this big are generated, and their images are rarely empty: the probe
         // stays cheap rather than exhaustive (the reasons above still apply).
         return None;

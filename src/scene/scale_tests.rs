@@ -158,6 +158,64 @@ fn flat_shapes_kept_compactly_load_as_their_statements_do() {
 }
 
 #[test]
+fn lines_the_direct_reader_leaves_to_the_general_one_load_as_their_statements_do() {
+    // The reader takes a canonical primitive line straight into the compact shapes; every
+    // other spelling (a warning to give, a variant to read, a number to repair, a shape to
+    // drop) goes the general way. Each line here, among canonical ones, must load as the
+    // same line read as a statement.
+    let odd = [
+        "define shape sphere neg 0 0 -5 -1 m",
+        "define shape sphere zero 0 0 -5 0 m",
+        "define shape box rect 0 0 0 1 1 0 m",
+        "define shape box line 0 0 0 1 0 0 m",
+        "define shape box point 1 1 1 1 1 1 m",
+        "define shape sphere suffix 0 0 -5 1.0f m",
+        "define shape sphere comma 0 0 -5 1,5 m",
+        "define shape sphere numeric 0 0 -5 1 2",
+        "define shape sphere many 0 0 -5 1 2 m",
+        "define shape sphere few 0 0 -5 m",
+        "define shape sphere bad 0 0 -5 1O m",
+        "define shape sphere huge 0 0 -5 1e13 m",
+        "define shape cone up 0 0 -5 2 1 m",
+        "define shape cylinder negc 0 0 -5 0 1 -5 -1 m",
+        "define shape triangle flat 0 0 0 1 1 1 2 2 2 m",
+        "define shape plane nonormal 0 0 0 0 0 0 m",
+        "define shape sphere 0 0 -5 1 m after",
+        "define shape sphere first m 0 0 -5 1",
+        "define sphere noshape 0 0 -5 1 m",
+        "define shape sphere 12 0 0 -5 1 m",
+        "define shape sphere exp 0 0 -5e0 1E-1 m",
+        "define shape sphere signs +.5 -.5 -5. +1 m",
+        "define shape sphere digits 0.1234567890123456 0 -5 1 m",
+        "define\tshape\tsphere\ttab 0 0 -5 1 m\r",
+        "define shape sphere jklö 0 0 -5 1 m",
+        "define shape sphere a 0 0 -5 1 m # comment 1 2",
+        "define shape sphere late 0 0 -5 1 later",
+        "define shape sphere s1 0 0 -6 1 m",
+    ];
+    let opts = LoadOptions::default();
+    let mut all = format!("{MATERIAL}define shape sphere s1 0 0 -5 1 m\n");
+    for line in odd {
+        let text = format!(
+            "{MATERIAL}define shape sphere s1 0 0 -5 1 m\n{line}\n\
+             define shape sphere s2 1 0 -5 1 m\ndefine camera c 60\nrender c o.png 4 3\n"
+        );
+        let _ = same_both_ways(&text, &opts, true);
+        all.push_str(line);
+        all.push('\n');
+    }
+    all.push_str(
+        "define material later 1 1 1 1 1 1 1 1 1 10\ndefine camera c 60\nrender c o.png 4 3\n",
+    );
+    let _ = same_both_ways(&all, &opts, true);
+    let strict = LoadOptions {
+        strict: true,
+        ..LoadOptions::default()
+    };
+    let _ = same_both_ways(&all, &strict, true);
+}
+
+#[test]
 fn a_flat_sphere_costs_at_most_200_bytes_once_read() {
     let n = 20_000;
     let mut text = format!("{MATERIAL}define camera c 60\nrender c o.png 1 1\n");

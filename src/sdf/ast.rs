@@ -98,10 +98,30 @@ pub struct FlatShape {
     pos: u32,
 }
 
+/// A primitive shape as its line is written, for [`FlatShapes::push_fitting`].
+pub struct FlatShapeLine<'a> {
+    pub file: &'a Arc<Path>,
+    pub name: &'a str,
+    pub geometry: Geometry,
+    pub material: &'a str,
+    /// The line, and the columns of its first token, name and material.
+    pub line: u32,
+    pub col: u32,
+    pub name_col: u32,
+    pub material_col: u32,
+    /// Statements (other than the shapes kept apart) read before it.
+    pub pos: usize,
+}
+
 impl FlatShape {
     /// The line its statement is on.
     pub fn line(&self) -> u32 {
         self.line
+    }
+
+    /// The column its statement starts at.
+    pub fn col(&self) -> u32 {
+        self.col
     }
 }
 
@@ -142,11 +162,7 @@ impl FlatShapes {
     /// Takes `stmt`, read after `pos` other statements, if it is a primitive shape whose
     /// places fit the compact form; else gives it back.
     pub fn push(&mut self, stmt: Statement, pos: usize) -> Option<Statement> {
-        let fits = |v: usize| u32::try_from(v).ok().filter(|&v| v < DEFINED_BEFORE);
-        let (Some(name_start), Some(pos)) = (fits(self.names.len()), fits(pos)) else {
-            return Some(stmt);
-        };
-        let (name, geometry, material, loc, name_span) = match stmt {
+        match stmt {
             Statement {
                 kind:
                     StatementKind::Shape {
@@ -161,42 +177,75 @@ impl FlatShapes {
                         name: Some(name_span),
                     }),
             } if !matches!(geometry, Geometry::Mesh(_))
-                && self.file.as_ref().is_none_or(|f| Arc::ptr_eq(f, &loc.file))
-                && fits(name.len()).is_some()
-                && name_span.width as usize == name.chars().count()
                 && material.loc.line == loc.line
-                && (self.materials.len() as u64) < u64::from(DEFINED_BEFORE) =>
+                && self.fits(&loc.file, &name, name_span.width, pos) =>
             {
-                (name, geometry, material, loc, name_span)
+                self.push_fitting(FlatShapeLine {
+                    file: &loc.file,
+                    name: &name,
+                    geometry,
+                    material: &material.name,
+                    line: loc.line,
+                    col: loc.col,
+                    name_col: name_span.col,
+                    material_col: material.loc.col,
+                    pos,
+                });
+                None
             }
-            other => return Some(other),
-        };
-        let id = self.material_id(&material.name);
+            other => Some(other),
+        }
+    }
+
+    /// Whether a primitive shape of `file` named `name` (its token `name_width` characters
+    /// wide), read after `pos` other statements, fits the compact form.
+    pub fn fits(&self, file: &Arc<Path>, name: &str, name_width: u32, pos: usize) -> bool {
+        let fits = |v: usize| u32::try_from(v).is_ok_and(|v| v < DEFINED_BEFORE);
+        fits(self.names.len())
+            && fits(pos)
+            && self.file.as_ref().is_none_or(|f| Arc::ptr_eq(f, file))
+            && fits(name.len())
+            && name_width as usize == name.chars().count()
+            && (self.materials.len() as u64) < u64::from(DEFINED_BEFORE)
+    }
+
+    /// Takes a primitive shape written on one line, straight from the reader's tokens (no
+    /// statement made). Its places must fit the compact form ([`FlatShapes::fits`]).
+    pub fn push_fitting(&mut self, shape: FlatShapeLine<'_>) {
+        let id = self.material_id(shape.material);
         let before = if self.material_defined[id as usize] {
             DEFINED_BEFORE
         } else {
             0
         };
-        self.names.push_str(&name);
-        let shape = FlatShape {
-            geometry,
+        let name_start = self.names.len() as u32;
+        self.names.push_str(shape.name);
+        let record = FlatShape {
+            geometry: shape.geometry,
             name_start,
-            name_len: name.len() as u32,
+            name_len: shape.name.len() as u32,
             material: id | before,
-            line: loc.line,
-            col: loc.col,
-            name_col: name_span.col,
-            material_col: material.loc.col,
-            pos,
+            line: shape.line,
+            col: shape.col,
+            name_col: shape.name_col,
+            material_col: shape.material_col,
+            pos: shape.pos as u32,
         };
-        self.file.get_or_insert(loc.file);
+        if self.file.is_none() {
+            self.file = Some(shape.file.clone());
+        }
         match self.chunks.last_mut() {
-            Some(chunk) if chunk.len() < FLAT_CHUNK => chunk.push(shape),
-            // The last chunk grows as a vector does: a small file holds no empty chunk.
-            _ => self.chunks.push(vec![shape]),
+            Some(chunk) if chunk.len() < FLAT_CHUNK => chunk.push(record),
+            // The first chunk grows as a vector does (a small file holds no empty chunk); the
+            // next ones are made whole at once, never copied as they fill.
+            Some(_) => {
+                let mut chunk = Vec::with_capacity(FLAT_CHUNK);
+                chunk.push(record);
+                self.chunks.push(chunk);
+            }
+            None => self.chunks.push(vec![record]),
         }
         self.len += 1;
-        None
     }
 
     /// The shapes, in file order.
@@ -226,6 +275,16 @@ impl FlatShapes {
         self.names
             .get(start..start + s.name_len as usize)
             .unwrap_or("")
+    }
+
+    /// The file every shape was read from (`None` when there is no shape).
+    pub fn file(&self) -> Option<&Arc<Path>> {
+        self.file.as_ref()
+    }
+
+    /// Bytes of all the shapes' names together.
+    pub fn names_len(&self) -> usize {
+        self.names.len()
     }
 
     /// The material id of `s` (from 0, below [`FlatShapes::material_count`]).

@@ -83,15 +83,31 @@ fn scan_line<'t>(rest: &'t str, tokens: &mut Vec<Token<'t>>) -> (usize, usize) {
     tokens.clear();
     let bytes = rest.as_bytes();
     let class = |i: usize| bytes.get(i).map_or(END, |&b| BYTE_CLASS[usize::from(b)]);
+    // The end of the run of bytes of class `c` from `from` (at most the end of the text):
+    // a search over the slice, which compiles to a tighter loop than testing `class(i)`.
+    let run = |from: usize, c: u8| {
+        bytes
+            .get(from..)
+            .and_then(|tail| tail.iter().position(|&b| BYTE_CLASS[usize::from(b)] != c))
+            .map_or(bytes.len(), |n| from + n)
+    };
+    // The end of a word: eight bytes at a time where the text holds eight more, so that a
+    // word (rarely longer) costs one test whose outcome is predictable, not one per byte.
+    let word_end = |mut i: usize| {
+        while let Some(Ok(chunk)) = bytes.get(i..i + 8).map(<[u8; 8]>::try_from) {
+            let stop = non_word_bytes(u64::from_le_bytes(chunk));
+            if stop != 0 {
+                return i + (stop.trailing_zeros() / 8) as usize;
+            }
+            i += 8;
+        }
+        run(i, WORD)
+    };
     let mut i = 0;
     loop {
-        while class(i) == SPACE {
-            i += 1;
-        }
+        i = run(i, SPACE);
         let start = i;
-        while class(i) == WORD {
-            i += 1;
-        }
+        i = word_end(i);
         if i > start && tokens.len() < crate::limits::MAX_TOKENS_PER_LINE {
             // Past the cap the rest is not kept (see `overlong`, by which the line is
             // reported).
@@ -155,6 +171,21 @@ const BYTE_CLASS: [u8; 256] = {
     }
     class
 };
+
+const ONES: u64 = 0x0101_0101_0101_0101;
+const HIGH_BITS: u64 = 0x8080_8080_8080_8080;
+
+/// The high bit of each byte of `x` (eight bytes of text, the first in the lowest byte) whose
+/// [`BYTE_CLASS`] is not `WORD`: ASCII whitespace (tab to carriage return, space), `#`, and
+/// every byte beyond ASCII. Each test adds within a byte's low seven bits, which never carries
+/// into the next byte.
+fn non_word_bytes(x: u64) -> u64 {
+    let low = x & !HIGH_BITS;
+    let is = |c: u8| !((low ^ (ONES * u64::from(c))) + ONES * 0x7f) & HIGH_BITS;
+    let from_tab = (low + ONES * (0x80 - 0x09)) & HIGH_BITS;
+    let to_cr = !(low + ONES * (0x7f - 0x0d)) & HIGH_BITS;
+    (x & HIGH_BITS) | is(b' ') | is(b'#') | (from_tab & to_cr)
+}
 
 /// The length of the line ending at byte `end`: CRLF, LF, a lone CR, or none at the end.
 fn line_ending(bytes: &[u8], end: usize) -> usize {
@@ -377,29 +408,28 @@ fn short_decimal(s: &str) -> Option<f64> {
         b'+' => (false, &b[1..]),
         _ => (false, b),
     };
-    let mut mantissa: u64 = 0;
-    let mut count = 0;
-    let mut fraction: Option<usize> = None;
-    for &c in digits {
-        match c {
-            b'0'..=b'9' => {
-                if count == 15 {
-                    return None;
-                }
-                mantissa = mantissa * 10 + u64::from(c - b'0');
-                count += 1;
-                if let Some(f) = &mut fraction {
-                    *f += 1;
-                }
-            }
-            b'.' if fraction.is_none() => fraction = Some(0),
-            _ => return None,
-        }
-    }
-    if count == 0 {
+    // At most 15 digits and a point.
+    if digits.len() > 16 {
         return None;
     }
-    let v = mantissa as f64 / EXACT_POWERS_OF_TEN[fraction.unwrap_or(0)];
+    let mut mantissa: u64 = 0;
+    let mut point: Option<usize> = None;
+    for (k, &c) in digits.iter().enumerate() {
+        let d = c.wrapping_sub(b'0');
+        if d < 10 {
+            mantissa = mantissa * 10 + u64::from(d);
+        } else if c == b'.' && point.is_none() {
+            point = Some(k);
+        } else {
+            return None;
+        }
+    }
+    let count = digits.len() - usize::from(point.is_some());
+    if count == 0 || count > 15 {
+        return None;
+    }
+    let fraction = point.map_or(0, |p| digits.len() - 1 - p);
+    let v = mantissa as f64 / EXACT_POWERS_OF_TEN[fraction];
     if v > MAX_MAGNITUDE {
         return None;
     }
@@ -633,6 +663,69 @@ mod tests {
         assert_eq!(line_text(text, 4), Some("d # x"));
         assert_eq!(line_text(text, 9), None);
         assert_eq!(line_text(text, 0), None);
+    }
+
+    #[test]
+    fn eight_bytes_at_a_time_classify_as_the_table_does() {
+        for b in 0..=255u8 {
+            for at in 0..8 {
+                // The byte among others of every class, before and after it.
+                let mut chunk = [b'a'; 8];
+                chunk[at] = b;
+                chunk[(at + 3) % 8] = [b' ', 0xc3, b'#', b'\n', b'x'][usize::from(b) % 5];
+                let got = non_word_bytes(u64::from_le_bytes(chunk));
+                let want = chunk.iter().enumerate().fold(0u64, |m, (k, &c)| {
+                    m | (u64::from(BYTE_CLASS[usize::from(c)] != WORD) << (8 * k + 7))
+                });
+                assert_eq!(got, want, "{chunk:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn each_line_splits_random_text_as_lines_does() {
+        let pieces = [
+            "a",
+            "define",
+            "1.5",
+            " ",
+            "  ",
+            "\t",
+            "\x0b",
+            "\x0c",
+            "\n",
+            "\r",
+            "\r\n",
+            "#",
+            "//",
+            "jklö",
+            "\u{a0}",
+            "\u{1}",
+            "\x7f",
+            "é",
+            "sphere_name_long",
+        ];
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        for _ in 0..3000 {
+            let mut text = String::new();
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let mut r = state;
+            for _ in 0..(r % 40) {
+                r = r
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                text.push_str(pieces[(r >> 33) as usize % pieces.len()]);
+            }
+            let mut seen = Vec::new();
+            each_line(&text, |l| seen.push((l.number, l.text, l.tokens.clone())));
+            let expected: Vec<_> = lines(&text)
+                .into_iter()
+                .map(|l| (l.number, l.text, l.tokens))
+                .collect();
+            assert_eq!(seen, expected, "{text:?}");
+        }
     }
 
     #[test]

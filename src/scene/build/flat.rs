@@ -68,7 +68,9 @@ impl Builder<'_> {
 
         // Later definitions of a name replace earlier ones; materials used before their
         // definition are pointed out.
-        let mut superseded = vec![false; shapes.len()];
+        // By shape: `SUPERSEDED` once a later shape takes its name, `DRAWABLE` when its
+        // material resolves and it is not degenerate (found in the same walk over the shapes).
+        let mut state = vec![0u8; shapes.len()];
         let mut total = Expansion::default();
         let mut first_root: Option<usize> = None;
         {
@@ -82,6 +84,11 @@ impl Builder<'_> {
                 hashes.extend(chunk.iter().map(|s| NameTable::hash(shapes.name(s))));
                 for (s, &hash) in chunk.iter().zip(&hashes) {
                     let name = shapes.name(s);
+                    if resolved[shapes.material_of(s)].is_some()
+                        && degeneracy(&s.geometry).is_none()
+                    {
+                        state[k] = DRAWABLE;
+                    }
                     let earlier = latest.insert(hash, name, k, |j| {
                         shapes.get(j).map_or("", |e| shapes.name(e))
                     });
@@ -89,7 +96,7 @@ impl Builder<'_> {
                     if let Some((earlier, earlier_line)) =
                         earlier.and_then(|j| Some((j, shapes.get(j)?.line())))
                     {
-                        superseded[earlier] = true;
+                        state[earlier] |= SUPERSEDED;
                         let (loc, width) = shapes.name_place(s);
                         self.warn(
                             At::Place(&loc, width),
@@ -109,14 +116,13 @@ impl Builder<'_> {
                 }
             }
         }
-        for (k, s) in shapes.iter().enumerate() {
-            if superseded[k] {
-                continue;
-            }
-            first_root.get_or_insert(k);
-            total.nodes += 1;
-            if resolved[shapes.material_of(s)].is_some() && degeneracy(&s.geometry).is_none() {
-                total.shapes += 1;
+        // What is drawn: neither superseded, nor of a material that cannot be resolved, nor
+        // degenerate.
+        for (k, &st) in state.iter().enumerate() {
+            if st & SUPERSEDED == 0 {
+                first_root.get_or_insert(k);
+                total.nodes += 1;
+                total.shapes += u64::from(st == DRAWABLE);
             }
         }
         let snapshots = self.snapshots(statements, &d);
@@ -136,19 +142,22 @@ impl Builder<'_> {
         let mut instances = Vec::new();
         let mut names = Names::default();
         if let Some(count) = fits {
-            instances.reserve_exact(usize::try_from(count).unwrap_or(0));
+            let count = usize::try_from(count).unwrap_or(0);
+            instances.reserve_exact(count);
+            names.reserve(count, shapes.names_len());
+            let file = shapes.file().map(|f| names.file_id(f));
             let mut k = 0;
             for chunk in shapes.take_chunks() {
                 for s in chunk {
-                    let keep = !superseded[k];
                     k += 1;
-                    let Some(material) = resolved[shapes.material_of(&s)] else {
-                        continue;
-                    };
-                    if !keep || degeneracy(&s.geometry).is_some() {
+                    if state[k - 1] != DRAWABLE {
                         continue;
                     }
-                    let object = names.add_object(shapes.name(&s), &shapes.loc(&s));
+                    let (Some(material), Some(file)) = (resolved[shapes.material_of(&s)], file)
+                    else {
+                        continue;
+                    };
+                    let object = names.add_object_in(shapes.name(&s), file, s.line(), s.col());
                     instances.push(Instance {
                         geometry: placed_geometry(s.geometry),
                         material,
@@ -159,7 +168,7 @@ impl Builder<'_> {
                 }
             }
         }
-        drop(superseded);
+        drop(state);
         drop(shapes);
         let flat = Flat {
             instances: Arc::new(instances),
@@ -172,6 +181,11 @@ impl Builder<'_> {
         self.jobs_of(&d, &snapshots, &flat)
     }
 }
+
+/// A shape's state in `flat_jobs`: a later shape of the same name replaces it.
+const SUPERSEDED: u8 = 1;
+/// A shape's state in `flat_jobs`: its material resolves and it can be drawn.
+const DRAWABLE: u8 = 2;
 
 /// The shapes seen so far by name, to find a name defined again: an open-addressing table of
 /// 8 bytes a slot (a 32-bit hash tag and the shape's index), about a sixth of a `HashMap`

@@ -3,8 +3,8 @@
 use super::{At, Fail, PResult, Parser, SHAPE_KINDS};
 use crate::diag::suggest;
 use crate::limits;
-use crate::sdf::ast::StatementKind;
-use crate::sdf::lexer::{looks_numeric, Line};
+use crate::sdf::ast::{FlatShapeLine, StatementKind};
+use crate::sdf::lexer::{self, looks_numeric, Line};
 use crate::shape::geometry::degeneracy;
 use crate::shape::{Geometry, MeshFile};
 use glam::DVec3;
@@ -44,6 +44,9 @@ impl Parser<'_> {
                 }
             }
             k if SHAPE_KINDS.contains(&k) => {
+                if kind_at == 2 && self.flat_shape(line, k) {
+                    return;
+                }
                 if let Some(reordered) = name_after_material(line, kind_at) {
                     let last = line.tokens.len() - 1;
                     self.variant(
@@ -113,6 +116,56 @@ impl Parser<'_> {
         };
         self.emit_named(line, kind_at + 1, kind);
         Ok(())
+    }
+
+    /// The common line of a flat file, `define shape <kind> <name> <numbers> <material>`
+    /// written in canonical form with a shape that can be drawn, read straight into the
+    /// compact shapes: no statement, string or list is made for it. `false`, with nothing
+    /// done, for any other line (the general path reads it, and says what there is to say).
+    fn flat_shape(&mut self, line: &Line, kind: &str) -> bool {
+        let toks = &line.tokens;
+        let expected = Layout::of(kind).numbers;
+        if !self.flat || toks.len() != expected + 5 {
+            return false;
+        }
+        let (name, material) = (toks[3], toks[expected + 4]);
+        if looks_numeric(material.text) {
+            return false;
+        }
+        let mut nums = [0.0; 9];
+        for (slot, t) in nums.iter_mut().zip(&toks[4..expected + 4]) {
+            match lexer::parse_number(t.text) {
+                Ok(v) => *slot = v,
+                Err(_) => return false,
+            }
+        }
+        let geometry = geometry_from(kind, &nums[..expected]);
+        let warned = match geometry {
+            Geometry::Sphere { radius, .. }
+            | Geometry::Cylinder { radius, .. }
+            | Geometry::Cone { radius, .. } => radius < 0.0,
+            Geometry::Box { p1, p2 } => (p2 - p1).to_array().contains(&0.0),
+            _ => false,
+        };
+        let pos = self.statements.len();
+        if warned
+            || degeneracy(&geometry).is_some()
+            || !self.shapes.fits(&self.file, name.text, name.width, pos)
+        {
+            return false;
+        }
+        self.shapes.push_fitting(FlatShapeLine {
+            file: &self.file,
+            name: name.text,
+            geometry,
+            material: material.text,
+            line: line.number,
+            col: toks[0].col,
+            name_col: name.col,
+            material_col: material.col,
+            pos,
+        });
+        true
     }
 
     fn geometric_shape(&mut self, line: &Line, kind_at: usize) -> PResult<()> {
