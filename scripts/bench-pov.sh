@@ -6,6 +6,7 @@
 #
 #   scripts/bench-pov.sh                 # RUNS=3; tools from ../shared beside the repository
 #   RUNS=5 SHARED=/path/to/shared scripts/bench-pov.sh
+#   ANIM=/path/to/other/anim scripts/bench-pov.sh   # another build of anim (not rebuilt)
 #
 # Scenes: the assignment example at 1920×1080, 1 spp; 10k spheres in a deep grid at 1280×720,
 # 1 spp; 1k and 100k random spheres at 640×360, 1 spp; the mirror and glass room at 1280×720,
@@ -37,8 +38,12 @@ elif ! command -v povray >/dev/null; then
   pov=no
 fi
 
-cargo build --release --quiet --manifest-path "$root/Cargo.toml"
-anim=$root/target/release/anim
+if [ -n "${ANIM:-}" ]; then
+  anim=$ANIM
+else
+  cargo build --release --quiet --manifest-path "$root/Cargo.toml"
+  anim=$root/target/release/anim
+fi
 python3 "$root/scripts/gen-scenes.py" "$work/scenes"
 
 # name file width height spp pov(yes/no)

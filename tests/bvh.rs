@@ -203,11 +203,28 @@ fn mixed_instances(rng: &mut Rng, n: usize) -> (Vec<Instance>, Vec<Transform>) {
     (out, transforms)
 }
 
+/// Also on scenes of world-space spheres only (with a duplicate: a tie), which the render
+/// scene tests without looking at kinds; `occluder` names a primitive that is really hit.
 #[test]
 fn render_scene_equals_brute_force_on_mixed_scenes() {
     let mut rng = Rng(0x2545F4914F6CDD1D);
-    for n in [4, 40, 2000] {
-        let (instances, transforms) = mixed_instances(&mut rng, n);
+    for (n, spheres_only) in [
+        (4, false),
+        (40, false),
+        (2000, false),
+        (40, true),
+        (2000, true),
+    ] {
+        let (mut instances, transforms) = mixed_instances(&mut rng, n);
+        if spheres_only {
+            instances.retain(|i| {
+                matches!(i.geometry, Geometry::Sphere { .. })
+                    && transforms[i.transform as usize] == Transform::IDENTITY
+            });
+            for (k, i) in instances.iter_mut().enumerate() {
+                i.material = k;
+            }
+        }
         let prims: Vec<Primitive> = instances
             .iter()
             .map(|i| {
@@ -256,6 +273,11 @@ fn render_scene_equals_brute_force_on_mixed_scenes() {
                 brute.is_some(),
                 "n={n} ray {i}"
             );
+            let occluder = render.occluder(&ray, t_limit);
+            assert_eq!(occluder.is_some(), brute.is_some(), "n={n} ray {i}");
+            if let Some(id) = occluder {
+                assert!(render.hit(id, &ray, t_limit).is_some(), "n={n} ray {i}");
+            }
         }
         assert!(n < 2000 || hits > 1000, "{hits} hits");
     }
@@ -383,6 +405,13 @@ fn instanced_render_scene_equals_flattened_and_brute_force() {
             let blocked = brute.is_some();
             assert_eq!(a.occluded(&ray, t_limit), blocked, "seed {seed} ray {i}");
             assert_eq!(b.occluded(&ray, t_limit), blocked, "seed {seed} ray {i}");
+            for s in [&a, &b] {
+                let occluder = s.occluder(&ray, t_limit);
+                assert_eq!(occluder.is_some(), blocked, "seed {seed} ray {i}");
+                if let Some(id) = occluder {
+                    assert!(s.hit(id, &ray, t_limit).is_some(), "seed {seed} ray {i}");
+                }
+            }
             let any = a.any_candidate(&ray, t_limit, |id| a.hit(id, &ray, t_limit).is_some());
             assert_eq!(any, blocked, "seed {seed} ray {i}");
         }

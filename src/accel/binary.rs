@@ -46,6 +46,38 @@ struct BuildItem {
     index: u32,
 }
 
+/// A node's items as the builder knows them: the union of their boxes and of their
+/// centroids. A split hands each side its own, gathered while binning and partitioning, so
+/// no level reads its items only to measure them.
+#[derive(Clone, Copy)]
+struct Extent {
+    bounds: Aabb,
+    centroids: Aabb,
+}
+
+impl Extent {
+    fn of(items: &[BuildItem]) -> Extent {
+        items.iter().fold(
+            Extent {
+                bounds: Aabb::EMPTY,
+                centroids: Aabb::EMPTY,
+            },
+            |e, it| Extent {
+                bounds: e.bounds.union(it.bounds),
+                centroids: e.centroids.union_point(it.centroid),
+            },
+        )
+    }
+}
+
+/// A node's split: along `axis`, items `..mid` to the first child, with each side's extent.
+struct Split {
+    axis: usize,
+    mid: usize,
+    left: Extent,
+    right: Extent,
+}
+
 impl BinaryBvh {
     /// Builds over `bounds[i]` for the primitive indices in `items`; subtrees of at least
     /// `parallel_min` primitives build their halves with `rayon::join`.
@@ -68,7 +100,8 @@ impl BinaryBvh {
         if work.is_empty() {
             return BinaryBvh::default();
         }
-        build_subtree(&mut work, 0, parallel_min.max(2))
+        let extent = Extent::of(&work);
+        build_subtree(&mut work, extent, 0, parallel_min.max(2))
     }
 
     fn with_capacity(items: usize) -> BinaryBvh {
@@ -78,22 +111,21 @@ impl BinaryBvh {
         }
     }
 
-    fn build_node(&mut self, items: &mut [BuildItem], depth: usize) -> usize {
+    fn build_node(&mut self, items: &mut [BuildItem], extent: Extent, depth: usize) -> usize {
         let node_index = self.nodes.len();
-        let bounds = bounds_of(items);
         self.nodes.push(Node {
-            bounds,
+            bounds: extent.bounds,
             offset: 0,
             count: 0,
             axis: 0,
         });
-        match split_of(items, &bounds, depth) {
+        match split_of(items, &extent, depth) {
             None => self.make_leaf(node_index, items),
-            Some((axis, mid)) => {
-                self.nodes[node_index].axis = axis as u8;
-                let (left, right) = items.split_at_mut(mid);
-                self.build_node(left, depth + 1);
-                let second = self.build_node(right, depth + 1);
+            Some(split) => {
+                self.nodes[node_index].axis = split.axis as u8;
+                let (left, right) = items.split_at_mut(split.mid);
+                self.build_node(left, split.left, depth + 1);
+                let second = self.build_node(right, split.right, depth + 1);
                 self.nodes[node_index].offset = second as u32;
             }
         }
@@ -121,48 +153,48 @@ impl BinaryBvh {
     }
 }
 
-fn bounds_of(items: &[BuildItem]) -> Aabb {
-    items.iter().fold(Aabb::EMPTY, |b, it| b.union(it.bounds))
-}
-
 /// The split of a node at `depth`, or `None` for a leaf. Partitions `items` in place.
-fn split_of(items: &mut [BuildItem], bounds: &Aabb, depth: usize) -> Option<(usize, usize)> {
+fn split_of(items: &mut [BuildItem], extent: &Extent, depth: usize) -> Option<Split> {
     if items.len() <= MAX_LEAF || depth >= MAX_DEPTH {
         None
     } else {
-        find_split(items, bounds)
+        find_split(items, extent)
     }
 }
 
 /// The tree over `items`, exactly as `build_node` makes it; above `parallel_min` primitives
 /// the two halves are built concurrently and joined in a fixed order (left, then right), so
 /// the layout does not depend on which thread finished first.
-fn build_subtree(items: &mut [BuildItem], depth: usize, parallel_min: usize) -> BinaryBvh {
+fn build_subtree(
+    items: &mut [BuildItem],
+    extent: Extent,
+    depth: usize,
+    parallel_min: usize,
+) -> BinaryBvh {
     if items.len() < parallel_min {
         let mut bvh = BinaryBvh::with_capacity(items.len());
-        bvh.build_node(items, depth);
+        bvh.build_node(items, extent, depth);
         return bvh;
     }
-    let bounds = bounds_of(items);
-    let Some((axis, mid)) = split_of(items, &bounds, depth) else {
+    let Some(split) = split_of(items, &extent, depth) else {
         let mut bvh = BinaryBvh::with_capacity(items.len());
-        bvh.build_node(items, depth);
+        bvh.build_node(items, extent, depth);
         return bvh;
     };
-    let (left, right) = items.split_at_mut(mid);
+    let (left, right) = items.split_at_mut(split.mid);
     let (left, right) = rayon::join(
-        || build_subtree(left, depth + 1, parallel_min),
-        || build_subtree(right, depth + 1, parallel_min),
+        || build_subtree(left, split.left, depth + 1, parallel_min),
+        || build_subtree(right, split.right, depth + 1, parallel_min),
     );
     let mut bvh = BinaryBvh {
         nodes: Vec::with_capacity(1 + left.nodes.len() + right.nodes.len()),
         order: Vec::with_capacity(left.order.len() + right.order.len()),
     };
     bvh.nodes.push(Node {
-        bounds,
+        bounds: extent.bounds,
         offset: (1 + left.nodes.len()) as u32,
         count: 0,
-        axis: axis as u8,
+        axis: split.axis as u8,
     });
     bvh.append(left);
     bvh.append(right);
@@ -171,29 +203,38 @@ fn build_subtree(items: &mut [BuildItem], depth: usize, parallel_min: usize) -> 
 
 /// Binned surface-area heuristic: the best (axis, split position) over `BINS` centroid bins,
 /// or `None` when a leaf is cheaper (or unavoidable). Partitions `items` in place.
-fn find_split(items: &mut [BuildItem], bounds: &Aabb) -> Option<(usize, usize)> {
-    let centroid_bounds = items
-        .iter()
-        .fold(Aabb::EMPTY, |b, it| b.union_point(it.centroid));
-    let extent = centroid_bounds.extent();
+///
+/// One pass bins the items along all three axes at once (lane `a` of a bin index is the bin
+/// along axis `a`, the same float operations as binning each axis alone), and the partition
+/// pass gathers each side's centroid bounds; each side's bounds are the union of its bins'.
+fn find_split(items: &mut [BuildItem], extent: &Extent) -> Option<Split> {
+    let centroid_bounds = &extent.centroids;
+    let size = centroid_bounds.extent();
     let leaf_cost = items.len() as f32;
-    let parent_area = bounds.surface_area().max(f32::MIN_POSITIVE);
-    let mut best: Option<(f32, usize, usize)> = None;
-    for axis in 0..3 {
-        // Skips flat axes, and NaN or infinite extents alike.
-        if !(extent[axis].is_finite() && extent[axis] > 0.0) {
-            continue;
-        }
-        let scale = BINS as f32 / extent[axis];
-        let bin_of =
-            |c: Vec3A| (((c[axis] - centroid_bounds.min[axis]) * scale) as usize).min(BINS - 1);
-        let mut bin_bounds = [Aabb::EMPTY; BINS];
-        let mut bin_counts = [0usize; BINS];
+    let parent_area = extent.bounds.surface_area().max(f32::MIN_POSITIVE);
+    // Skips flat axes, and NaN or infinite extents alike.
+    let live = [0, 1, 2].map(|a| size[a].is_finite() && size[a] > 0.0);
+    let scale =
+        Vec3A::from_array([0, 1, 2].map(|a| if live[a] { BINS as f32 / size[a] } else { 0.0 }));
+    let bin_of = |c: Vec3A| {
+        let b = ((c - centroid_bounds.min) * scale).to_array();
+        b.map(|x| (x as usize).min(BINS - 1))
+    };
+    let mut bin_bounds = [[Aabb::EMPTY; BINS]; 3];
+    let mut bin_counts = [[0usize; BINS]; 3];
+    if live.contains(&true) {
         for it in items.iter() {
             let b = bin_of(it.centroid);
-            bin_bounds[b] = bin_bounds[b].union(it.bounds);
-            bin_counts[b] += 1;
+            for axis in 0..3 {
+                let bin = &mut bin_bounds[axis][b[axis]];
+                *bin = bin.union(it.bounds);
+                bin_counts[axis][b[axis]] += 1;
+            }
         }
+    }
+    let mut best: Option<(f32, usize, usize)> = None;
+    for axis in (0..3).filter(|&a| live[a]) {
+        let (bin_bounds, bin_counts) = (&bin_bounds[axis], &bin_counts[axis]);
         // Sweep from the right to get the area and count of everything right of each split.
         let mut right_area = [0.0f32; BINS];
         let mut right_count = [0usize; BINS];
@@ -225,24 +266,45 @@ fn find_split(items: &mut [BuildItem], bounds: &Aabb) -> Option<(usize, usize)> 
         // All centroids coincide: split in halves if the leaf would be too big to store.
         None if items.len() > u16::MAX as usize => {
             let mid = items.len() / 2;
-            return Some((0, mid));
+            let (left, right) = items.split_at(mid);
+            return Some(Split {
+                axis: 0,
+                mid,
+                left: Extent::of(left),
+                right: Extent::of(right),
+            });
         }
         None => return None,
     };
     if cost >= leaf_cost && items.len() <= u16::MAX as usize {
         return None;
     }
-    let scale = BINS as f32 / extent[axis];
-    let min = centroid_bounds.min[axis];
-    let mut left = 0;
+    let side = |bins: &[Aabb]| bins.iter().fold(Aabb::EMPTY, |b, &o| b.union(o));
+    let mut left = Extent {
+        bounds: side(&bin_bounds[axis][..split]),
+        centroids: Aabb::EMPTY,
+    };
+    let mut right = Extent {
+        bounds: side(&bin_bounds[axis][split..]),
+        centroids: Aabb::EMPTY,
+    };
+    let mut mid = 0;
     for i in 0..items.len() {
-        let b = (((items[i].centroid[axis] - min) * scale) as usize).min(BINS - 1);
-        if b < split {
-            items.swap(i, left);
-            left += 1;
+        let c = items[i].centroid;
+        if bin_of(c)[axis] < split {
+            left.centroids = left.centroids.union_point(c);
+            items.swap(i, mid);
+            mid += 1;
+        } else {
+            right.centroids = right.centroids.union_point(c);
         }
     }
-    Some((axis, left))
+    Some(Split {
+        axis,
+        mid,
+        left,
+        right,
+    })
 }
 
 #[cfg(test)]
@@ -321,5 +383,58 @@ impl BinaryBvh {
             }
         }
         false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every node's box is exactly the union of its primitives' boxes (no level measures its
+    /// items: a split hands each side the union of its bins), and every primitive is in one
+    /// leaf.
+    #[test]
+    fn node_bounds_are_the_union_of_their_primitives() {
+        let mut state = 0x9E3779B97F4A7C15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let boxes: Vec<Aabb> = (0..3000)
+            .map(|i| {
+                let p = Vec3A::new(next(), next(), next()) * 50.0;
+                // Some flat, some on a plane shared by many (one axis without extent).
+                let mut e = Vec3A::new(next(), next(), next()) * 2.0;
+                e[i % 3] *= f32::from(u8::from(i % 5 != 0));
+                let p = if i % 7 == 0 {
+                    p * Vec3A::new(1.0, 0.0, 1.0)
+                } else {
+                    p
+                };
+                Aabb::new(p, p + e)
+            })
+            .collect();
+        for parallel_min in [usize::MAX, 64] {
+            let bvh = BinaryBvh::build(&boxes, 0..boxes.len() as u32, parallel_min);
+            fn check(bvh: &BinaryBvh, boxes: &[Aabb], n: usize) -> Aabb {
+                let node = &bvh.nodes[n];
+                let union = if node.is_leaf() {
+                    let start = node.offset as usize;
+                    bvh.order[start..start + node.count as usize]
+                        .iter()
+                        .fold(Aabb::EMPTY, |b, &i| b.union(boxes[i as usize]))
+                } else {
+                    check(bvh, boxes, n + 1).union(check(bvh, boxes, node.offset as usize))
+                };
+                assert_eq!(node.bounds, union, "node {n}");
+                union
+            }
+            check(&bvh, &boxes, 0);
+            let mut seen = bvh.order.clone();
+            seen.sort_unstable();
+            assert_eq!(seen, (0..boxes.len() as u32).collect::<Vec<_>>());
+        }
     }
 }

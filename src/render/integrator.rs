@@ -219,8 +219,15 @@ impl Integrator<'_> {
         // Most shadow rays meet nothing at all; the plain any-hit query (packed spheres four
         // at a time) says so for them. Only a ray that meets something needs the walk below,
         // which tells glass from opaque and names the blocker for the next ray.
-        if !scene.occluded(&ray, remaining) {
+        let Some(first) = scene.occluder(&ray, remaining) else {
             return 1.0;
+        };
+        // Without glass, what it met is opaque: no light, and the blocker to try next time.
+        if !scene.any_transparent {
+            if let Some(b) = blocker {
+                *b = first;
+            }
+            return 0.0;
         }
         let mut transmit = 1.0f32;
         let blocked = scene.any_candidate(&ray, remaining, |i| {
@@ -251,8 +258,7 @@ impl Integrator<'_> {
             }
             false
         });
-        // Without glass, what `occluded` met was opaque, whether or not the walk named it.
-        if blocked || !scene.any_transparent {
+        if blocked {
             0.0
         } else {
             transmit

@@ -350,19 +350,22 @@ impl Instances {
         stopped
     }
 
-    /// Whether some instanced shape through top-level use `k` lies on the ray before `t_max`.
-    pub fn occluded(&self, k: u32, ray: &Ray, t_max: f32) -> bool {
+    /// An instanced shape through top-level use `k` that lies on the ray before `t_max`
+    /// (its id), if there is one.
+    pub fn occluder(&self, k: u32, ray: &Ray, t_max: f32) -> Option<u32> {
         let u = &self.scene.instanced.uses[k as usize];
-        let mut hit = false;
+        let mut hit = None;
         self.visit(
             u,
             &self.frames[k as usize],
             u.offset,
             ray,
             &|| t_max,
-            &mut |_, prim| {
-                hit = prim.hit(ray, t_max).is_some();
-                !hit
+            &mut |id, prim| {
+                if prim.hit(ray, t_max).is_some() {
+                    hit = Some(id);
+                }
+                hit.is_none()
             },
         );
         hit
