@@ -6,7 +6,7 @@
 #   scripts/adaptive-measure.sh [extra anim flags for the adaptive run, e.g. --error 0.4]
 #
 # Environment: ANIM (binary, default target/release/anim), TOOLS (the POV-Ray converters,
-# default /work/shared/tools), OUT (work directory, default /tmp/adaptive-measure),
+# default ../shared/tools beside the checkout), OUT (work directory, default /tmp/adaptive-measure),
 # REUSE_REF=1 to keep reference renders from an earlier run, SIZE (default "640 360"),
 # QUICK=1 for the adaptive run alone, SCENES (default: the mirror-glass bench, its moved
 # variant and the showcase), TURNS (default 3: every run, the default, the LADDER runs and
@@ -17,7 +17,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ANIM=${ANIM:-target/release/anim}
-TOOLS=${TOOLS:-/work/shared/tools}
+TOOLS=${TOOLS:-$(pwd)/../shared/tools}
 OUT=${OUT:-/tmp/adaptive-measure}
 TURNS=${TURNS:-3}
 read -r W H <<<"${SIZE:-640 360}"
