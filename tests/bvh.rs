@@ -204,7 +204,8 @@ fn mixed_instances(rng: &mut Rng, n: usize) -> (Vec<Instance>, Vec<Transform>) {
 }
 
 /// Also on scenes of world-space spheres only (with a duplicate: a tie), which the render
-/// scene tests without looking at kinds; `occluder` names a primitive that is really hit.
+/// scene tests without looking at kinds, and of world-space boxes only (with a duplicate, and
+/// rooms around every ray origin); `occluder` names a primitive that is really hit.
 #[test]
 fn render_scene_equals_brute_force_on_mixed_scenes() {
     let mut rng = Rng(0x2545F4914F6CDD1D);
@@ -215,72 +216,128 @@ fn render_scene_equals_brute_force_on_mixed_scenes() {
         (40, true),
         (2000, true),
     ] {
-        let (mut instances, transforms) = mixed_instances(&mut rng, n);
-        if spheres_only {
-            instances.retain(|i| {
-                matches!(i.geometry, Geometry::Sphere { .. })
-                    && transforms[i.transform as usize] == Transform::IDENTITY
-            });
-            for (k, i) in instances.iter_mut().enumerate() {
-                i.material = k;
-            }
-        }
-        let prims: Vec<Primitive> = instances
-            .iter()
-            .map(|i| {
-                let xf = &transforms[i.transform as usize];
-                Primitive::new(&i.geometry, xf, i.material as u32).unwrap()
-            })
-            .collect();
-        let scene = Scene {
-            materials: (0..instances.len())
-                .map(|i| Material::phong(&format!("m{i}"), Vec3::ONE, Vec3::ONE, Vec3::ONE, 1.0))
-                .collect(),
-            instances: instances.into(),
+        let (instances, transforms) = mixed_instances(&mut rng, n);
+        check_render_scene(
+            &mut rng,
+            n,
+            instances_only(instances, &transforms, spheres_only),
             transforms,
-            ..Scene::default()
-        };
-        let (render, dropped) = RenderScene::compile(&scene);
-        assert!(dropped.is_empty());
-        assert_eq!(render.len(), prims.len());
-        let mut hits = 0;
-        for i in 0..4000 {
-            let ray = random_ray(&mut rng, i);
-            let t_limit = t_limit_of(i);
-            let brute = brute_closest(&prims, &ray, t_limit);
-            let found = render.closest(&ray, t_limit);
-            assert_eq!(
-                brute.map(|(_, t)| t.to_bits()),
-                found.map(|(_, h)| h.t.to_bits()),
-                "n={n} ray {i}"
-            );
-            if let (Some((a, t)), Some((slot, h))) = (brute, found) {
-                let b = render.material_of(slot) as usize;
-                // The same primitive, unless two are hit at exactly the same distance.
-                assert!(a == b || prims[b].hit(&ray, t_limit).map(|h| h.t) == Some(t));
-                let expected = prims[b].intersect(&ray, t_limit).unwrap();
-                assert_eq!(
-                    (expected.point.to_array(), expected.normal.to_array()),
-                    (h.point.to_array(), h.normal.to_array()),
-                    "n={n} ray {i}: surface of primitive {b}"
-                );
-                let again = render.intersect(slot, &ray, t_limit).unwrap();
-                assert_eq!(again.t.to_bits(), h.t.to_bits());
-                hits += 1;
-            }
-            assert_eq!(
-                render.occluded(&ray, t_limit),
-                brute.is_some(),
-                "n={n} ray {i}"
-            );
-            let occluder = render.occluder(&ray, t_limit);
-            assert_eq!(occluder.is_some(), brute.is_some(), "n={n} ray {i}");
-            if let Some(id) = occluder {
-                assert!(render.hit(id, &ray, t_limit).is_some(), "n={n} ray {i}");
-            }
-        }
-        assert!(n < 2000 || hits > 1000, "{hits} hits");
+        );
     }
+    for n in [3, 40, 600] {
+        let (instances, transforms) = world_boxes(&mut rng, n);
+        check_render_scene(&mut rng, n, instances, transforms);
+    }
+}
+
+/// World-space axis-aligned boxes (tested by distance alone, the surface built for the
+/// winner): small ones, an exact duplicate (a tie), and rooms enclosing every ray origin,
+/// so that rays start inside boxes and leave through them.
+fn world_boxes(rng: &mut Rng, n: usize) -> (Vec<Instance>, Vec<Transform>) {
+    let mut geometry: Vec<Geometry> = (0..n)
+        .map(|_| {
+            let c = rng.vec(50.0);
+            Geometry::Box {
+                p1: c,
+                p2: c + rng.vec(6.0),
+            }
+        })
+        .collect();
+    geometry.push(geometry[1].clone());
+    for half in [300.0, 400.0] {
+        geometry.push(Geometry::Box {
+            p1: DVec3::splat(-half),
+            p2: DVec3::new(half, half, half * 0.9),
+        });
+    }
+    let instances = geometry
+        .into_iter()
+        .enumerate()
+        .map(|(k, g)| Instance::new(g, k))
+        .collect();
+    (instances, vec![Transform::IDENTITY])
+}
+
+/// With `spheres_only`, the world-space spheres alone, renumbered.
+fn instances_only(
+    mut instances: Vec<Instance>,
+    transforms: &[Transform],
+    spheres_only: bool,
+) -> Vec<Instance> {
+    if spheres_only {
+        instances.retain(|i| {
+            matches!(i.geometry, Geometry::Sphere { .. })
+                && transforms[i.transform as usize] == Transform::IDENTITY
+        });
+        for (k, i) in instances.iter_mut().enumerate() {
+            i.material = k;
+        }
+    }
+    instances
+}
+
+/// `closest`, `intersect`, `occluded` and `occluder` of the render scene against brute force.
+fn check_render_scene(
+    rng: &mut Rng,
+    n: usize,
+    instances: Vec<Instance>,
+    transforms: Vec<Transform>,
+) {
+    let prims: Vec<Primitive> = instances
+        .iter()
+        .map(|i| {
+            let xf = &transforms[i.transform as usize];
+            Primitive::new(&i.geometry, xf, i.material as u32).unwrap()
+        })
+        .collect();
+    let scene = Scene {
+        materials: (0..instances.len())
+            .map(|i| Material::phong(&format!("m{i}"), Vec3::ONE, Vec3::ONE, Vec3::ONE, 1.0))
+            .collect(),
+        instances: instances.into(),
+        transforms,
+        ..Scene::default()
+    };
+    let (render, dropped) = RenderScene::compile(&scene);
+    assert!(dropped.is_empty());
+    assert_eq!(render.len(), prims.len());
+    let mut hits = 0;
+    for i in 0..4000 {
+        let ray = random_ray(rng, i);
+        let t_limit = t_limit_of(i);
+        let brute = brute_closest(&prims, &ray, t_limit);
+        let found = render.closest(&ray, t_limit);
+        assert_eq!(
+            brute.map(|(_, t)| t.to_bits()),
+            found.map(|(_, h)| h.t.to_bits()),
+            "n={n} ray {i}"
+        );
+        if let (Some((a, t)), Some((slot, h))) = (brute, found) {
+            let b = render.material_of(slot) as usize;
+            // The same primitive, unless two are hit at exactly the same distance.
+            assert!(a == b || prims[b].hit(&ray, t_limit).map(|h| h.t) == Some(t));
+            let expected = prims[b].intersect(&ray, t_limit).unwrap();
+            assert_eq!(
+                (expected.point.to_array(), expected.normal.to_array()),
+                (h.point.to_array(), h.normal.to_array()),
+                "n={n} ray {i}: surface of primitive {b}"
+            );
+            let again = render.intersect(slot, &ray, t_limit).unwrap();
+            assert_eq!(again.t.to_bits(), h.t.to_bits());
+            hits += 1;
+        }
+        assert_eq!(
+            render.occluded(&ray, t_limit),
+            brute.is_some(),
+            "n={n} ray {i}"
+        );
+        let occluder = render.occluder(&ray, t_limit);
+        assert_eq!(occluder.is_some(), brute.is_some(), "n={n} ray {i}");
+        if let Some(id) = occluder {
+            assert!(render.hit(id, &ray, t_limit).is_some(), "n={n} ray {i}");
+        }
+    }
+    assert!(n < 2000 || hits > 1000, "{hits} hits");
 }
 
 #[path = "common/composites.rs"]
