@@ -136,18 +136,7 @@ impl Parser<'_> {
         {
             return;
         }
-        let defined: HashSet<&str> = self
-            .statements
-            .iter()
-            .filter_map(|s| match &s.kind {
-                StatementKind::Shape { name, .. } | StatementKind::Composite { name, .. } => {
-                    Some(name.as_str())
-                }
-                StatementKind::Light(l) => Some(l.name.as_str()),
-                StatementKind::Camera(c) => Some(c.name.as_str()),
-                _ => None,
-            })
-            .collect();
+        let defined = self.defined_names();
         let mut last: HashMap<&str, f64> = HashMap::new();
         // Motion of a thing whose definition was rejected (and reported) goes quietly.
         let mut drop = HashSet::new();

@@ -41,6 +41,21 @@ impl Parser<'_> {
         });
     }
 
+    /// Names of the shapes, composites, lights and cameras the statements define.
+    pub(super) fn defined_names(&self) -> HashSet<&str> {
+        self.statements
+            .iter()
+            .filter_map(|s| match &s.kind {
+                StatementKind::Shape { name, .. } | StatementKind::Composite { name, .. } => {
+                    Some(name.as_str())
+                }
+                StatementKind::Light(l) => Some(l.name.as_str()),
+                StatementKind::Camera(c) => Some(c.name.as_str()),
+                _ => None,
+            })
+            .collect()
+    }
+
     /// Drops (with one warning per name) the transforms of names that are defined only in a
     /// commented-out line: a definition disabled while its transforms were left in, which
     /// leaves them nothing to move (as for a composite's commented-out child).
@@ -52,18 +67,7 @@ impl Parser<'_> {
         if commented.is_empty() {
             return;
         }
-        let defined: HashSet<&str> = self
-            .statements
-            .iter()
-            .filter_map(|s| match &s.kind {
-                StatementKind::Shape { name, .. } | StatementKind::Composite { name, .. } => {
-                    Some(name.as_str())
-                }
-                StatementKind::Light(l) => Some(l.name.as_str()),
-                StatementKind::Camera(c) => Some(c.name.as_str()),
-                _ => None,
-            })
-            .collect();
+        let defined = self.defined_names();
         let mut dropped: Vec<(usize, &NameRef, u32)> = Vec::new();
         for (i, s) in self.statements.iter().enumerate() {
             if let StatementKind::Transform { target, .. } = &s.kind {
