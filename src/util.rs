@@ -3,7 +3,7 @@
 
 use std::fs;
 use std::io::{self, BufWriter};
-use std::path::Path;
+use std::path::{Component, Path, PathBuf};
 
 /// Suffix of the temporary files of [`write_atomically`]: `.NAME.PID.tmp`.
 const TEMP_SUFFIX: &str = ".tmp";
@@ -194,9 +194,87 @@ pub fn human_bytes(bytes: u64) -> String {
     }
 }
 
+/// A path to `target` that reads the same from the directory `from` as `target` reads from
+/// the current one: relative when both lie under one root, else absolute. Existing parts are
+/// resolved (symbolic links followed), because `..` climbs out of where a link leads, not out
+/// of the link; the parts of `from` that do not exist yet are taken as written.
+pub fn path_from(from: &Path, target: &Path) -> io::Result<PathBuf> {
+    let target = fs::canonicalize(target)?;
+    let from = resolve_existing_prefix(from)?;
+    let (t, f): (Vec<Component>, Vec<Component>) =
+        (target.components().collect(), from.components().collect());
+    if t.first() != f.first() {
+        return Ok(target);
+    }
+    let common = t.iter().zip(&f).take_while(|(a, b)| a == b).count();
+    let mut out = PathBuf::new();
+    for _ in common..f.len() {
+        out.push("..");
+    }
+    out.extend(&t[common..]);
+    Ok(out)
+}
+
+/// `dir` made absolute, part by part: each part that exists is canonicalised (links followed)
+/// before the next is added, and the parts that do not exist yet are taken as written
+/// (`.` dropped, `..` taking off the part before, which cannot be a link since it does not
+/// exist).
+fn resolve_existing_prefix(dir: &Path) -> io::Result<PathBuf> {
+    let mut resolved = PathBuf::new();
+    for part in std::path::absolute(dir)?.components() {
+        match part {
+            Component::CurDir => {}
+            // `resolved` is canonical wherever it exists, so its parent is the real one.
+            Component::ParentDir => {
+                resolved.pop();
+            }
+            _ => {
+                resolved.push(part);
+                if let Ok(real) = fs::canonicalize(&resolved) {
+                    resolved = real;
+                }
+            }
+        }
+    }
+    Ok(resolved)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_path_from_another_directory_reads_the_same_file() {
+        let root = tempfile::tempdir().unwrap();
+        let root = fs::canonicalize(root.path()).unwrap();
+        let scenes = root.join("scenes/meshes");
+        fs::create_dir_all(&scenes).unwrap();
+        let mesh = scenes.join("tri.obj");
+        fs::write(&mesh, "v 0 0 0\n").unwrap();
+        // A frame directory that does not exist yet, named through `.` and `..`.
+        let frames = root.join("anim/./frames/../frames/orbit");
+        let rel = path_from(&frames, &mesh).unwrap();
+        assert_eq!(rel, Path::new("../../../scenes/meshes/tri.obj"));
+        fs::create_dir_all(&frames).unwrap();
+        assert_eq!(fs::read(frames.join(&rel)).unwrap(), b"v 0 0 0\n");
+        // From the mesh's own directory: the file name alone.
+        assert_eq!(path_from(&scenes, &mesh).unwrap(), Path::new("tri.obj"));
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_path_from_inside_a_linked_directory_climbs_out_of_its_target() {
+        let root = tempfile::tempdir().unwrap();
+        let root = fs::canonicalize(root.path()).unwrap();
+        fs::create_dir_all(root.join("real/deep")).unwrap();
+        fs::create_dir_all(root.join("scenes")).unwrap();
+        fs::write(root.join("scenes/m.obj"), "").unwrap();
+        std::os::unix::fs::symlink(root.join("real/deep"), root.join("link")).unwrap();
+        let frames = root.join("link/out");
+        let rel = path_from(&frames, &root.join("scenes/m.obj")).unwrap();
+        fs::create_dir_all(&frames).unwrap();
+        assert!(frames.join(&rel).is_file(), "{rel:?} from {frames:?}");
+    }
 
     #[test]
     fn bytes_read_in_mib_or_gib() {

@@ -63,7 +63,7 @@ pub fn run_generate(config: &GenerateConfig) -> Result<GenerateReport, Vec<Diagn
         .unwrap_or_default();
 
     let (statements, warnings) = load_base(&spec_file.scene, &spec_dir, &src)?;
-    let base = BaseScene::new(statements);
+    let mut base = BaseScene::new(statements);
     let anim = spec::validate(&spec_file, &base, &src)?;
 
     let dir = match (&config.out, &spec_file.frames_dir) {
@@ -77,19 +77,67 @@ pub fn run_generate(config: &GenerateConfig) -> Result<GenerateReport, Vec<Diagn
             spec_dir.join("frames").join(stem)
         }
     };
-    // Every frame is made and checked before any is written, so an invalid spec writes
-    // nothing; then they are made again one at a time as they are written, so memory holds
-    // one frame, however long the animation.
-    let generator = Generator::new(&base, &anim, &src);
-    for i in 0..anim.frames {
-        checked_frame_text(&generator, &anim, &src, &dir, i)?;
+    let base_dir = match &spec_file.scene {
+        SceneSource::File(rel) => spec_dir.join(rel).parent().map(Path::to_path_buf),
+        SceneSource::Inline(_) => None,
     }
-    std::fs::create_dir_all(&dir).map_err(|e| {
+    .unwrap_or_else(|| spec_dir.clone());
+    // The frame directory exists while the frames are checked, because the paths of their
+    // mesh files climb out of it; a run that fails removes the directories it made, so an
+    // invalid spec leaves nothing behind.
+    let created = create_dirs(&dir).map_err(|e| {
         vec![Diagnostic::file_error(
             &dir,
             format!("cannot create the frame directory: {e}"),
         )]
     })?;
+    let result = rebase_mesh_files(&mut base.statements, &base_dir, &dir, &src)
+        .and_then(|()| write_frames(&base, &anim, &src, &dir));
+    match result {
+        Ok((written, removed)) => Ok(GenerateReport {
+            dir,
+            frames: anim.frames,
+            written,
+            removed,
+            fps: anim.fps,
+            warnings,
+        }),
+        Err(e) => {
+            // Deepest first; a directory that holds anything is not removed.
+            for d in &created {
+                let _ = std::fs::remove_dir(d);
+            }
+            Err(e)
+        }
+    }
+}
+
+/// Creates `dir` and its missing parents; returns the ones it created, deepest first.
+fn create_dirs(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let missing: Vec<PathBuf> = dir
+        .ancestors()
+        .take_while(|d| !d.as_os_str().is_empty() && !d.exists())
+        .map(Path::to_path_buf)
+        .collect();
+    std::fs::create_dir_all(dir)?;
+    Ok(missing)
+}
+
+/// Checks every frame, then writes those that changed, trims frames an earlier run wrote that
+/// the animation no longer has, and records the list. Returns (written, removed).
+fn write_frames(
+    base: &BaseScene,
+    anim: &Animation,
+    src: &Source,
+    dir: &Path,
+) -> Result<(usize, usize), Vec<Diagnostic>> {
+    // Every frame is made and checked before any is written, so an invalid spec writes
+    // nothing; then they are made again one at a time as they are written, so memory holds
+    // one frame, however long the animation.
+    let generator = Generator::new(base, anim, src);
+    for i in 0..anim.frames {
+        checked_frame_text(&generator, anim, src, dir, i)?;
+    }
     let fail = |path: &Path, what: &str, e: std::io::Error| {
         vec![Diagnostic::file_error(path, format!("{what}: {e}"))]
     };
@@ -104,7 +152,7 @@ pub fn run_generate(config: &GenerateConfig) -> Result<GenerateReport, Vec<Diagn
     let mut written = 0;
     let mut manifest = String::new();
     for i in 0..anim.frames {
-        let text = checked_frame_text(&generator, &anim, &src, &dir, i)?;
+        let text = checked_frame_text(&generator, anim, src, dir, i)?;
         let name = anim.output.sdf(i, anim.digits());
         let path = dir.join(&name);
         manifest.push_str(&name);
@@ -130,14 +178,7 @@ pub fn run_generate(config: &GenerateConfig) -> Result<GenerateReport, Vec<Diagn
     }
     write_atomically(&manifest_path, |w| w.write_all(manifest.as_bytes()))
         .map_err(|e| fail(&manifest_path, "cannot record the generated frames", e))?;
-    Ok(GenerateReport {
-        dir,
-        frames: anim.frames,
-        written,
-        removed,
-        fps: anim.fps,
-        warnings,
-    })
+    Ok((written, removed))
 }
 
 /// Parses the base scene. Errors stop generation; warnings are passed on.
@@ -189,6 +230,48 @@ fn load_base(
         return Err(diags);
     }
     Ok((statements, diags))
+}
+
+/// Points the base scene's OBJ files (`define shape obj`, relative to the base scene) at the
+/// same files from the frame directory, where the frames are read. Each mesh was loaded with
+/// the base scene, so it exists; a path that cannot be expressed is an error at the spec.
+fn rebase_mesh_files(
+    statements: &mut [crate::sdf::ast::Statement],
+    base_dir: &Path,
+    frame_dir: &Path,
+    src: &Source,
+) -> Result<(), Vec<Diagnostic>> {
+    use crate::scene::Geometry;
+    use crate::sdf::ast::StatementKind;
+    for s in statements {
+        let StatementKind::Shape {
+            geometry: Geometry::Mesh(m),
+            ..
+        } = &mut s.kind
+        else {
+            continue;
+        };
+        let rebased = crate::util::path_from(frame_dir, &base_dir.join(&m.file));
+        match rebased.as_ref().map(|p| p.to_str()) {
+            // A file name the SDF reader would split into two words cannot be written.
+            Ok(Some(p)) if !p.contains(char::is_whitespace) => m.file = p.to_string(),
+            _ => {
+                let why = match rebased {
+                    Err(e) => e.to_string(),
+                    Ok(p) => format!("its path from there, `{}`, is not one word", p.display()),
+                };
+                return Err(vec![src.error(
+                    &["scene[0]", "scene"],
+                    format!(
+                        "the mesh file `{}` cannot be named from the frame directory `{}`: {why}",
+                        m.file,
+                        frame_dir.display()
+                    ),
+                )]);
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Moves a diagnostic about an inline scene from the scene text's own line:col to where that
