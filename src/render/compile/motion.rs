@@ -1,0 +1,217 @@
+//! The moving part of a render scene (docs/scene-language.md §10): shapes whose transform
+//! slot moves during the exposure, each a top-level entry of the hierarchy bounded over the
+//! whole exposure and placed at the time of the ray that tests it; and moving lights.
+//!
+//! Static geometry pays nothing: its primitives and their tests are those of a frame without
+//! motion. A moving shape is placed by `Motion::slot_matrix` at the ray's time, a function of
+//! that time alone, so every ray of one camera sample (primary, shadow, reflected) meets the
+//! same floats, and the spawn bounds of `Primitive::surface` hold between them as for a
+//! static shape.
+
+use crate::math::{Aabb, Transform};
+use crate::render::primitive::Primitive;
+use crate::scene::motion::Motion;
+use crate::scene::{Instance, Scene};
+use glam::{DVec3, Vec3A};
+use std::cell::{Cell, RefCell};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+
+/// Instants, evenly spread over the exposure, at which a moving shape's bounds are taken
+/// (besides its keys' instants): between two of them its corners move along paths so little
+/// curved that twice the longest chord bounds how far they stray (see [`swept_bounds`]).
+const BOUND_STEPS: usize = 64;
+
+thread_local! {
+    /// Whether a query of this thread has met a moving entry since it was last cleared:
+    /// adaptive sampling's first pass asks it per pixel ([`take_touched`]).
+    static TOUCHED: Cell<bool> = const { Cell::new(false) };
+    /// The moving entries this thread placed at the time of its latest ray: every ray of a
+    /// camera sample (primary, shadow, reflected) has that sample's time, so each entry is
+    /// placed once per sample, not once per test. Only saves work: an entry placed again at
+    /// the same time is the same floats.
+    static PLACED: RefCell<Placed> = RefCell::new(Placed::default());
+}
+
+/// Numbers the moving parts made, so that a thread's cache knows whose entries it holds.
+static NEXT_ID: AtomicU64 = AtomicU64::new(1);
+
+#[derive(Default)]
+struct Placed {
+    /// The moving part and the time (bits) the entries were placed for.
+    owner: u64,
+    time: u32,
+    /// Bumped when the owner or time changes: an entry is valid for its own generation only.
+    generation: u64,
+    entries: Vec<(u64, Option<Primitive>)>,
+}
+
+/// Whether this thread's queries met a moving shape's swept bounds since the last call.
+pub fn take_touched() -> bool {
+    TOUCHED.with(|t| t.replace(false))
+}
+
+/// The moving shapes and lights of a scene.
+#[derive(Clone, Debug)]
+pub struct Moving {
+    id: u64,
+    motion: Arc<Motion>,
+    instances: Arc<Vec<Instance>>,
+    /// Per moving entry: its instance.
+    entries: Vec<u32>,
+    /// Scene light positions (moved with the scene), for moving lights.
+    lights: Vec<DVec3>,
+}
+
+impl Moving {
+    /// The moving part of `scene`, if anything in it moves (geometry or lights).
+    pub fn new(scene: &Scene) -> Option<Moving> {
+        let motion = scene.motion.as_ref()?;
+        if !(motion.moves_geometry() || motion.moves_lights()) {
+            return None;
+        }
+        Some(Moving {
+            id: NEXT_ID.fetch_add(1, Ordering::Relaxed),
+            motion: motion.clone(),
+            instances: scene.instances.clone(),
+            entries: Vec::new(),
+            lights: scene.lights.iter().map(|l| l.position).collect(),
+        })
+    }
+
+    /// Whether `inst` moves (it is then added with [`Moving::add`], not as a primitive).
+    #[inline]
+    pub fn moves(&self, inst: &Instance) -> bool {
+        self.motion.moves_slot(inst.transform)
+    }
+
+    /// Adds instance `index` as a moving entry; its number and its bounds over the exposure.
+    pub fn add(&mut self, index: usize) -> (u32, Aabb) {
+        let k = self.entries.len() as u32;
+        self.entries.push(index as u32);
+        (k, self.swept(k))
+    }
+
+    /// Entry `k` at time `u`: its transform.
+    fn transform(&self, k: u32, u: f64) -> Option<(&Instance, Transform)> {
+        let inst = self
+            .instances
+            .get(*self.entries.get(k as usize)? as usize)?;
+        Some((inst, self.motion.slot_at(inst.transform, u)))
+    }
+
+    /// Entry `k` placed at `time` (`None` where it is degenerate then).
+    fn place(&self, k: u32, time: f32) -> Option<Primitive> {
+        let (inst, xf) = self.transform(k, time as f64)?;
+        Primitive::new(&inst.geometry, &xf, inst.material as u32).ok()
+    }
+
+    /// `f` of entry `k` placed at `time`; `None` where it is degenerate then.
+    #[inline]
+    pub fn with<R>(&self, k: u32, time: f32, f: impl FnOnce(&Primitive) -> R) -> Option<R> {
+        TOUCHED.with(|t| t.set(true));
+        PLACED.with_borrow_mut(|c| {
+            if c.owner != self.id || c.time != time.to_bits() {
+                c.owner = self.id;
+                c.time = time.to_bits();
+                c.generation += 1;
+                if c.entries.len() != self.entries.len() {
+                    c.entries.clear();
+                    c.entries.resize_with(self.entries.len(), || (0, None));
+                }
+            }
+            let generation = c.generation;
+            let slot = c.entries.get_mut(k as usize)?;
+            if slot.0 != generation {
+                *slot = (generation, self.place(k, time));
+            }
+            slot.1.as_ref().map(f)
+        })
+    }
+
+    /// Entry `k`'s bounds over the whole exposure.
+    fn swept(&self, k: u32) -> Aabb {
+        let Some(inst) = self
+            .entries
+            .get(k as usize)
+            .and_then(|&i| self.instances.get(i as usize))
+        else {
+            return Aabb::EMPTY;
+        };
+        let mut instants: Vec<f64> = (0..=BOUND_STEPS)
+            .map(|s| s as f64 / BOUND_STEPS as f64)
+            .collect();
+        instants.extend(self.motion.slot_instants(inst.transform));
+        let Ok(local) = Primitive::new(&inst.geometry, &Transform::IDENTITY, 0) else {
+            return Aabb::EMPTY;
+        };
+        swept_bounds(&instants, |u| {
+            Some((local.bounds, self.motion.slot_at(inst.transform, u)))
+        })
+    }
+
+    /// Where light `k` is at `time`.
+    #[inline]
+    pub fn light_position(&self, k: usize, time: f32) -> Vec3A {
+        let p = self.lights.get(k).map_or(DVec3::ZERO, |&p| {
+            self.motion.light_position(k, p, time as f64)
+        });
+        Vec3A::from(p.as_vec3())
+    }
+
+    pub fn memory_bytes(&self) -> usize {
+        self.entries.capacity() * 4 + self.lights.capacity() * 24
+    }
+}
+
+/// Bounds of a moving box over the exposure: `placed(u)` gives the box in its own space and
+/// its transform at `u` (`None` where degenerate). The union of the boxes at `instants`
+/// (0 and 1 among them), each widened by twice the longest path a corner takes between two
+/// neighbouring instants (its chord).
+///
+/// Why it holds: a point of the shape is an affine combination of the box's corners, so
+/// between two instants it strays from where it was at the nearer one by at most the longest
+/// path a corner takes in that span. Between instants 1/64 of the exposure apart (and every
+/// key instant), a corner's path is a smooth curve (a constant-speed turn combined with a
+/// straight slide and a steady stretch) that turns far less than a half circle, and the path
+/// of a curve turning by less than 180° is at most π/2 times its chord: twice the chord
+/// covers it with room to spare. `motion_bounds_hold` (proptest) checks it.
+pub fn swept_bounds(instants: &[f64], placed: impl Fn(f64) -> Option<(Aabb, Transform)>) -> Aabb {
+    let mut instants: Vec<f64> = instants
+        .iter()
+        .copied()
+        .filter(|u| (0.0..=1.0).contains(u))
+        .collect();
+    instants.extend([0.0, 1.0]);
+    instants.sort_by(f64::total_cmp);
+    instants.dedup();
+    let mut all = Aabb::EMPTY;
+    let mut margin = 0.0f64;
+    let mut previous: Option<[DVec3; 8]> = None;
+    for &u in &instants {
+        let Some((local, xf)) = placed(u) else {
+            previous = None;
+            continue;
+        };
+        if !local.is_finite() {
+            return Aabb::new(Vec3A::NEG_INFINITY, Vec3A::INFINITY);
+        }
+        let corners = local.corners().map(|c| xf.point(c.as_dvec3()));
+        for c in corners {
+            all = all.union_point(Vec3A::from(c.as_vec3()));
+        }
+        if let Some(before) = previous {
+            for (a, b) in before.iter().zip(&corners) {
+                margin = margin.max(a.distance(*b));
+            }
+        }
+        previous = Some(corners);
+    }
+    if all.is_empty() {
+        return all;
+    }
+    // Twice the longest chord, and a relative margin for the f32 rounding of the corners.
+    let pad = Vec3A::splat((2.0 * margin) as f32)
+        + (all.min.abs().max(all.max.abs()) + all.extent()) * 1e-5;
+    Aabb::new(all.min - pad, all.max + pad)
+}
