@@ -150,6 +150,9 @@ impl RenderScene {
                 }),
             }
         }
+        if let Some(m) = &mut moving {
+            m.finish();
+        }
         let instances = scene.has_prototypes().then(|| {
             let first_id = (material.len() + scene.instanced.uses.len()) as u32;
             Box::new(Instances::new(scene, first_id))
@@ -619,6 +622,7 @@ impl RenderScene {
                 .instances
                 .as_ref()
                 .map_or(0, |inst| inst.memory_bytes())
+            + self.moving.as_ref().map_or(0, |m| m.memory_bytes())
     }
 
     /// Top-level uses of prototypes (each stands for all the shapes of its composite).

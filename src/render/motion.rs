@@ -67,8 +67,11 @@ impl Shutter {
     /// The camera ray through (`x`, `y`) at instant `time`; `still` is the camera at the
     /// middle of the exposure (used as it is when the camera does not move, or where its
     /// placement at `time` is degenerate).
+    /// The time is rounded to the instants moving shapes are placed at
+    /// (`compile::motion::quantize`), so every thing of the scene is seen at one instant.
     #[inline]
     pub fn ray(&self, still: &CameraRays, x: f32, y: f32, time: f32) -> Ray {
+        let time = super::compile::motion::quantize(time);
         let ray = if self.camera_moves() {
             self.camera_at(time)
                 .unwrap_or_else(|| still.clone())

@@ -8,6 +8,7 @@
 //! same floats, and the spawn bounds of `Primitive::surface` hold between them as for a
 //! static shape.
 
+use crate::limits::{MOTION_MAX_PLACED, MOTION_TIME_STEPS};
 use crate::math::{Aabb, Transform};
 use crate::render::primitive::Primitive;
 use crate::scene::motion::Motion;
@@ -15,7 +16,7 @@ use crate::scene::{Instance, Scene};
 use glam::{DVec3, Vec3A};
 use std::cell::{Cell, RefCell};
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// Instants, evenly spread over the exposure, at which a moving shape's bounds are taken
 /// (besides its keys' instants): between two of them its corners move along paths so little
@@ -61,6 +62,23 @@ pub struct Moving {
     entries: Vec<u32>,
     /// Scene light positions (moved with the scene), for moving lights.
     lights: Vec<DVec3>,
+    /// Entry `k` placed at instant `i` (of `MOTION_TIME_STEPS`) in cell `k·steps + i`, made
+    /// by the first ray that needs it; empty when the scene has too many moving shapes for
+    /// it (each worker then places them per camera sample).
+    placed: Vec<OnceLock<Option<Primitive>>>,
+}
+
+/// The instant camera samples at `time` are taken at: the middle of its part of the
+/// exposure (`limits::MOTION_TIME_STEPS`).
+#[inline]
+pub fn quantize(time: f32) -> f32 {
+    (step(time) as f32 + 0.5) / MOTION_TIME_STEPS as f32
+}
+
+/// The part of the exposure `time` falls in.
+#[inline]
+fn step(time: f32) -> u32 {
+    ((time * MOTION_TIME_STEPS as f32) as u32).min(MOTION_TIME_STEPS - 1)
 }
 
 impl Moving {
@@ -76,7 +94,16 @@ impl Moving {
             instances: scene.instances.clone(),
             entries: Vec::new(),
             lights: scene.lights.iter().map(|l| l.position).collect(),
+            placed: Vec::new(),
         })
+    }
+
+    /// Makes room for the placed entries, once they are all added, if they fit.
+    pub fn finish(&mut self) {
+        let cells = self.entries.len() * MOTION_TIME_STEPS as usize;
+        if cells <= MOTION_MAX_PLACED {
+            self.placed = (0..cells).map(|_| OnceLock::new()).collect();
+        }
     }
 
     /// Whether `inst` moves (it is then added with [`Moving::add`], not as a primitive).
@@ -110,6 +137,16 @@ impl Moving {
     #[inline]
     pub fn with<R>(&self, k: u32, time: f32, f: impl FnOnce(&Primitive) -> R) -> Option<R> {
         TOUCHED.with(|t| t.set(true));
+        if !self.placed.is_empty() {
+            let i = step(time);
+            let cell = self
+                .placed
+                .get(k as usize * MOTION_TIME_STEPS as usize + i as usize)?;
+            return cell
+                .get_or_init(|| self.place(k, (i as f32 + 0.5) / MOTION_TIME_STEPS as f32))
+                .as_ref()
+                .map(f);
+        }
         PLACED.with_borrow_mut(|c| {
             if c.owner != self.id || c.time != time.to_bits() {
                 c.owner = self.id;
@@ -160,7 +197,9 @@ impl Moving {
     }
 
     pub fn memory_bytes(&self) -> usize {
-        self.entries.capacity() * 4 + self.lights.capacity() * 24
+        self.entries.capacity() * 4
+            + self.lights.capacity() * 24
+            + self.placed.capacity() * std::mem::size_of::<OnceLock<Option<Primitive>>>()
     }
 }
 
