@@ -254,3 +254,67 @@ pub fn swept_bounds(instants: &[f64], placed: impl Fn(f64) -> Option<(Aabb, Tran
         + (all.min.abs().max(all.max.abs()) + all.extent()) * 1e-5;
     Aabb::new(all.min - pad, all.max + pad)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::motion::MotionKeys;
+    use proptest::prelude::*;
+
+    fn trs(t: [f64; 3], degrees: f64, axis: [f64; 3], s: [f64; 3]) -> Transform {
+        Transform::translate(t.into())
+            .then_after(&Transform::rotate(degrees, axis.into()).expect("axis"))
+            .then_after(&Transform::scale(s.into()).expect("scale"))
+    }
+
+    proptest! {
+        /// The swept bounds hold the box at every instant, turns of up to 180° between two
+        /// keys and a parent's motion carrying the child included.
+        #[test]
+        fn motion_bounds_hold(
+            t in prop::array::uniform3(prop::array::uniform3(-5.0f64..5.0)),
+            d in prop::array::uniform3(-180.0f64..180.0),
+            axis in prop::array::uniform3(0.1f64..1.0),
+            s in prop::array::uniform3(0.5f64..2.0),
+            parent_turn in -180.0f64..180.0,
+            u in prop::collection::vec(0.0f64..1.0, 16),
+        ) {
+            let local = Aabb::new(Vec3A::new(-1.0, -0.5, -0.2), Vec3A::new(1.0, 0.5, 2.0));
+            let keys = [0.0, 0.5, 1.0];
+            let child: Vec<(f64, Transform)> = (0..3)
+                .map(|k| (keys[k], trs(t[k], d[k], axis, [s[k], 1.0, s[(k + 1) % 3]])))
+                .collect();
+            let child = MotionKeys::new(DVec3::new(0.0, 0.0, 0.9), &child).expect("keys");
+            let spin = |deg: f64| trs([3.0, 0.0, 0.0], deg, [0.0, 1.0, 0.0], [1.0; 3]);
+            let parent = MotionKeys::new(
+                DVec3::ZERO,
+                &[(0.0, spin(0.0)), (1.0, spin(parent_turn))],
+            )
+            .expect("keys");
+            let at = |u: f64| {
+                let m = parent.matrix_at(u) * child.matrix_at(u);
+                Transform { world_from_object: m, object_from_world: m.inverse() }
+            };
+            let instants: Vec<f64> = (0..=BOUND_STEPS).map(|k| k as f64 / BOUND_STEPS as f64).collect();
+            let bounds = swept_bounds(&instants, |u| Some((local, at(u))));
+            for u in u {
+                for c in local.corners() {
+                    let p = Vec3A::from(at(u).point(c.as_dvec3()).as_vec3());
+                    prop_assert!(
+                        p.cmpge(bounds.min).all() && p.cmple(bounds.max).all(),
+                        "{p} outside {bounds:?} at {u}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn quantized_times_are_the_middles_of_their_parts() {
+        let n = MOTION_TIME_STEPS as f32;
+        assert_eq!(quantize(0.0), 0.5 / n);
+        assert_eq!(quantize(1.0), (n - 0.5) / n);
+        assert_eq!(quantize(0.5), 512.5 / n);
+        assert_eq!(quantize(quantize(0.3)), quantize(0.3));
+    }
+}
