@@ -264,7 +264,7 @@ impl RenderScene {
     /// `f` of the moving entry of kind `k` placed at the ray's time.
     #[inline(never)]
     fn moving_with<R>(&self, k: u32, ray: &Ray, f: impl FnOnce(&Primitive) -> R) -> Option<R> {
-        self.moving.as_ref()?.with(k & !MOVING, ray.time, f)
+        self.moving.as_ref()?.with(k & !MOVING, ray, f)
     }
 
     /// The moving entry of kind `k` hit by the ray before `t_max`: its hit, and the entry

@@ -289,7 +289,8 @@ fn render_uniform(
 /// How a pixel's centre ray saw the motion of a frame (adaptive sampling's first pass).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Sweep {
-    /// It met the swept bounds of a moving shape.
+    /// It met the swept bounds of a moving shape, and changes during the exposure
+    /// (`Shutter::changes`).
     touched: bool,
     /// How far around it the image must be flat for it to keep its centre sample (the
     /// camera's sweep of its hit point), or `None` when it sweeps too far for that.
@@ -369,7 +370,16 @@ fn render_adaptive(
                     let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
                     compile::motion::take_touched();
                     *px = integrator.trace_primary(&ray, &mut st);
-                    sw.touched = compile::motion::take_touched();
+                    let swept = compile::motion::take_touched();
+                    sw.touched = swept > 0.0
+                        && s.changes(
+                            integrator,
+                            camera,
+                            (x as u32, y as u32),
+                            *px,
+                            swept,
+                            &mut st,
+                        );
                     if s.camera_moves() {
                         let t = integrator
                             .scene

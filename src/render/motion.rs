@@ -4,6 +4,8 @@
 //! never builds a [`Shutter`] and renders by the path it always took.
 
 use super::camera::CameraRays;
+use super::integrator::{Integrator, TraceState};
+use super::sampling::{tone3, FLAT_CONTRAST};
 use crate::math::Ray;
 use crate::scene::motion::Motion;
 use crate::scene::Camera;
@@ -17,6 +19,14 @@ const MAX_FLAT_RADIUS: u32 = 8;
 /// Instants at which a moving camera's sweep over the image is measured, besides its keys.
 const SWEEP_STEPS: usize = 8;
 
+/// Most instants at which adaptive sampling's first pass probes a pixel whose rays met
+/// something moving; motion that sweeps further refines the pixel without probing.
+const MAX_PROBES: u32 = 9;
+
+/// How much further than the moving thing itself its shadow or reflection may move across
+/// the image, as the probes allow for.
+const STRETCH: f32 = 2.0;
+
 /// A moving frame's exposure, as the renderer samples it.
 pub struct Shutter {
     motion: Arc<Motion>,
@@ -26,6 +36,8 @@ pub struct Shutter {
     height: u32,
     /// The camera at instants spread over the exposure, when it moves.
     sweep: Vec<CameraRays>,
+    /// The angle one pixel spans at the image centre (radians).
+    pixel_angle: f32,
 }
 
 impl Shutter {
@@ -38,6 +50,8 @@ impl Shutter {
             width,
             height,
             sweep: Vec::new(),
+            pixel_angle: (2.0 * (camera.fov_x_deg.to_radians() / 2.0).tan() / width.max(1) as f64)
+                as f32,
         };
         if let Some(c) = &motion.camera {
             let mut instants: Vec<f64> = (0..=SWEEP_STEPS)
@@ -101,6 +115,43 @@ impl Shutter {
             }
         }
         most
+    }
+
+    /// Whether the pixel (`x`, `y`) changes during the exposure, for adaptive sampling's first
+    /// pass: its centre sample `centre` (colour, primitive) was taken at the middle instant,
+    /// and its rays met moving things that sweep up to `swept` radians. Probed with centre
+    /// rays at instants evenly spread over the exposure, close enough that a moving thing
+    /// (or its shadow or reflection, up to `STRETCH` times as fast) moves at most about a
+    /// pixel between two of them: a probe that sees another surface or more than
+    /// `FLAT_CONTRAST` levels of difference says it changes. Motion too fast for
+    /// `MAX_PROBES` probes changes it without probing.
+    pub fn changes(
+        &self,
+        integrator: &Integrator,
+        still: &CameraRays,
+        (x, y): (u32, u32),
+        centre: (Vec3A, u32),
+        swept: f32,
+        st: &mut TraceState,
+    ) -> bool {
+        let spread = STRETCH * swept / self.pixel_angle;
+        if spread.is_nan() || spread >= (MAX_PROBES - 1) as f32 {
+            return true;
+        }
+        let parts = (spread.ceil() as u32).max(2);
+        let tone = tone3(centre.0);
+        // The ends first: most motion that changes a pixel shows there.
+        let order = [0, parts].into_iter().chain(1..parts);
+        for i in order.filter(|&i| 2 * i != parts) {
+            let u = i as f32 / parts as f32;
+            let ray = self.ray(still, x as f32 + 0.5, y as f32 + 0.5, u);
+            let (c, prim) = integrator.trace_primary(&ray, st);
+            st.counts.primary += 1;
+            if prim != centre.1 || 255.0 * (tone3(c) - tone).abs().max_element() > FLAT_CONTRAST {
+                return true;
+            }
+        }
+        false
     }
 
     /// The radius (pixels) of the neighbourhood that must be flat for a pixel whose hit point

@@ -9,7 +9,7 @@
 //! static shape.
 
 use crate::limits::{MOTION_MAX_PLACED, MOTION_TIME_STEPS};
-use crate::math::{Aabb, Transform};
+use crate::math::{Aabb, Ray, Transform};
 use crate::render::primitive::Primitive;
 use crate::scene::motion::Motion;
 use crate::scene::{Instance, Scene};
@@ -24,9 +24,10 @@ use std::sync::{Arc, OnceLock};
 const BOUND_STEPS: usize = 64;
 
 thread_local! {
-    /// Whether a query of this thread has met a moving entry since it was last cleared:
-    /// adaptive sampling's first pass asks it per pixel ([`take_touched`]).
-    static TOUCHED: Cell<bool> = const { Cell::new(false) };
+    /// The largest angle (radians, as the eye sees it) swept by the moving entries this
+    /// thread's queries met since it was last cleared: adaptive sampling's first pass asks it
+    /// per pixel ([`take_touched`]).
+    static TOUCHED: Cell<f32> = const { Cell::new(0.0) };
     /// The moving entries this thread placed at the time of its latest ray: every ray of a
     /// camera sample (primary, shadow, reflected) has that sample's time, so each entry is
     /// placed once per sample, not once per test. Only saves work: an entry placed again at
@@ -47,9 +48,10 @@ struct Placed {
     entries: Vec<(u64, Option<Primitive>)>,
 }
 
-/// Whether this thread's queries met a moving shape's swept bounds since the last call.
-pub fn take_touched() -> bool {
-    TOUCHED.with(|t| t.replace(false))
+/// The largest angle (radians) swept, as the eye sees it, by the moving shapes whose swept
+/// bounds this thread's queries met since the last call; 0 when they met none.
+pub fn take_touched() -> f32 {
+    TOUCHED.with(|t| t.replace(0.0))
 }
 
 /// The moving shapes and lights of a scene.
@@ -60,6 +62,10 @@ pub struct Moving {
     instances: Arc<Vec<Instance>>,
     /// Per moving entry: its instance.
     entries: Vec<u32>,
+    /// Per moving entry: the angle (radians) its motion sweeps as the eye sees it, at most.
+    sweep: Vec<f32>,
+    /// Per moving entry: its bounds over the exposure.
+    bounds: Vec<Aabb>,
     /// Scene light positions (moved with the scene), for moving lights.
     lights: Vec<DVec3>,
     /// Entry `k` placed at instant `i` (of `MOTION_TIME_STEPS`) in cell `k·steps + i`, made
@@ -93,6 +99,8 @@ impl Moving {
             motion: motion.clone(),
             instances: scene.instances.clone(),
             entries: Vec::new(),
+            sweep: Vec::new(),
+            bounds: Vec::new(),
             lights: scene.lights.iter().map(|l| l.position).collect(),
             placed: Vec::new(),
         })
@@ -116,7 +124,21 @@ impl Moving {
     pub fn add(&mut self, index: usize) -> (u32, Aabb) {
         let k = self.entries.len() as u32;
         self.entries.push(index as u32);
-        (k, self.swept(k))
+        let swept = self.swept(k);
+        // Seen from the eye (at the origin: rendering is camera-relative), the angle its
+        // corners sweep, at most: their path over the distance to the nearest point of the
+        // bounds.
+        let b = swept.bounds;
+        let nearest = Vec3A::ZERO.clamp(b.min, b.max).length() as f64;
+        let angle = if swept.path == 0.0 {
+            0.0
+        } else {
+            (swept.path / nearest) as f32
+        };
+        self.sweep
+            .push(if angle.is_nan() { f32::INFINITY } else { angle });
+        self.bounds.push(b);
+        (k, swept.bounds)
     }
 
     /// Entry `k` at time `u`: its transform.
@@ -133,10 +155,21 @@ impl Moving {
         Primitive::new(&inst.geometry, &xf, inst.material as u32).ok()
     }
 
-    /// `f` of entry `k` placed at `time`; `None` where it is degenerate then.
+    /// `f` of entry `k` placed at the ray's time; `None` where it is degenerate then.
     #[inline]
-    pub fn with<R>(&self, k: u32, time: f32, f: impl FnOnce(&Primitive) -> R) -> Option<R> {
-        TOUCHED.with(|t| t.set(true));
+    pub fn with<R>(&self, k: u32, ray: &Ray, f: impl FnOnce(&Primitive) -> R) -> Option<R> {
+        let time = ray.time;
+        let swept = self.sweep.get(k as usize).copied().unwrap_or(f32::INFINITY);
+        // Asked also outside a traversal (a shadow ray tries the last blocker first): only a
+        // ray that meets the swept bounds counts.
+        if TOUCHED.with(Cell::get) < swept
+            && self.bounds.get(k as usize).is_some_and(|b| {
+                b.hit_range(ray, ray.dir.recip(), 0.0, f32::INFINITY)
+                    .is_some()
+            })
+        {
+            TOUCHED.with(|t| t.set(swept));
+        }
         if !self.placed.is_empty() {
             let i = step(time);
             let cell = self
@@ -167,20 +200,26 @@ impl Moving {
     }
 
     /// Entry `k`'s bounds over the whole exposure.
-    fn swept(&self, k: u32) -> Aabb {
+    fn swept(&self, k: u32) -> Swept {
         let Some(inst) = self
             .entries
             .get(k as usize)
             .and_then(|&i| self.instances.get(i as usize))
         else {
-            return Aabb::EMPTY;
+            return Swept {
+                bounds: Aabb::EMPTY,
+                path: 0.0,
+            };
         };
         let mut instants: Vec<f64> = (0..=BOUND_STEPS)
             .map(|s| s as f64 / BOUND_STEPS as f64)
             .collect();
         instants.extend(self.motion.slot_instants(inst.transform));
         let Ok(local) = Primitive::new(&inst.geometry, &Transform::IDENTITY, 0) else {
-            return Aabb::EMPTY;
+            return Swept {
+                bounds: Aabb::EMPTY,
+                path: 0.0,
+            };
         };
         swept_bounds(&instants, |u| {
             Some((local.bounds, self.motion.slot_at(inst.transform, u)))
@@ -215,7 +254,7 @@ impl Moving {
 /// straight slide and a steady stretch) that turns far less than a half circle, and the path
 /// of a curve turning by less than 180° is at most π/2 times its chord: twice the chord
 /// covers it with room to spare. `motion_bounds_hold` (proptest) checks it.
-pub fn swept_bounds(instants: &[f64], placed: impl Fn(f64) -> Option<(Aabb, Transform)>) -> Aabb {
+pub fn swept_bounds(instants: &[f64], placed: impl Fn(f64) -> Option<(Aabb, Transform)>) -> Swept {
     let mut instants: Vec<f64> = instants
         .iter()
         .copied()
@@ -226,6 +265,7 @@ pub fn swept_bounds(instants: &[f64], placed: impl Fn(f64) -> Option<(Aabb, Tran
     instants.dedup();
     let mut all = Aabb::EMPTY;
     let mut margin = 0.0f64;
+    let mut paths = [0.0f64; 8];
     let mut previous: Option<[DVec3; 8]> = None;
     for &u in &instants {
         let Some((local, xf)) = placed(u) else {
@@ -233,26 +273,42 @@ pub fn swept_bounds(instants: &[f64], placed: impl Fn(f64) -> Option<(Aabb, Tran
             continue;
         };
         if !local.is_finite() {
-            return Aabb::new(Vec3A::NEG_INFINITY, Vec3A::INFINITY);
+            return Swept {
+                bounds: Aabb::new(Vec3A::NEG_INFINITY, Vec3A::INFINITY),
+                path: f64::INFINITY,
+            };
         }
         let corners = local.corners().map(|c| xf.point(c.as_dvec3()));
         for c in corners {
             all = all.union_point(Vec3A::from(c.as_vec3()));
         }
         if let Some(before) = previous {
-            for (a, b) in before.iter().zip(&corners) {
+            for ((a, b), path) in before.iter().zip(&corners).zip(&mut paths) {
                 margin = margin.max(a.distance(*b));
+                *path += a.distance(*b);
             }
         }
         previous = Some(corners);
     }
+    let path = paths.into_iter().fold(0.0, f64::max);
     if all.is_empty() {
-        return all;
+        return Swept { bounds: all, path };
     }
     // Twice the longest chord, and a relative margin for the f32 rounding of the corners.
     let pad = Vec3A::splat((2.0 * margin) as f32)
         + (all.min.abs().max(all.max.abs()) + all.extent()) * 1e-5;
-    Aabb::new(all.min - pad, all.max + pad)
+    Swept {
+        bounds: Aabb::new(all.min - pad, all.max + pad),
+        path,
+    }
+}
+
+/// What [`swept_bounds`] finds of a moving box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Swept {
+    pub bounds: Aabb,
+    /// The longest way a corner of the box travels over the exposure (through the instants).
+    pub path: f64,
 }
 
 #[cfg(test)]
@@ -296,7 +352,7 @@ mod tests {
                 Transform { world_from_object: m, object_from_world: m.inverse() }
             };
             let instants: Vec<f64> = (0..=BOUND_STEPS).map(|k| k as f64 / BOUND_STEPS as f64).collect();
-            let bounds = swept_bounds(&instants, |u| Some((local, at(u))));
+            let bounds = swept_bounds(&instants, |u| Some((local, at(u)))).bounds;
             for u in u {
                 for c in local.corners() {
                     let p = Vec3A::from(at(u).point(c.as_dvec3()).as_vec3());
