@@ -181,7 +181,7 @@ pub const MOTION_MAX_STEPS: usize = 256;
 /// equal parts). A moving shape is placed once per instant and frame, and shared by every
 /// ray at that instant; an edge that sweeps less than this many pixels in one exposure is
 /// smeared without visible steps.
-pub const MOTION_TIME_STEPS: u32 = 1024;
+pub const MOTION_TIME_STEPS: u32 = 256;
 
 /// Most placed moving shapes (shapes × instants) a render keeps; beyond, each worker places
 /// a shape once per camera sample instead.

@@ -370,7 +370,7 @@ mod tests {
         let n = MOTION_TIME_STEPS as f32;
         assert_eq!(quantize(0.0), 0.5 / n);
         assert_eq!(quantize(1.0), (n - 0.5) / n);
-        assert_eq!(quantize(0.5), 512.5 / n);
+        assert_eq!(quantize(0.5), (n / 2.0 + 0.5) / n);
         assert_eq!(quantize(quantize(0.3)), quantize(0.3));
     }
 }
