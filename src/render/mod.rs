@@ -292,16 +292,17 @@ struct Sweep {
     /// It met the swept bounds of a moving shape, and changes during the exposure
     /// (`Shutter::changes`).
     touched: bool,
-    /// How far around it the image must be flat for it to keep its centre sample (the
-    /// camera's sweep of its hit point), or `None` when it sweeps too far for that.
-    radius: Option<u32>,
+    /// The ends of the streak the camera's motion draws its hit point along (pixels from
+    /// its centre), along which the image must be flat for it to keep its centre sample;
+    /// `None` when it sweeps too far for that (`Shutter::camera_sweep`).
+    streak: Option<[(f32, f32); 2]>,
 }
 
 impl Default for Sweep {
     fn default() -> Self {
         Sweep {
             touched: false,
-            radius: Some(1),
+            streak: Some([(0.0, 0.0); 2]),
         }
     }
 }
@@ -385,8 +386,7 @@ fn render_adaptive(
                             .scene
                             .closest(&ray, f32::INFINITY)
                             .map(|(_, h)| h.t);
-                        let moved = s.camera_sweep(camera, x as u32, y as u32, t);
-                        sw.radius = Shutter::flat_radius(moved);
+                        sw.streak = s.camera_sweep(camera, x as u32, y as u32, t);
                     }
                 }
                 st.counts.primary += row.len() as u64;
@@ -404,24 +404,34 @@ fn render_adaptive(
         let tone = sampling::tone3(colour);
         let mut contrast = 0.0f32;
         let mut other_surface = false;
-        // A moving frame looks as far as the camera sweeps the hit point, and a pixel next to
-        // one whose centre ray met something moving is not flat.
-        let (r, mut moving) = match sweeps.get(y * w + x) {
-            None => (1, false),
-            Some(s) => match s.radius {
-                Some(r) => (r as usize, false),
-                None => (1, true),
-            },
-        };
-        for ny in y.saturating_sub(r)..(y + r + 1).min(h) {
+        // In a moving frame, a pixel next to one whose centre ray met something moving is not
+        // flat, and the image must be flat along the streak the camera's motion draws.
+        let mut moving = false;
+        for ny in y.saturating_sub(1)..(y + 2).min(h) {
             let row = ny * w;
-            for (c, p) in &base[row + x.saturating_sub(r)..row + (x + r + 1).min(w)] {
+            for (c, p) in &base[row + x.saturating_sub(1)..row + (x + 2).min(w)] {
                 other_surface |= *p != prim;
                 contrast = contrast.max((sampling::tone3(*c) - tone).abs().max_element());
             }
-            if !sweeps.is_empty() && ny.abs_diff(y) <= 1 {
+            if !sweeps.is_empty() {
                 let near = &sweeps[row + x.saturating_sub(1)..row + (x + 2).min(w)];
                 moving |= near.iter().any(|s| s.touched);
+            }
+        }
+        match sweeps.get(y * w + x).map(|s| s.streak) {
+            None => {}
+            Some(None) => moving = true,
+            Some(Some(ends)) => {
+                for end in ends {
+                    for (px, py) in Shutter::streak_pixels(x, y, end) {
+                        if px < 0 || py < 0 || px >= w as i64 || py >= h as i64 {
+                            continue;
+                        }
+                        let (c, p) = &base[py as usize * w + px as usize];
+                        other_surface |= *p != prim;
+                        contrast = contrast.max((sampling::tone3(*c) - tone).abs().max_element());
+                    }
+                }
             }
         }
         let contrast = 255.0 * contrast;

@@ -12,9 +12,9 @@ use crate::scene::Camera;
 use glam::Vec3A;
 use std::sync::Arc;
 
-/// Largest neighbourhood radius (pixels) over which adaptive sampling judges a pixel flat
-/// under a moving camera; a hit point that moves further across the image is refined.
-const MAX_FLAT_RADIUS: u32 = 8;
+/// Longest way (pixels) across the image along which adaptive sampling judges a pixel flat
+/// under a moving camera; a hit point that moves further is refined.
+const MAX_FLAT_SWEEP: f32 = 96.0;
 
 /// Instants at which a moving camera's sweep over the image is measured, besides its keys.
 const SWEEP_STEPS: usize = 8;
@@ -96,25 +96,49 @@ impl Shutter {
         ray.at_time(time)
     }
 
-    /// How far (pixels) the point the middle instant's centre ray of (`x`, `y`) meets at
-    /// distance `t` (`None`: nothing, the background far away) moves across the image while
-    /// the camera moves; 0 for a still camera.
-    pub fn camera_sweep(&self, still: &CameraRays, x: u32, y: u32, t: Option<f32>) -> f32 {
-        if self.sweep.is_empty() {
-            return 0.0;
-        }
+    /// Where (pixels, from the centre of (`x`, `y`)) the point its middle-instant centre ray
+    /// meets at distance `t` (`None`: nothing, the background far away) is seen when the
+    /// shutter opens and closes, while the camera moves: the ends of its streak, which
+    /// adaptive sampling's flat test walks. `None` when it leaves the view or sweeps further
+    /// than `MAX_FLAT_SWEEP`, or strays more than a pixel from the two straight halves.
+    pub fn camera_sweep(
+        &self,
+        still: &CameraRays,
+        x: u32,
+        y: u32,
+        t: Option<f32>,
+    ) -> Option<[(f32, f32); 2]> {
+        let (Some(first), Some(last)) = (self.sweep.first(), self.sweep.last()) else {
+            return Some([(0.0, 0.0); 2]);
+        };
         let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
         let ray = still.ray(cx, cy);
         // The background: a point far enough that the eye's slide does not move it.
         let p: Vec3A = ray.at(t.unwrap_or(1e7));
-        let mut most = 0.0f32;
-        for c in &self.sweep {
-            match c.project(p) {
-                Some((px, py)) => most = most.max((px - cx).hypot(py - cy)),
-                None => return f32::INFINITY,
+        let end = |c: &CameraRays| c.project(p).map(|(px, py)| (px - cx, py - cy));
+        let ends = [end(first)?, end(last)?];
+        if ends
+            .iter()
+            .any(|e| e.0.hypot(e.1).partial_cmp(&MAX_FLAT_SWEEP) != Some(std::cmp::Ordering::Less))
+        {
+            return None;
+        }
+        // The instants between lie on the halves, within a pixel.
+        let n = self.sweep.len();
+        for (i, c) in self.sweep.iter().enumerate() {
+            let (dx, dy) = end(c)?;
+            let (ex, ey) = if 2 * i < n { ends[0] } else { ends[1] };
+            let len2 = ex * ex + ey * ey;
+            let off = if len2 > 0.0 {
+                (dx * ey - dy * ex).abs() / len2.sqrt()
+            } else {
+                dx.hypot(dy)
+            };
+            if off.is_nan() || off > 1.0 {
+                return None;
             }
         }
-        most
+        Some(ends)
     }
 
     /// Whether the pixel (`x`, `y`) changes during the exposure, for adaptive sampling's first
@@ -154,13 +178,22 @@ impl Shutter {
         false
     }
 
-    /// The radius (pixels) of the neighbourhood that must be flat for a pixel whose hit point
-    /// sweeps `sweep` pixels to keep its centre sample, or `None` when it sweeps too far.
-    pub fn flat_radius(sweep: f32) -> Option<u32> {
-        if sweep.is_finite() && sweep <= MAX_FLAT_RADIUS as f32 {
-            Some((sweep.ceil() as u32).max(1))
+    /// The pixels along a streak from the centre of (`x`, `y`) to offset `end` (pixels), a pixel
+    /// apart, each with its neighbours across the streak: what must be flat for the pixel to keep
+    /// its centre sample under a moving camera.
+    pub fn streak_pixels(x: usize, y: usize, end: (f32, f32)) -> impl Iterator<Item = (i64, i64)> {
+        let steps = end.0.abs().max(end.1.abs()).ceil() as i64;
+        // Across the streak: ±1 along the axis it runs less along.
+        let across = if end.0.abs() >= end.1.abs() {
+            (0, 1)
         } else {
-            None
-        }
+            (1, 0)
+        };
+        (1..=steps).flat_map(move |s| {
+            let f = s as f32 / steps as f32;
+            let px = (x as f32 + 0.5 + end.0 * f).floor() as i64;
+            let py = (y as f32 + 0.5 + end.1 * f).floor() as i64;
+            (-1..=1).map(move |k| (px + k * across.0, py + k * across.1))
+        })
     }
 }

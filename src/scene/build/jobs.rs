@@ -217,7 +217,15 @@ impl Builder<'_> {
                 }
             })
             .collect::<Vec<Light>>();
-        let motion = job_motion(d, flat, snapshot, lines, &transforms, &lights, Some(camera));
+        let motion = job_motion(
+            d,
+            (&flat.instances, &flat.slots),
+            snapshot,
+            lines,
+            &transforms,
+            &lights,
+            Some(camera),
+        );
         let own = |i: usize| snapshot.get(&(Space::Object, d.objects[i].name));
         Scene {
             materials: d.materials.clone(),

@@ -3,7 +3,6 @@
 //! operations), keyed about its centre.
 
 use super::definitions::{Definitions, ObjectKind};
-use super::jobs::Flat;
 use super::transforms::{finite_transform, Snapshot, Space};
 use super::Builder;
 use crate::math::motion::MotionKeys;
@@ -90,7 +89,7 @@ impl Builder<'_> {
 /// The job's motion: its moving slots, lights and camera, or `None` when nothing moves.
 pub(super) fn job_motion(
     d: &Definitions,
-    flat: &Flat,
+    (instances, flat_slots): (&[Instance], &[(u32, usize)]),
     snapshot: &Snapshot,
     lines: &MotionLines,
     transforms: &[Transform],
@@ -102,19 +101,18 @@ pub(super) fn job_motion(
     }
     let own_of =
         |name: &str, space: Space| snapshot.get(&(space, name)).copied().unwrap_or_default();
-    // Slot k (from 1) is `flat.slots[k - 1]`; parents come before children.
-    let n = flat.slots.len() + 1;
+    // Slot k (from 1) is `flat_slots[k - 1]`; parents come before children.
+    let n = flat_slots.len() + 1;
     let mut slots: Vec<Option<SlotMotion>> = vec![None; n];
-    let centres = if flat
-        .slots
+    let centres = if flat_slots
         .iter()
         .any(|&(_, i)| lines.moves_object(d.objects[i].name))
     {
-        slot_centres(&flat.instances, &flat.slots, transforms)
+        slot_centres(instances, flat_slots, transforms)
     } else {
         Vec::new()
     };
-    for (k, &(parent, i)) in flat.slots.iter().enumerate() {
+    for (k, &(parent, i)) in flat_slots.iter().enumerate() {
         let slot = k + 1;
         let name = d.objects[i].name;
         let own = own_of(name, Space::Object);
