@@ -144,3 +144,38 @@ fn motion_lines_that_move_nothing_leave_the_frame_as_it_was() {
     assert_eq!(render(&plain, 4), render(&still, 4));
     assert_ne!(render(&plain, 4), render(&moving, 4));
 }
+
+/// The rows of the streak against `expected`, as in the sliding-ball test.
+fn worst_difference(pixels: &[[f32; 3]]) -> f64 {
+    let mut worst = 0.0f64;
+    for y in [3, 4] {
+        for x in 0..W {
+            let got = pixels[(y * W + x) as usize][0] as f64;
+            worst = worst.max((got - expected(x, y)).abs());
+        }
+    }
+    worst
+}
+
+#[test]
+fn a_camera_sliding_the_other_way_draws_the_same_streak() {
+    let camera = "motion eye 0 translate 2 0 0\nmotion eye 0.5\nmotion eye 1 translate -2 0 0\n";
+    let job = job(&scene(camera));
+    assert!(job
+        .scene
+        .motion
+        .as_ref()
+        .is_some_and(|m| m.camera.is_some()));
+    let worst = worst_difference(&render(&job, 256));
+    assert!(worst < 0.04, "largest difference {worst}");
+}
+
+#[test]
+fn a_moving_composite_carries_its_shape() {
+    let text = scene(
+        "define shape composite group ball\n\
+         motion group 0 translate -2 0 0\nmotion group 0.5\nmotion group 1 translate 2 0 0\n",
+    );
+    let worst = worst_difference(&render(&job(&text), 256));
+    assert!(worst < 0.04, "largest difference {worst}");
+}
