@@ -177,6 +177,16 @@ pub const MOTION_TURN_SAMPLES: usize = 32;
 /// writes a bounded file).
 pub const MOTION_MAX_STEPS: usize = 256;
 
+/// Instants one exposure's camera samples are rounded to (the middle of each of this many
+/// equal parts). A moving shape is placed once per instant and frame, and shared by every
+/// ray at that instant; an edge that sweeps less than this many pixels in one exposure is
+/// smeared without visible steps.
+pub const MOTION_TIME_STEPS: u32 = 256;
+
+/// Most placed moving shapes (shapes × instants) a render keeps; beyond, each worker places
+/// a shape once per camera sample instead.
+pub const MOTION_MAX_PLACED: usize = 1 << 18;
+
 #[cfg(test)]
 mod tests {
     use super::*;

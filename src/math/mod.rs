@@ -15,11 +15,25 @@ use glam::Vec3A;
 pub struct Ray {
     pub origin: Vec3A,
     pub dir: Vec3A,
+    /// The instant of the exposure the ray belongs to (0 at shutter open, 1 at close): its
+    /// camera sample's, inherited by every ray spawned from it. Only moving things read it.
+    pub time: f32,
 }
 
 impl Ray {
+    /// A ray at the middle of the exposure, the instant a frame's statements describe.
     pub fn new(origin: Vec3A, dir: Vec3A) -> Self {
-        Ray { origin, dir }
+        Ray {
+            origin,
+            dir,
+            time: 0.5,
+        }
+    }
+
+    /// The same ray at instant `time` of the exposure.
+    #[inline]
+    pub fn at_time(self, time: f32) -> Self {
+        Ray { time, ..self }
     }
 
     pub fn at(&self, t: f32) -> Vec3A {

@@ -112,6 +112,15 @@ impl MotionKeys {
     /// The transform at `u`: interpolated between the keys around it, held before the first
     /// and after the last.
     pub fn at(&self, u: f64) -> Transform {
+        let m = self.matrix_at(u);
+        Transform {
+            world_from_object: m,
+            object_from_world: m.inverse(),
+        }
+    }
+
+    /// `at(u).world_from_object`, without the inverse (for chains that invert once).
+    pub fn matrix_at(&self, u: f64) -> DMat4 {
         let parts = match self.keys.iter().position(|(k, _)| *k >= u) {
             // At a key exactly (and before the first), the key itself, not a blend ending on it.
             Some(i) if i == 0 || self.keys[i].0 == u => self.keys[i].1,
@@ -121,11 +130,12 @@ impl MotionKeys {
                 a.lerp(b, (u - u0) / (u1 - u0))
             }
         };
-        let m = parts.matrix(self.centre);
-        Transform {
-            world_from_object: m,
-            object_from_world: m.inverse(),
-        }
+        parts.matrix(self.centre)
+    }
+
+    /// The instants of the keys, in increasing order.
+    pub fn instants(&self) -> impl Iterator<Item = f64> + '_ {
+        self.keys.iter().map(|(u, _)| *u)
     }
 
     /// Whether every key is the same transform: then nothing moves.

@@ -45,6 +45,20 @@ impl CameraRays {
         })
     }
 
+    /// The image position (pixels from the top-left corner) at which `p` is seen, if it lies
+    /// in front of the eye: the inverse of [`CameraRays::ray`].
+    pub fn project(&self, p: Vec3A) -> Option<(f32, f32)> {
+        let d = p - self.eye;
+        let s = d.dot(self.forward) / self.forward.length_squared();
+        if s.is_nan() || s <= 0.0 {
+            return None;
+        }
+        Some((
+            self.half_w + d.dot(self.right) / s,
+            self.half_h - d.dot(self.up) / s,
+        ))
+    }
+
     /// Ray through image position (`x`, `y`) in pixels from the top-left corner.
     #[inline]
     pub fn ray(&self, x: f32, y: f32) -> Ray {
@@ -93,6 +107,20 @@ mod tests {
         assert!(edge.dir.x < 0.0);
         // Row 0 is the top: y grows upwards in the scene.
         assert!(rays.ray(100.0, 0.0).dir.y > 0.0);
+    }
+
+    #[test]
+    fn project_undoes_ray() {
+        let mut cam = Camera::default_with_fov("c", 70.0);
+        cam.eye = DVec3::new(1.0, -2.0, 3.0);
+        cam.dir = DVec3::new(0.3, -0.2, -1.0);
+        let rays = CameraRays::new(&cam, 64, 48).unwrap();
+        for (x, y) in [(0.5, 0.5), (32.0, 24.0), (63.2, 11.7)] {
+            let r = rays.ray(x, y);
+            let (px, py) = rays.project(r.at(7.5)).expect("in front");
+            assert!((px - x).abs() < 1e-3 && (py - y).abs() < 1e-3, "{px} {py}");
+        }
+        assert!(rays.project(rays.ray(10.0, 10.0).at(-1.0)).is_none());
     }
 
     #[test]

@@ -2,6 +2,7 @@
 //! ray: primitives in one array, a BVH over the bounded ones, materials in f32 SIMD form.
 
 mod instance;
+pub mod motion;
 
 use super::primitive::{Primitive, SurfaceHit};
 use crate::accel::Bvh;
@@ -10,6 +11,7 @@ use crate::scene::{Material, Scene};
 use crate::shape::{Shape, ShapeHit, Sphere, SphereRay};
 use glam::{Vec3A, Vec4};
 use instance::{Best, Instances};
+use motion::Moving;
 
 #[derive(Clone, Debug)]
 pub struct ShadeMaterial {
@@ -50,6 +52,9 @@ pub struct PointLight {
 const SPHERE: u32 = u32::MAX;
 /// `RenderScene::kind` of a top-level use of a prototype: this bit, and the use's index.
 const USE: u32 = 1 << 31;
+/// `RenderScene::kind` of a shape that moves during the exposure: these bits, and its index
+/// among the moving entries (`motion::Moving`).
+const MOVING: u32 = USE | 1 << 30;
 /// Spheres tested at once.
 const LANES: usize = 4;
 
@@ -73,6 +78,8 @@ pub struct RenderScene {
     /// The scene's instanced composites. Their shapes have ids from `len()` on: `len()` plus
     /// their depth-first number.
     instances: Option<Box<Instances>>,
+    /// What moves during the exposure, if anything does.
+    moving: Option<Box<Moving>>,
     bvh: Bvh,
     /// The first primitive without finite bounds (planes); these are tested on every ray.
     unbounded: u32,
@@ -108,7 +115,17 @@ impl RenderScene {
         let mut dropped = Vec::new();
         let mut key = Vec::with_capacity(n);
         let offsets = &scene.instanced.offsets;
+        let mut moving = Moving::new(scene).map(Box::new);
         for (index, inst) in scene.instances.iter().enumerate() {
+            if let Some(m) = moving.as_mut().filter(|m| m.moves(inst)) {
+                let (k, b) = m.add(index);
+                key.push(offsets.get(index).copied().unwrap_or(index as u32));
+                bounds.push(b);
+                material.push(inst.material as u32);
+                kind.push(MOVING | k);
+                spheres.push(Vec4::NAN);
+                continue;
+            }
             match Primitive::new(
                 &inst.geometry,
                 scene.transform_of(inst),
@@ -132,6 +149,9 @@ impl RenderScene {
                     loc: scene.instance_loc(inst),
                 }),
             }
+        }
+        if let Some(m) = &mut moving {
+            m.finish();
         }
         let instances = scene.has_prototypes().then(|| {
             let first_id = (material.len() + scene.instanced.uses.len()) as u32;
@@ -179,7 +199,7 @@ impl RenderScene {
         let top_materials = material
             .iter()
             .zip(&kind)
-            .filter(|&(_, &k)| !is_use(k))
+            .filter(|&(_, &k)| !is_use(k) || is_moving(k))
             .map(|(&m, _)| m);
         for m in top_materials.chain(prototype_materials) {
             if let Some(u) = used.get_mut(m as usize) {
@@ -210,6 +230,7 @@ impl RenderScene {
             objects,
             key,
             instances,
+            moving,
             bvh,
             unbounded: first_unbounded,
             materials,
@@ -238,6 +259,32 @@ impl RenderScene {
             Some(&m) => m,
             None => self.instances.as_ref().map_or(0, |inst| inst.material(i)),
         }
+    }
+
+    /// `f` of the moving entry of kind `k` placed at the ray's time.
+    #[inline(never)]
+    fn moving_with<R>(&self, k: u32, ray: &Ray, f: impl FnOnce(&Primitive) -> R) -> Option<R> {
+        self.moving.as_ref()?.with(k & !MOVING, ray, f)
+    }
+
+    /// The moving entry of kind `k` hit by the ray before `t_max`: its hit, and the entry
+    /// placed (for its surface).
+    fn moving_hit(&self, k: u32, ray: &Ray, t_max: f32) -> Option<(ShapeHit, Primitive)> {
+        self.moving_with(k, ray, |p| p.hit(ray, t_max).map(|h| (h, p.clone())))?
+    }
+
+    /// Where light `k` is at `time` (its position unless it moves).
+    #[inline(always)]
+    pub fn light_position(&self, k: usize, light: &PointLight, time: f32) -> Vec3A {
+        match &self.moving {
+            None => light.position,
+            Some(m) => m.light_position(k, time),
+        }
+    }
+
+    /// Whether a shape or light moves during the exposure.
+    pub fn has_motion(&self) -> bool {
+        self.moving.is_some()
     }
 
     /// Instanced primitive `i` (an id from `len()` on), placed.
@@ -277,6 +324,9 @@ impl RenderScene {
         match self.kind.get(i as usize).copied() {
             Some(SPHERE) => self.sphere(i as usize).intersect(ray, t_max).map(|h| h.t),
             Some(k) if !is_use(k) => self.objects[k as usize].hit(ray, t_max).map(|h| h.t),
+            Some(k) if is_moving(k) => {
+                self.moving_with(k, ray, |p| p.hit(ray, t_max).map(|h| h.t))?
+            }
             _ => self.instanced(i)?.hit(ray, t_max).map(|h| h.t),
         }
     }
@@ -290,8 +340,11 @@ impl RenderScene {
                 .intersect(ray, t_max)
                 .map(|h| sphere_surface(&h)),
             Some(k) if !is_use(k) => self.objects[k as usize].intersect(ray, t_max),
-            _ => {
-                let p = self.instanced(i)?;
+            k => {
+                let p = match k {
+                    Some(k) if is_moving(k) => self.moving_hit(k, ray, t_max)?.1,
+                    _ => self.instanced(i)?,
+                };
                 let h = p.hit(ray, t_max)?;
                 Some(match p.world_sphere() {
                     Some(s) => sphere_surface(&s.hit_at(ray, h.t)),
@@ -308,8 +361,16 @@ impl RenderScene {
         // The winner's object-space hit is kept for its surface (spheres recompute theirs).
         let mut best: Option<Best> = None;
         let mut t_best = t_max;
+        let mut won = None;
         for i in self.unbounded..self.len() as u32 {
-            if let Some(h) = self.shape_hit(i, ray, t_best) {
+            let h = match self.kind[i as usize] {
+                k if is_moving(k) => self.moving_hit(k, ray, t_best).map(|(h, p)| {
+                    won = Some(p);
+                    h
+                }),
+                _ => self.shape_hit(i, ray, t_best),
+            };
+            if let Some(h) = h {
                 t_best = h.t;
                 best = Some(Best {
                     id: i,
@@ -320,7 +381,6 @@ impl RenderScene {
             }
         }
         let lanes = SphereRay::new(ray);
-        let mut won = None;
         if self.all_spheres {
             self.bvh.closest_leaves(ray, t_best, |leaf, t_max| {
                 self.closest_in_sphere_leaf(&lanes, leaf, t_max, &mut best)
@@ -333,8 +393,8 @@ impl RenderScene {
         let Best { id: i, t, hit, .. } = best?;
         let surface = match (self.kind.get(i as usize).copied(), hit) {
             (Some(SPHERE), _) => sphere_surface(&self.sphere(i as usize).hit_at(ray, t)),
-            (Some(o), Some(h)) => self.objects[o as usize].surface(&h),
-            (None, Some(h)) => {
+            (Some(o), Some(h)) if !is_moving(o) => self.objects[o as usize].surface(&h),
+            (_, Some(h)) => {
                 let p = won?;
                 match p.world_sphere() {
                     Some(s) => sphere_surface(&s.hit_at(ray, t)),
@@ -413,6 +473,22 @@ impl RenderScene {
                                 key: self.key[i],
                                 hit: None,
                             });
+                        }
+                    }
+                    m if is_moving(m) => {
+                        let h = self
+                            .moving_with(m, ray, |p| p.hit(ray, t_max.next_up()))
+                            .flatten();
+                        if let Some(h) = h.filter(|h| Best::loses_to(best, t_max, h.t, self.key[i]))
+                        {
+                            t_max = h.t;
+                            *best = Some(Best {
+                                id: i as u32,
+                                t: t_max,
+                                key: self.key[i],
+                                hit: Some(h),
+                            });
+                            *won = self.moving_with(m, ray, Primitive::clone);
                         }
                     }
                     u if is_use(u) => {
@@ -497,6 +573,10 @@ impl RenderScene {
                 for (k, &kind) in kinds.iter().enumerate() {
                     found = match kind {
                         SPHERE => None,
+                        m if is_moving(m) => self
+                            .moving_with(m, ray, |p| p.hit(ray, t_max).is_some())
+                            .filter(|&hit| hit)
+                            .map(|_| (start + k) as u32),
                         u if is_use(u) => self
                             .instances
                             .as_ref()
@@ -521,6 +601,7 @@ impl RenderScene {
     pub fn any_candidate(&self, ray: &Ray, t_max: f32, mut stop: impl FnMut(u32) -> bool) -> bool {
         (self.unbounded..self.len() as u32).any(&mut stop)
             || self.bvh.any(ray, t_max, |i| match self.kind[i as usize] {
+                m if is_moving(m) => stop(i),
                 u if is_use(u) => self
                     .instances
                     .as_ref()
@@ -541,12 +622,20 @@ impl RenderScene {
                 .instances
                 .as_ref()
                 .map_or(0, |inst| inst.memory_bytes())
+            + self.moving.as_ref().map_or(0, |m| m.memory_bytes())
     }
 
     /// Top-level uses of prototypes (each stands for all the shapes of its composite).
     pub fn instance_uses(&self) -> usize {
         self.instances.as_ref().map_or(0, |inst| inst.uses())
     }
+}
+
+/// Whether a `kind` is a moving shape (which `is_use` also says, so that the paths of
+/// static scenes test one bit as before).
+#[inline(always)]
+fn is_moving(kind: u32) -> bool {
+    kind != SPHERE && kind & MOVING == MOVING
 }
 
 /// Whether a `kind` is a top-level use of a prototype.

@@ -97,7 +97,7 @@ impl Integrator<'_> {
         let n = if entering { hit.normal } else { -hit.normal };
         let (rho, alpha) = (mat.reflectivity, mat.opacity);
         if rho == 0.0 && alpha == 1.0 {
-            return self.local(mat, hit, n, -ray.dir, st);
+            return self.local(mat, hit, n, -ray.dir, ray.time, st);
         }
 
         // c = α·((1−ρ)·c_local + ρ·c_r) + (1−α)·(F·c_r + (1−F)·c_t)
@@ -120,7 +120,7 @@ impl Integrator<'_> {
         let mut c = if w_local == 0.0 {
             Vec3A::ZERO
         } else {
-            self.local(mat, hit, n, -ray.dir, st) * w_local
+            self.local(mat, hit, n, -ray.dir, ray.time, st) * w_local
         };
         let can_recurse = depth < self.max_depth;
         let worth =
@@ -128,18 +128,19 @@ impl Integrator<'_> {
         if worth(w_reflect) {
             let dir = reflect(ray.dir, n);
             st.counts.reflected += 1;
-            let r = hit.spawn_ray(dir);
+            let r = hit.spawn_ray(dir).at_time(ray.time);
             c += self.trace(&r, depth + 1, weight * w_reflect, st) * w_reflect;
         }
         if let Some(dir) = refracted.filter(|_| worth(w_refract)) {
             st.counts.refracted += 1;
-            let r = hit.spawn_ray(dir);
+            let r = hit.spawn_ray(dir).at_time(ray.time);
             c += self.trace(&r, depth + 1, weight * w_refract, st) * w_refract;
         }
         c
     }
 
     /// `Ka·I_ambient + Σ vis·I·(Kd·max(N·L,0) + Ks·max(R·V,0)^m)`, specular only where N·L > 0.
+    /// Lights and shadowing geometry are taken at `time`, the instant of the exposure.
     #[inline]
     fn local(
         &self,
@@ -147,6 +148,7 @@ impl Integrator<'_> {
         hit: &SurfaceHit,
         n: Vec3A,
         v: Vec3A,
+        time: f32,
         st: &mut TraceState,
     ) -> Vec3A {
         let scene = self.scene;
@@ -154,7 +156,7 @@ impl Integrator<'_> {
         // `ks·spec` is exactly zero without a specular colour (spec is at most 1 for m ≥ 0).
         let specular = mat.ks != Vec3A::ZERO || mat.m < 0.0 || mat.m.is_nan();
         for (k, light) in scene.lights.iter().enumerate() {
-            let to_light = light.position - hit.point;
+            let to_light = scene.light_position(k, light, time) - hit.point;
             let dist = to_light.length();
             if dist == 0.0 {
                 continue;
@@ -182,7 +184,7 @@ impl Integrator<'_> {
                 continue;
             }
             st.counts.shadow += 1;
-            let vis = self.visibility(hit, l, dist, st.blockers.get_mut(k));
+            let vis = self.visibility(hit, l, dist, time, st.blockers.get_mut(k));
             if vis == 0.0 {
                 continue;
             }
@@ -205,10 +207,11 @@ impl Integrator<'_> {
         hit: &SurfaceHit,
         l: Vec3A,
         dist: f32,
+        time: f32,
         mut blocker: Option<&mut u32>,
     ) -> f32 {
         let scene = self.scene;
-        let ray = hit.spawn_ray(l);
+        let ray = hit.spawn_ray(l).at_time(time);
         let light = hit.point + l * dist;
         let remaining = (light - ray.origin).dot(l);
         if let Some(&mut b) = blocker.as_deref_mut() {
@@ -250,7 +253,7 @@ impl Integrator<'_> {
                 if transmit == 0.0 {
                     return true;
                 }
-                segment = hit.spawn_ray(l);
+                segment = hit.spawn_ray(l).at_time(time);
                 left = (light - segment.origin).dot(l);
                 if left <= 0.0 {
                     break;

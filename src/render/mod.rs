@@ -4,6 +4,7 @@ pub mod camera;
 pub mod compile;
 pub mod film;
 pub mod integrator;
+pub mod motion;
 pub mod primitive;
 pub mod sampling;
 
@@ -13,6 +14,7 @@ use camera::{sample_offsets, CameraError, CameraRays};
 use compile::RenderScene;
 use glam::{DVec3, Vec3, Vec3A};
 use integrator::{Integrator, TraceState, NO_HIT};
+use motion::Shutter;
 use rayon::prelude::*;
 use std::path::PathBuf;
 
@@ -186,6 +188,11 @@ pub fn render_job(
     let (scene, camera) = rebased
         .as_ref()
         .map_or((&job.scene, &job.camera), |(s, c)| (s, c));
+    let shutter = scene
+        .motion
+        .as_ref()
+        .map(|m| Shutter::new(m, camera, width, height));
+    let shutter = shutter.as_ref();
     let camera = CameraRays::new(camera, width, height)?;
     let (scene, dropped) = RenderScene::compile(scene);
     let integrator = Integrator {
@@ -193,10 +200,18 @@ pub fn render_job(
         max_depth: settings.max_depth,
     };
     let (pixels, counts) = match settings.sampling(job) {
-        Sampling::Uniform(spp) => render_uniform(&camera, &integrator, width, height, spp, on_tile),
-        Sampling::Adaptive { error, max_spp } => {
-            render_adaptive(&camera, &integrator, width, height, error, max_spp, on_tile)
+        Sampling::Uniform(spp) => {
+            render_uniform(&camera, shutter, &integrator, width, height, spp, on_tile)
         }
+        Sampling::Adaptive { error, max_spp } => render_adaptive(
+            &camera,
+            shutter,
+            &integrator,
+            (width, height),
+            error,
+            max_spp,
+            on_tile,
+        ),
     };
     Ok(Rendered {
         image: HdrImage {
@@ -210,9 +225,11 @@ pub fn render_job(
     })
 }
 
-/// Every pixel takes the same `spp` samples at the same sub-pixel offsets.
+/// Every pixel takes the same `spp` samples at the same sub-pixel offsets (and, in a frame
+/// with motion, at instants of the exposure stratified per pixel: `sampling::uniform_time`).
 fn render_uniform(
     camera: &CameraRays,
+    shutter: Option<&Shutter>,
     integrator: &Integrator,
     width: u32,
     height: u32,
@@ -236,8 +253,16 @@ fn render_uniform(
             for y in y0..y1 {
                 for x in x0..x1 {
                     let mut sum = Vec3A::ZERO;
-                    for &(dx, dy) in &offsets {
-                        let ray = camera.ray(x as f32 + dx, y as f32 + dy);
+                    for (i, &(dx, dy)) in offsets.iter().enumerate() {
+                        let (px, py) = (x as f32 + dx, y as f32 + dy);
+                        let ray = match shutter {
+                            None => camera.ray(px, py),
+                            Some(s) => {
+                                let n = offsets.len() as u32;
+                                let time = sampling::uniform_time(x, y, i as u32, n);
+                                s.ray(camera, px, py, time)
+                            }
+                        };
                         sum += integrator.trace(&ray, 0, 1.0, &mut st);
                     }
                     st.counts.primary += offsets.len() as u64;
@@ -259,6 +284,27 @@ fn render_uniform(
         }
     }
     (pixels, counts)
+}
+
+/// How a pixel's centre ray saw the motion of a frame (adaptive sampling's first pass).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Sweep {
+    /// It met the swept bounds of a moving shape, and changes during the exposure
+    /// (`Shutter::changes`).
+    touched: bool,
+    /// The ends of the streak the camera's motion draws its hit point along (pixels from
+    /// its centre), along which the image must be flat for it to keep its centre sample;
+    /// `None` when it sweeps too far for that (`Shutter::camera_sweep`).
+    streak: Option<[(f32, f32); 2]>,
+}
+
+impl Default for Sweep {
+    fn default() -> Self {
+        Sweep {
+            touched: false,
+            streak: Some([(0.0, 0.0); 2]),
+        }
+    }
 }
 
 fn add_counts(mut a: RayCounts, b: RayCounts) -> RayCounts {
@@ -283,32 +329,74 @@ fn add_counts(mut a: RayCounts, b: RayCounts) -> RayCounts {
 /// and writes each pixel from its own position, so the image does not depend on the thread
 /// count, and each pixel's pattern depends on its position only, so it does not crawl from
 /// frame to frame of an animation.
+///
+/// In a frame with motion, the first pass takes the middle of the exposure and the samples of
+/// pass 2 carry instants (`PixelPattern::time`). A pixel is not flat when a centre ray around
+/// it met the swept bounds of a moving shape, nor when the camera's motion sweeps its hit
+/// point across a neighbourhood that is not flat.
 fn render_adaptive(
     camera: &CameraRays,
+    shutter: Option<&Shutter>,
     integrator: &Integrator,
-    width: u32,
-    height: u32,
+    (width, height): (u32, u32),
     error: f32,
     max_spp: u32,
     on_tile: &(dyn Fn(u64) + Sync),
 ) -> (Vec<Vec3>, RayCounts) {
     let (w, h) = (width as usize, height as usize);
     let mut base = vec![(Vec3A::ZERO, NO_HIT); w * h];
-    let base_counts = base
-        .par_chunks_mut(w)
-        .enumerate()
-        .map(|(y, row)| {
-            let mut st = TraceState::default();
-            for (x, px) in row.iter_mut().enumerate() {
-                let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
-                *px = integrator.trace_primary(&ray, &mut st);
-            }
-            st.counts.primary += row.len() as u64;
-            st.counts
-        })
-        .reduce(RayCounts::default, add_counts);
+    // Per pixel, in a frame with motion: how its centre ray saw the motion (`Sweep`).
+    let mut sweeps = vec![Sweep::default(); if shutter.is_some() { w * h } else { 0 }];
+    let base_counts = match shutter {
+        None => base
+            .par_chunks_mut(w)
+            .enumerate()
+            .map(|(y, row)| {
+                let mut st = TraceState::default();
+                for (x, px) in row.iter_mut().enumerate() {
+                    let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
+                    *px = integrator.trace_primary(&ray, &mut st);
+                }
+                st.counts.primary += row.len() as u64;
+                st.counts
+            })
+            .reduce(RayCounts::default, add_counts),
+        Some(s) => base
+            .par_chunks_mut(w)
+            .zip(sweeps.par_chunks_mut(w))
+            .enumerate()
+            .map(|(y, (row, sweep_row))| {
+                let mut st = TraceState::default();
+                for (x, (px, sw)) in row.iter_mut().zip(sweep_row).enumerate() {
+                    let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
+                    compile::motion::take_touched();
+                    *px = integrator.trace_primary(&ray, &mut st);
+                    let swept = compile::motion::take_touched();
+                    sw.touched = swept > 0.0
+                        && s.changes(
+                            integrator,
+                            camera,
+                            (x as u32, y as u32),
+                            *px,
+                            swept,
+                            &mut st,
+                        );
+                    if s.camera_moves() {
+                        let t = integrator
+                            .scene
+                            .closest(&ray, f32::INFINITY)
+                            .map(|(_, h)| h.t);
+                        sw.streak = s.camera_sweep(camera, x as u32, y as u32, t);
+                    }
+                }
+                st.counts.primary += row.len() as u64;
+                st.counts
+            })
+            .reduce(RayCounts::default, add_counts),
+    };
 
     let base = &base;
+    let sweeps = &sweeps;
     // The largest tone-mapped difference (8-bit levels) between the centre of (x, y) and the
     // centres around it, or None if the pixel is flat and keeps its centre sample.
     let edge_contrast = |x: usize, y: usize| -> Option<f32> {
@@ -316,14 +404,38 @@ fn render_adaptive(
         let tone = sampling::tone3(colour);
         let mut contrast = 0.0f32;
         let mut other_surface = false;
+        // In a moving frame, a pixel next to one whose centre ray met something moving is not
+        // flat, and the image must be flat along the streak the camera's motion draws.
+        let mut moving = false;
         for ny in y.saturating_sub(1)..(y + 2).min(h) {
-            for (c, p) in &base[ny * w + x.saturating_sub(1)..ny * w + (x + 2).min(w)] {
+            let row = ny * w;
+            for (c, p) in &base[row + x.saturating_sub(1)..row + (x + 2).min(w)] {
                 other_surface |= *p != prim;
                 contrast = contrast.max((sampling::tone3(*c) - tone).abs().max_element());
             }
+            if !sweeps.is_empty() {
+                let near = &sweeps[row + x.saturating_sub(1)..row + (x + 2).min(w)];
+                moving |= near.iter().any(|s| s.touched);
+            }
+        }
+        match sweeps.get(y * w + x).map(|s| s.streak) {
+            None => {}
+            Some(None) => moving = true,
+            Some(Some(ends)) => {
+                for end in ends {
+                    for (px, py) in Shutter::streak_pixels(x, y, end) {
+                        if px < 0 || py < 0 || px >= w as i64 || py >= h as i64 {
+                            continue;
+                        }
+                        let (c, p) = &base[py as usize * w + px as usize];
+                        other_surface |= *p != prim;
+                        contrast = contrast.max((sampling::tone3(*c) - tone).abs().max_element());
+                    }
+                }
+            }
         }
         let contrast = 255.0 * contrast;
-        (other_surface || contrast > sampling::FLAT_CONTRAST).then_some(contrast)
+        (moving || other_surface || contrast > sampling::FLAT_CONTRAST).then_some(contrast)
     };
 
     let mut pixels = vec![Vec3::ZERO; w * h];
@@ -342,7 +454,11 @@ fn render_adaptive(
                 let mut m = sampling::Moments::default();
                 while m.n < max_spp {
                     let (dx, dy) = pattern.sample(m.n);
-                    let ray = camera.ray(x as f32 + dx, y as f32 + dy);
+                    let (px, py) = (x as f32 + dx, y as f32 + dy);
+                    let ray = match shutter {
+                        None => camera.ray(px, py),
+                        Some(s) => s.ray(camera, px, py, pattern.time(m.n)),
+                    };
                     m.add(integrator.trace(&ray, 0, 1.0, &mut st));
                     // Checked at powers of two only: there every prefix is a full net.
                     if m.n >= at_least && m.n.is_power_of_two() && m.error() <= error {

@@ -57,15 +57,28 @@ fn mix64(mut z: u64) -> u64 {
 /// The scramble of one pixel: one key per dimension, derived from the pixel position alone.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PixelPattern {
-    keys: [u64; 2],
+    keys: [u64; 3],
 }
 
 impl PixelPattern {
     pub fn new(x: u32, y: u32) -> Self {
         let base = mix64(((y as u64) << 32 | x as u64) ^ 0x5eed_a11a_5eed_a11a);
         PixelPattern {
-            keys: [mix64(base), mix64(base ^ 0x9e37_79b9_7f4a_7c15)],
+            keys: [
+                mix64(base),
+                mix64(base ^ 0x9e37_79b9_7f4a_7c15),
+                mix64(base ^ 0x3c6e_f372_fe94_f82a),
+            ],
         }
+    }
+
+    /// The instant of the exposure of sample `i` (0 to 1), for frames in which something
+    /// moves: the third Sobol dimension under this pixel's own scramble, so that time is
+    /// stratified together with the position (any 2^m samples put one in each 2^-m of the
+    /// exposure, and the first two dimensions keep their net).
+    #[inline]
+    pub fn time(&self, i: u32) -> f32 {
+        to_unit(owen_scramble(sobol3(i), self.keys[2]))
     }
 
     /// Sample `i` of this pixel, in [0,1)².
@@ -94,6 +107,61 @@ pub fn sobol2(i: u32) -> (u32, u32) {
         v ^= v >> 1;
     }
     (i.reverse_bits(), y)
+}
+
+/// Direction numbers of the third Sobol dimension (primitive polynomial x² + x + 1, initial
+/// m = 1, 3: Joe and Kuo's table): v_k = v_{k−1} ⊕ v_{k−2} ⊕ (v_{k−2} >> 2).
+const SOBOL3: [u32; 32] = {
+    let mut v = [0u32; 32];
+    v[0] = 1 << 31;
+    v[1] = 3 << 29;
+    let mut k = 2;
+    while k < 32 {
+        v[k] = v[k - 1] ^ v[k - 2] ^ (v[k - 2] >> 2);
+        k += 1;
+    }
+    v
+};
+
+/// The third Sobol dimension of point `i` as a 32-bit fraction.
+#[inline]
+pub fn sobol3(i: u32) -> u32 {
+    let mut y = 0u32;
+    let mut bits = i;
+    let mut k = 0;
+    while bits != 0 {
+        if bits & 1 != 0 {
+            y ^= SOBOL3[k];
+        }
+        bits >>= 1;
+        k += 1;
+    }
+    y
+}
+
+/// The instant of the exposure of sample `i` of `n` in pixel (`x`, `y`) under uniform
+/// sampling: the strata `(σ(i) + ½)/n`, with σ a stride through them that is coprime to `n`
+/// and near `n/φ` (so time does not follow the order of the sub-pixel grid), shifted by an
+/// amount keyed by the pixel position alone (neighbours do not see the same instants at the
+/// same sub-pixel offsets, which would print discrete copies of a moving edge).
+pub fn uniform_time(x: u32, y: u32, i: u32, n: u32) -> f32 {
+    let n = n.max(1) as u64;
+    let mut stride = ((n as f64 * 0.618_033_988_749_895) as u64).max(1);
+    while gcd(stride, n) != 1 {
+        stride += 1;
+    }
+    let stratum = (i as u64 * stride) % n;
+    let shift = mix64(((y as u64) << 32 | x as u64) ^ 0x7157_0f5e_ed00_71de) >> 11;
+    let shift = shift as f64 / (1u64 << 53) as f64;
+    let t = (stratum as f64 + 0.5) / n as f64 + shift;
+    (t - t.floor()) as f32
+}
+
+fn gcd(mut a: u64, mut b: u64) -> u64 {
+    while b != 0 {
+        (a, b) = (b, a % b);
+    }
+    a
 }
 
 /// A nested uniform scramble of a 32-bit fraction: each digit is flipped or not depending

@@ -6,6 +6,7 @@
 mod build;
 mod instancing;
 mod load;
+pub mod motion;
 pub mod probe;
 #[cfg(test)]
 mod scale_tests;
@@ -232,6 +233,9 @@ pub struct Scene {
     /// `transforms` before the first of `moves`, kept when the scene has prototypes (their
     /// uses are placed from it).
     pub unmoved: Vec<Transform>,
+    /// What moves while the shutter is open; `None` when nothing does (a frame without
+    /// `motion` lines), and then nothing of the renderer's motion machinery runs.
+    pub motion: Option<Arc<motion::Motion>>,
 }
 
 impl Scene {
@@ -255,6 +259,10 @@ impl Scene {
         }
         for m in &mut self.transforms {
             *m = t.then_after(m);
+        }
+        if let Some(motion) = &mut self.motion {
+            let motion = Arc::make_mut(motion);
+            motion.after = t.then_after(&motion.after);
         }
     }
 

@@ -178,7 +178,7 @@ impl Builder<'_> {
             instanced: Arc::default(),
             local: Vec::new(),
         };
-        self.jobs_of(&d, &snapshots, &flat)
+        self.jobs_of(&d, &snapshots, &flat, &Default::default())
     }
 }
 

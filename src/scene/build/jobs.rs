@@ -2,6 +2,7 @@
 //! there, with the composite tree flattened into instances.
 
 use super::definitions::{Definitions, Object, ObjectKind};
+use super::motion::{job_motion, moves_objects, MotionLines};
 use super::transforms::{finite_transform, Snapshot, Space};
 use super::{At, Builder, Building, Plan};
 use crate::diag::Diagnostic;
@@ -28,6 +29,7 @@ impl Builder<'_> {
         d: &Definitions<'s>,
     ) -> Vec<RenderJob> {
         let snapshots = self.snapshots(statements, d);
+        let lines = self.motion_lines(statements, d);
         // The composite tree is the same for every job; only the transforms differ. It is
         // flattened once, into instances every job shares: each place where an object that
         // some transform statement moves is listed gets its own transform slot, the rest share
@@ -40,8 +42,18 @@ impl Builder<'_> {
                 }
             }
         }
+        // A moving object gets its own slot, which its motion keys replace per instant.
+        for (i, o) in d.objects.iter().enumerate() {
+            moved[i] |= lines.moves_object(o.name);
+        }
         let roots = roots(d);
-        let plan = self.instancing_plan(d, &roots);
+        // Motion inside a prototype would move every use of it: a scene in which shapes or
+        // composites move is flattened without prototypes (docs/scene-language.md §10).
+        let plan = if moves_objects(&lines, d) {
+            Plan::default()
+        } else {
+            self.instancing_plan(d, &roots)
+        };
         let shapes = {
             let expansion = if plan.is_active() {
                 self.stored_expansion(d, &roots, &moved, &plan)
@@ -56,7 +68,7 @@ impl Builder<'_> {
         };
         // The counts are freed before the instances are made.
         let flat = self.flatten_tree(d, &roots, shapes, &moved, plan);
-        self.jobs_of(d, &snapshots, &flat)
+        self.jobs_of(d, &snapshots, &flat, &lines)
     }
 
     /// One job per render statement (or the default one), each placing the shared instances
@@ -66,6 +78,7 @@ impl Builder<'_> {
         d: &Definitions,
         snapshots: &[(Option<&Statement>, Snapshot)],
         flat: &Flat,
+        lines: &MotionLines,
     ) -> Vec<RenderJob> {
         let mut jobs = Vec::new();
         for (render, snapshot) in snapshots {
@@ -78,7 +91,7 @@ impl Builder<'_> {
                         continue;
                     };
                     RenderJob {
-                        scene: self.scene(d, flat, snapshot),
+                        scene: self.scene(d, flat, snapshot, lines, &camera),
                         camera,
                         output: PathBuf::from(&r.output),
                         width: r.width,
@@ -110,7 +123,7 @@ impl Builder<'_> {
                     w.severity = Severity::Warning;
                     self.diagnostics.push(w);
                     RenderJob {
-                        scene: self.scene(d, flat, snapshot),
+                        scene: self.scene(d, flat, snapshot, lines, &camera),
                         camera,
                         output: PathBuf::from(output),
                         width: DEFAULT_IMAGE_SIZE.0,
@@ -155,7 +168,14 @@ impl Builder<'_> {
     }
 
     /// The scene of one job: the shared instances, placed by this job's transforms.
-    fn scene(&mut self, d: &Definitions, flat: &Flat, snapshot: &Snapshot) -> Scene {
+    fn scene(
+        &mut self,
+        d: &Definitions,
+        flat: &Flat,
+        snapshot: &Snapshot,
+        lines: &MotionLines,
+        camera: &Camera,
+    ) -> Scene {
         let mut transforms = Vec::with_capacity(flat.slots.len() + 1);
         transforms.push(Transform::IDENTITY);
         for &(parent, i) in &flat.slots {
@@ -196,7 +216,16 @@ impl Builder<'_> {
                     intensity: l.color * l.brightness,
                 }
             })
-            .collect();
+            .collect::<Vec<Light>>();
+        let motion = job_motion(
+            d,
+            (&flat.instances, &flat.slots),
+            snapshot,
+            lines,
+            &transforms,
+            &lights,
+            Some(camera),
+        );
         let own = |i: usize| snapshot.get(&(Space::Object, d.objects[i].name));
         Scene {
             materials: d.materials.clone(),
@@ -212,6 +241,7 @@ impl Builder<'_> {
                 .iter()
                 .map(|&i| own(i).copied().unwrap_or_default())
                 .collect(),
+            motion,
             ..Scene::default()
         }
     }

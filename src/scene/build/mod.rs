@@ -10,6 +10,7 @@ mod definitions;
 mod flat;
 mod instancing;
 mod jobs;
+mod motion;
 mod references;
 mod transforms;
 

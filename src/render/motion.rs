@@ -1,0 +1,199 @@
+//! The exposure of a frame in which something moves (docs/scene-language.md §10): each camera
+//! sample gets an instant `u` of the exposure, its ray and every ray spawned from it carry
+//! that instant (`Ray::time`), and the camera is placed at it. A frame in which nothing moves
+//! never builds a [`Shutter`] and renders by the path it always took.
+
+use super::camera::CameraRays;
+use super::integrator::{Integrator, TraceState};
+use super::sampling::{tone3, FLAT_CONTRAST};
+use crate::math::Ray;
+use crate::scene::motion::Motion;
+use crate::scene::Camera;
+use glam::Vec3A;
+use std::sync::Arc;
+
+/// Longest way (pixels) across the image along which adaptive sampling judges a pixel flat
+/// under a moving camera; a hit point that moves further is refined.
+const MAX_FLAT_SWEEP: f32 = 96.0;
+
+/// Instants at which a moving camera's sweep over the image is measured, besides its keys.
+const SWEEP_STEPS: usize = 8;
+
+/// Most instants at which adaptive sampling's first pass probes a pixel whose rays met
+/// something moving; motion that sweeps further refines the pixel without probing.
+const MAX_PROBES: u32 = 9;
+
+/// How much further than the moving thing itself its shadow or reflection may move across
+/// the image, as the probes allow for.
+const STRETCH: f32 = 2.0;
+
+/// A moving frame's exposure, as the renderer samples it.
+pub struct Shutter {
+    motion: Arc<Motion>,
+    /// The job's camera, as the scene is placed (the eye rebased with it).
+    camera: Camera,
+    width: u32,
+    height: u32,
+    /// The camera at instants spread over the exposure, when it moves.
+    sweep: Vec<CameraRays>,
+    /// The angle one pixel spans at the image centre (radians).
+    pixel_angle: f32,
+}
+
+impl Shutter {
+    /// The exposure of a job whose scene has `motion`; `camera` is the job's camera as the
+    /// scene is placed for rendering.
+    pub fn new(motion: &Arc<Motion>, camera: &Camera, width: u32, height: u32) -> Shutter {
+        let mut shutter = Shutter {
+            motion: motion.clone(),
+            camera: camera.clone(),
+            width,
+            height,
+            sweep: Vec::new(),
+            pixel_angle: (2.0 * (camera.fov_x_deg.to_radians() / 2.0).tan() / width.max(1) as f64)
+                as f32,
+        };
+        if let Some(c) = &motion.camera {
+            let mut instants: Vec<f64> = (0..=SWEEP_STEPS)
+                .map(|s| s as f64 / SWEEP_STEPS as f64)
+                .chain(c.keys.instants())
+                .collect();
+            instants.sort_by(f64::total_cmp);
+            instants.dedup();
+            shutter.sweep = instants
+                .into_iter()
+                .filter_map(|u| shutter.camera_at(u as f32))
+                .collect();
+        }
+        shutter
+    }
+
+    /// Whether the camera moves.
+    pub fn camera_moves(&self) -> bool {
+        self.motion.camera.is_some()
+    }
+
+    fn camera_at(&self, time: f32) -> Option<CameraRays> {
+        let cam = self.motion.camera_at(&self.camera, time as f64);
+        CameraRays::new(&cam, self.width, self.height).ok()
+    }
+
+    /// The camera ray through (`x`, `y`) at instant `time`; `still` is the camera at the
+    /// middle of the exposure (used as it is when the camera does not move, or where its
+    /// placement at `time` is degenerate).
+    /// The time is rounded to the instants moving shapes are placed at
+    /// (`compile::motion::quantize`), so every thing of the scene is seen at one instant.
+    #[inline]
+    pub fn ray(&self, still: &CameraRays, x: f32, y: f32, time: f32) -> Ray {
+        let time = super::compile::motion::quantize(time);
+        let ray = if self.camera_moves() {
+            self.camera_at(time)
+                .unwrap_or_else(|| still.clone())
+                .ray(x, y)
+        } else {
+            still.ray(x, y)
+        };
+        ray.at_time(time)
+    }
+
+    /// Where (pixels, from the centre of (`x`, `y`)) the point its middle-instant centre ray
+    /// meets at distance `t` (`None`: nothing, the background far away) is seen when the
+    /// shutter opens and closes, while the camera moves: the ends of its streak, which
+    /// adaptive sampling's flat test walks. `None` when it leaves the view or sweeps further
+    /// than `MAX_FLAT_SWEEP`, or strays more than a pixel from the two straight halves.
+    pub fn camera_sweep(
+        &self,
+        still: &CameraRays,
+        x: u32,
+        y: u32,
+        t: Option<f32>,
+    ) -> Option<[(f32, f32); 2]> {
+        let (Some(first), Some(last)) = (self.sweep.first(), self.sweep.last()) else {
+            return Some([(0.0, 0.0); 2]);
+        };
+        let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
+        let ray = still.ray(cx, cy);
+        // The background: a point far enough that the eye's slide does not move it.
+        let p: Vec3A = ray.at(t.unwrap_or(1e7));
+        let end = |c: &CameraRays| c.project(p).map(|(px, py)| (px - cx, py - cy));
+        let ends = [end(first)?, end(last)?];
+        if ends
+            .iter()
+            .any(|e| e.0.hypot(e.1).partial_cmp(&MAX_FLAT_SWEEP) != Some(std::cmp::Ordering::Less))
+        {
+            return None;
+        }
+        // The instants between lie on the halves, within a pixel.
+        let n = self.sweep.len();
+        for (i, c) in self.sweep.iter().enumerate() {
+            let (dx, dy) = end(c)?;
+            let (ex, ey) = if 2 * i < n { ends[0] } else { ends[1] };
+            let len2 = ex * ex + ey * ey;
+            let off = if len2 > 0.0 {
+                (dx * ey - dy * ex).abs() / len2.sqrt()
+            } else {
+                dx.hypot(dy)
+            };
+            if off.is_nan() || off > 1.0 {
+                return None;
+            }
+        }
+        Some(ends)
+    }
+
+    /// Whether the pixel (`x`, `y`) changes during the exposure, for adaptive sampling's first
+    /// pass: its centre sample `centre` (colour, primitive) was taken at the middle instant,
+    /// and its rays met moving things that sweep up to `swept` radians. Probed with centre
+    /// rays at instants evenly spread over the exposure, close enough that a moving thing
+    /// (or its shadow or reflection, up to `STRETCH` times as fast) moves at most about a
+    /// pixel between two of them: a probe that sees another surface or more than
+    /// `FLAT_CONTRAST` levels of difference says it changes. Motion too fast for
+    /// `MAX_PROBES` probes changes it without probing.
+    pub fn changes(
+        &self,
+        integrator: &Integrator,
+        still: &CameraRays,
+        (x, y): (u32, u32),
+        centre: (Vec3A, u32),
+        swept: f32,
+        st: &mut TraceState,
+    ) -> bool {
+        let spread = STRETCH * swept / self.pixel_angle;
+        if spread.is_nan() || spread >= (MAX_PROBES - 1) as f32 {
+            return true;
+        }
+        let parts = (spread.ceil() as u32).max(2);
+        let tone = tone3(centre.0);
+        // The ends first: most motion that changes a pixel shows there.
+        let order = [0, parts].into_iter().chain(1..parts);
+        for i in order.filter(|&i| 2 * i != parts) {
+            let u = i as f32 / parts as f32;
+            let ray = self.ray(still, x as f32 + 0.5, y as f32 + 0.5, u);
+            let (c, prim) = integrator.trace_primary(&ray, st);
+            st.counts.primary += 1;
+            if prim != centre.1 || 255.0 * (tone3(c) - tone).abs().max_element() > FLAT_CONTRAST {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// The pixels along a streak from the centre of (`x`, `y`) to offset `end` (pixels), a pixel
+    /// apart, each with its neighbours across the streak: what must be flat for the pixel to keep
+    /// its centre sample under a moving camera.
+    pub fn streak_pixels(x: usize, y: usize, end: (f32, f32)) -> impl Iterator<Item = (i64, i64)> {
+        let steps = end.0.abs().max(end.1.abs()).ceil() as i64;
+        // Across the streak: ±1 along the axis it runs less along.
+        let across = if end.0.abs() >= end.1.abs() {
+            (0, 1)
+        } else {
+            (1, 0)
+        };
+        (1..=steps).flat_map(move |s| {
+            let f = s as f32 / steps as f32;
+            let px = (x as f32 + 0.5 + end.0 * f).floor() as i64;
+            let py = (y as f32 + 0.5 + end.1 * f).floor() as i64;
+            (-1..=1).map(move |k| (px + k * across.0, py + k * across.1))
+        })
+    }
+}
