@@ -24,6 +24,23 @@ pub struct Packet<const N: usize> {
     inv_dir: [[f32; N]; 3],
     octant: usize,
     nan_free: bool,
+    /// For rays from one origin that cannot make NaN (camera rays): bounds of all of them,
+    /// which reject a child box for the whole packet with one test.
+    bounds: Option<Bounds>,
+}
+
+/// The shared origin and, per axis, the least and greatest `1/d` of the packet's rays.
+///
+/// Why one test can speak for every ray: from a common origin, a slab distance is
+/// `(b − o) · (1/d)` with the same `b − o` for all rays, and a rounded product is monotonic in
+/// each factor, so the products with the least and the greatest `1/d` bound every ray's, as
+/// computed. Min, max and the widening product are monotonic too, so a box whose least
+/// possible entry lies beyond its greatest possible exit (or the greatest `t_max`) is missed
+/// by every ray in [`Node::hit_packet`]'s own arithmetic.
+struct Bounds {
+    origin: [Vec4; 3],
+    inv_lo: [Vec4; 3],
+    inv_hi: [Vec4; 3],
 }
 
 impl<const N: usize> Packet<N> {
@@ -40,11 +57,25 @@ impl<const N: usize> Packet<N> {
             return None;
         }
         let inv = rays.map(|r| r.dir.recip());
+        let nan_free = rays.iter().all(super::RayLanes::nan_free);
+        let origin = rays[0].origin;
+        let same =
+            |r: &Ray| r.origin.to_array().map(f32::to_bits) == origin.to_array().map(f32::to_bits);
+        let bounds = (nan_free && rays.iter().all(same)).then(|| {
+            let lo = inv.iter().fold(inv[0], |a, &b| a.min(b));
+            let hi = inv.iter().fold(inv[0], |a, &b| a.max(b));
+            Bounds {
+                origin: [0, 1, 2].map(|a| Vec4::splat(origin[a])),
+                inv_lo: [0, 1, 2].map(|a| Vec4::splat(lo[a])),
+                inv_hi: [0, 1, 2].map(|a| Vec4::splat(hi[a])),
+            }
+        });
         Some(Packet {
+            bounds,
             origin: [0, 1, 2].map(|a| std::array::from_fn(|r| rays[r].origin[a])),
             inv_dir: [0, 1, 2].map(|a| std::array::from_fn(|r| inv[r][a])),
             octant,
-            nan_free: rays.iter().all(super::RayLanes::nan_free),
+            nan_free,
         })
     }
 
@@ -96,6 +127,26 @@ impl Node {
             enter.write_to_slice(&mut enter_out[g * LANES..g * LANES + LANES]);
         }
         mask
+    }
+}
+
+impl Node {
+    /// Bit `i` clear when no ray of the packet can meet child `i`'s box within its `t_max`
+    /// (at most `t_max_hi`); see [`Bounds`].
+    #[inline(always)]
+    fn maybe_hit(&self, b: &Bounds, t_max_hi: f32) -> u32 {
+        let mut enter = Vec4::ZERO;
+        let mut exit = Vec4::INFINITY;
+        for axis in 0..3 {
+            let d0 = self.min[axis] - b.origin[axis];
+            let d1 = self.max[axis] - b.origin[axis];
+            let (a0, b0) = (d0 * b.inv_lo[axis], d0 * b.inv_hi[axis]);
+            let (a1, b1) = (d1 * b.inv_lo[axis], d1 * b.inv_hi[axis]);
+            enter = enter.max(a0.min(b0).min(a1.min(b1)));
+            exit = exit.min(a0.max(b0).max(a1.max(b1)));
+        }
+        let exit = (exit * SLAB_WIDEN).min(Vec4::splat(t_max_hi));
+        enter.cmple(exit).bitmask()
     }
 }
 
@@ -169,7 +220,13 @@ impl Bvh {
             }
             let node = &self.nodes[reference as usize];
             let mut hit = [0u32; WIDTH];
-            for slot in 0..usize::from(node.len) {
+            let maybe = match &p.bounds {
+                Some(b) if NAN_FREE => {
+                    node.maybe_hit(b, t_max.iter().fold(f32::NEG_INFINITY, |a, &t| a.max(t)))
+                }
+                _ => u32::MAX,
+            };
+            for slot in bits(maybe & ((1 << node.len) - 1)) {
                 hit[slot] = node.hit_packet::<N, NAN_FREE>(slot, p, t_max, &mut enter[slot]) & mask;
             }
             let order = node.order[p.octant];
@@ -212,6 +269,7 @@ impl Bvh {
         if self.nodes.is_empty() {
             return 0;
         }
+        let t_max_hi = t_max.iter().fold(f32::NEG_INFINITY, |a, &t| a.max(t));
         let mut stack: ArrayVec<(u32, u32), STACK_SIZE> = ArrayVec::new();
         stack.push((0, open));
         let mut enter = [0.0f32; N];
@@ -234,8 +292,12 @@ impl Bvh {
             }
             let node = &self.nodes[reference as usize];
             let mut hit = [0u32; WIDTH];
-            for (slot, hit) in hit.iter_mut().enumerate().take(usize::from(node.len)) {
-                *hit = node.hit_packet::<N, NAN_FREE>(slot, p, t_max, &mut enter) & mask;
+            let maybe = match &p.bounds {
+                Some(b) if NAN_FREE => node.maybe_hit(b, t_max_hi),
+                _ => u32::MAX,
+            };
+            for slot in bits(maybe & ((1 << node.len) - 1)) {
+                hit[slot] = node.hit_packet::<N, NAN_FREE>(slot, p, t_max, &mut enter) & mask;
             }
             let order = node.order[p.octant];
             for k in (0..node.len).rev() {
