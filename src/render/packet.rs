@@ -15,10 +15,16 @@ const BLOCK: usize = (BLOCK_W * BLOCK_H) as usize;
 /// A packet of adaptive sampling's first pass (one row at a time): this many pixels of a row.
 const ROW_RUN: usize = 8;
 
-/// Whether camera rays may be traced in packets. They may when every camera ray of a block
-/// sees the same scene, i.e. when nothing in it moves during the exposure; today no scene
-/// does. (The single predicate that motion blur sets to false for moving scenes.)
+/// Whether camera rays are traced in packets: when the scene's hierarchy is deep enough to
+/// be worth it, and every camera ray of a block sees the same scene.
 pub fn packets_apply(integrator: &Integrator) -> bool {
+    integrator.scene.packets_pay() && scene_is_static(integrator)
+}
+
+/// Whether nothing in the scene moves during the exposure (camera rays at different times
+/// would meet different geometry); today no scene moves. This is the one predicate for motion
+/// blur to wire: false for a scene with moving entries.
+fn scene_is_static(integrator: &Integrator) -> bool {
     let _ = integrator;
     true
 }
