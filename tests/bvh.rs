@@ -4,7 +4,7 @@
 //! render scene (spheres packed four to a test, leaf-ordered storage) is held to the same
 //! standard, and its hits to the bits `Primitive` computes.
 
-use anim::accel::Bvh;
+use anim::accel::{Bvh, Packet};
 use anim::math::{Ray, Transform};
 use anim::render::compile::RenderScene;
 use anim::render::primitive::Primitive;
@@ -338,6 +338,57 @@ fn check_render_scene(
         }
     }
     assert!(n < 2000 || hits > 1000, "{hits} hits");
+    let hits = check_packets(rng, &render, DVec3::splat(-15.0), DVec3::splat(80.0));
+    assert!(n < 600 || hits > 2000, "{hits} hits of packet rays");
+}
+
+/// Packets of eight rays from one origin towards nearby points (a fan narrow enough to share
+/// an octant, as the camera rays of a pixel block do; some axis-parallel, some with limits,
+/// some mixing octants, which go ray by ray): every ray's closest hit is `closest`'s to the
+/// bit, the same primitive included. Origins lie in `lo + [0, size)³`. Returns how many
+/// rays hit.
+fn check_packets(rng: &mut Rng, scene: &RenderScene, lo: DVec3, size: DVec3) -> usize {
+    let (mut packets, mut hits) = (0, 0);
+    for i in 0..1500 {
+        let origin = lo + rng.vec(1.0) * size;
+        let target = lo + rng.vec(1.0) * size;
+        let spread = [0.05, 0.5, 4.0][i % 3];
+        let rays: [Ray; 8] = std::array::from_fn(|k| {
+            let mut dir = (target + rng.vec(spread) - origin).normalize();
+            if i % 10 == 0 {
+                // Axis-parallel: zero direction components in every lane.
+                let axis = i / 10 % 3;
+                let sign = dir[axis].signum();
+                dir = DVec3::ZERO;
+                dir[axis] = sign;
+            } else if i % 10 == 5 && k % 2 == 1 {
+                // An exact copy of its neighbour: the same hits, ties included.
+                dir = (target - origin).normalize();
+            }
+            Ray::new(Vec3A::from(origin.as_vec3()), Vec3A::from(dir.as_vec3()))
+        });
+        let t_limit = t_limit_of(i);
+        packets += usize::from(Packet::new(&rays).is_some());
+        let together = scene.closest_packet(&rays, t_limit);
+        for (k, ray) in rays.iter().enumerate() {
+            let bits = |h: Option<(u32, anim::render::primitive::SurfaceHit)>| {
+                h.map(|(id, h)| {
+                    (
+                        id,
+                        h.t.to_bits(),
+                        h.point.to_array().map(f32::to_bits),
+                        h.normal.to_array().map(f32::to_bits),
+                    )
+                })
+            };
+            let alone = scene.closest(ray, t_limit);
+            hits += usize::from(alone.is_some());
+            assert_eq!(bits(together[k]), bits(alone), "packet {i} ray {k}");
+        }
+    }
+    // Not vacuous: most packets go together.
+    assert!(packets > 1000, "{packets} packets");
+    hits
 }
 
 #[path = "common/composites.rs"]
@@ -471,6 +522,14 @@ fn instanced_render_scene_equals_flattened_and_brute_force() {
             }
             let any = a.any_candidate(&ray, t_limit, |id| a.hit(id, &ray, t_limit).is_some());
             assert_eq!(any, blocked, "seed {seed} ray {i}");
+        }
+        let (lo, size) = (DVec3::new(-50.0, -30.0, -20.0), DVec3::splat(100.0));
+        for s in [&a, &b] {
+            let packet_hits = check_packets(&mut rng, s, lo, size);
+            assert!(
+                packet_hits > 2000,
+                "seed {seed}: {packet_hits} hits of packet rays"
+            );
         }
         // Not vacuous: many rays meet something, and some meet two surfaces at once.
         assert!(hits > 1500, "seed {seed}: {hits} hits");

@@ -4,4 +4,4 @@
 mod binary;
 mod wide;
 
-pub use wide::Bvh;
+pub use wide::{Bvh, Packet};

@@ -11,6 +11,9 @@ use crate::math::{Aabb, Ray, SLAB_WIDEN};
 use arrayvec::ArrayVec;
 use glam::Vec4;
 
+mod packet;
+pub use packet::Packet;
+
 const WIDTH: usize = 4;
 /// Marks a child reference as a leaf; the other bits index the leaf's header in `prims`.
 const LEAF: u32 = 1 << 31;
@@ -273,9 +276,7 @@ impl Bvh {
             return t_max;
         }
         let lanes = RayLanes::new(ray);
-        let octant = usize::from(ray.dir.x < 0.0)
-            | usize::from(ray.dir.y < 0.0) << 1
-            | usize::from(ray.dir.z < 0.0) << 2;
+        let octant = octant(ray);
         // Entries carry their box's entry distance: one that lies beyond a hit found since it
         // was pushed is dropped without touching its node.
         // Not zero-filled: clearing a whole fixed-size stack per ray cost about 5 % of the
@@ -344,9 +345,7 @@ impl Bvh {
             return false;
         }
         let lanes = RayLanes::new(ray);
-        let octant = usize::from(ray.dir.x < 0.0)
-            | usize::from(ray.dir.y < 0.0) << 1
-            | usize::from(ray.dir.z < 0.0) << 2;
+        let octant = octant(ray);
         let mut stack: ArrayVec<u32, STACK_SIZE> = ArrayVec::new();
         stack.push(0);
         while let Some(reference) = stack.pop() {
@@ -380,6 +379,14 @@ impl Bvh {
     pub fn memory_bytes(&self) -> usize {
         self.nodes.capacity() * std::mem::size_of::<Node>() + self.prims.capacity() * 4
     }
+}
+
+/// The ray's octant: bit `a` set when its direction's component `a` is negative.
+#[inline(always)]
+fn octant(ray: &Ray) -> usize {
+    usize::from(ray.dir.x < 0.0)
+        | usize::from(ray.dir.y < 0.0) << 1
+        | usize::from(ray.dir.z < 0.0) << 2
 }
 
 /// Appends to `order` the slots of the binary subtree at `b` in the order the binary

@@ -3,6 +3,7 @@
 
 mod instance;
 pub mod motion;
+mod packet;
 
 use super::primitive::{Primitive, SurfaceHit};
 use crate::accel::Bvh;
@@ -358,7 +359,25 @@ impl RenderScene {
     /// primitive's wins (the first of them), else the first in the flattened tree's order.
     #[inline]
     pub fn closest(&self, ray: &Ray, t_max: f32) -> Option<(u32, SurfaceHit)> {
-        // The winner's object-space hit is kept for its surface (spheres recompute theirs).
+        let (mut best, t_best, mut won) = self.closest_unbounded(ray, t_max);
+        let lanes = SphereRay::new(ray);
+        if self.all_spheres {
+            self.bvh.closest_leaves(ray, t_best, |leaf, t_max| {
+                self.closest_in_sphere_leaf(&lanes, leaf, t_max, &mut best)
+            });
+        } else {
+            self.bvh.closest_leaves(ray, t_best, |leaf, t_max| {
+                self.closest_in_leaf(&lanes, ray, leaf, t_max, &mut best, &mut won)
+            });
+        }
+        self.surface_of(ray, best?, won)
+    }
+
+    /// The nearest unbounded primitive's hit before `t_max`, the new `t_max`, and the placed
+    /// primitive when the winner moves: what `closest` starts from. The winner's object-space hit is kept for its surface (spheres
+    /// recompute theirs).
+    #[inline(always)]
+    fn closest_unbounded(&self, ray: &Ray, t_max: f32) -> (Option<Best>, f32, Option<Primitive>) {
         let mut best: Option<Best> = None;
         let mut t_best = t_max;
         let mut won = None;
@@ -380,17 +399,19 @@ impl RenderScene {
                 });
             }
         }
-        let lanes = SphereRay::new(ray);
-        if self.all_spheres {
-            self.bvh.closest_leaves(ray, t_best, |leaf, t_max| {
-                self.closest_in_sphere_leaf(&lanes, leaf, t_max, &mut best)
-            });
-        } else {
-            self.bvh.closest_leaves(ray, t_best, |leaf, t_max| {
-                self.closest_in_leaf(&lanes, ray, leaf, t_max, &mut best, &mut won)
-            });
-        }
-        let Best { id: i, t, hit, .. } = best?;
+        (best, t_best, won)
+    }
+
+    /// The world-space surface of `closest`'s winner (`won`: the placed instanced primitive
+    /// when the winner is one).
+    #[inline(always)]
+    fn surface_of(
+        &self,
+        ray: &Ray,
+        best: Best,
+        won: Option<Primitive>,
+    ) -> Option<(u32, SurfaceHit)> {
+        let Best { id: i, t, hit, .. } = best;
         let surface = match (self.kind.get(i as usize).copied(), hit) {
             (Some(SPHERE), _) => sphere_surface(&self.sphere(i as usize).hit_at(ray, t)),
             (Some(o), Some(h)) if !is_moving(o) => self.objects[o as usize].surface(&h),

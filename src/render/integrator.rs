@@ -81,7 +81,7 @@ impl Integrator<'_> {
 
     /// Radiance leaving the surface point `hit` of primitive `prim` back along `ray`.
     #[inline]
-    fn shade(
+    pub(super) fn shade(
         &self,
         ray: &Ray,
         prim: u32,

@@ -5,6 +5,7 @@ pub mod compile;
 pub mod film;
 pub mod integrator;
 pub mod motion;
+mod packet;
 pub mod primitive;
 pub mod sampling;
 
@@ -249,6 +250,15 @@ fn render_uniform(
         .map(|&(x0, y0)| {
             let (x1, y1) = ((x0 + TILE).min(width), (y0 + TILE).min(height));
             let mut st = TraceState::default();
+            let tile = (x0, x1, y0, y1);
+            let packed = shutter
+                .is_none()
+                .then(|| packet::render_tile(camera, integrator, tile, &offsets, &mut st))
+                .flatten();
+            if let Some(out) = packed {
+                on_tile(out.len() as u64);
+                return (out, st.counts);
+            }
             let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
             for y in y0..y1 {
                 for x in x0..x1 {
@@ -353,6 +363,9 @@ fn render_adaptive(
             .enumerate()
             .map(|(y, row)| {
                 let mut st = TraceState::default();
+                if packet::trace_centres(camera, integrator, y, row, &mut st) {
+                    return st.counts;
+                }
                 for (x, px) in row.iter_mut().enumerate() {
                     let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
                     *px = integrator.trace_primary(&ray, &mut st);

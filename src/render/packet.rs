@@ -1,0 +1,114 @@
+//! Camera rays traced in packets: the rays of a small block of pixels share their origin and
+//! nearly their direction, so one walk of the hierarchy serves them all
+//! (`RenderScene::closest_packet`); each is then shaded on its own. Every ray's closest hit
+//! is the single-ray one to the bit and each pixel sums its samples in the same order, so the
+//! image is the one the single-ray loops in `render` make.
+
+use super::camera::CameraRays;
+use super::integrator::{Integrator, TraceState, NO_HIT};
+use glam::{Vec3, Vec3A};
+
+/// A packet of the uniform path: `BLOCK_W × BLOCK_H` pixels, one sample position each.
+const BLOCK_W: u32 = 4;
+const BLOCK_H: u32 = 2;
+const BLOCK: usize = (BLOCK_W * BLOCK_H) as usize;
+/// A packet of adaptive sampling's first pass (one row at a time): this many pixels of a row.
+const ROW_RUN: usize = 8;
+
+/// Whether camera rays are traced in packets: when the scene's hierarchy is deep enough to
+/// be worth it. Frames with motion never come here (`render` keeps them on the single-ray
+/// loops: the rays of a block sample different instants).
+pub fn packets_apply(integrator: &Integrator) -> bool {
+    integrator.scene.packets_pay()
+}
+
+/// Radiance and hit primitive ([`NO_HIT`] for the background) of each camera ray, as
+/// `Integrator::trace_primary` gives them one by one.
+fn trace_primaries<const N: usize>(
+    integrator: &Integrator,
+    rays: &[crate::math::Ray; N],
+    st: &mut TraceState,
+) -> [(Vec3A, u32); N] {
+    let hits = integrator.scene.closest_packet(rays, f32::INFINITY);
+    let mut out = [(integrator.scene.background, NO_HIT); N];
+    for (r, hit) in hits.iter().enumerate() {
+        if let Some((prim, hit)) = hit {
+            out[r] = (integrator.shade(&rays[r], *prim, hit, 0, 1.0, st), *prim);
+        }
+    }
+    out
+}
+
+/// The pixels of the tile `x0..x1 × y0..y1` (row by row) for uniform sampling at `offsets`,
+/// or `None` when packets do not apply (the caller then traces ray by ray). Counts the
+/// camera rays in `st`.
+pub fn render_tile(
+    camera: &CameraRays,
+    integrator: &Integrator,
+    (x0, x1, y0, y1): (u32, u32, u32, u32),
+    offsets: &[(f32, f32)],
+    st: &mut TraceState,
+) -> Option<Vec<Vec3>> {
+    if !packets_apply(integrator) {
+        return None;
+    }
+    let w = (x1 - x0) as usize;
+    let mut sums = vec![Vec3A::ZERO; w * (y1 - y0) as usize];
+    for by in (y0..y1).step_by(BLOCK_H as usize) {
+        for bx in (x0..x1).step_by(BLOCK_W as usize) {
+            let at = |k: usize| (bx + k as u32 % BLOCK_W, by + k as u32 / BLOCK_W);
+            let index = |(x, y): (u32, u32)| (y - y0) as usize * w + (x - x0) as usize;
+            if bx + BLOCK_W > x1 || by + BLOCK_H > y1 {
+                // A partial block at the tile's edge: ray by ray.
+                for y in by..(by + BLOCK_H).min(y1) {
+                    for x in bx..(bx + BLOCK_W).min(x1) {
+                        for &(dx, dy) in offsets {
+                            let ray = camera.ray(x as f32 + dx, y as f32 + dy);
+                            sums[index((x, y))] += integrator.trace(&ray, 0, 1.0, st);
+                        }
+                    }
+                }
+                continue;
+            }
+            // Each pixel adds its samples in the order of `offsets`, as the single-ray loop.
+            for &(dx, dy) in offsets {
+                let rays: [_; BLOCK] = std::array::from_fn(|k| {
+                    let (x, y) = at(k);
+                    camera.ray(x as f32 + dx, y as f32 + dy)
+                });
+                for (k, (c, _)) in trace_primaries(integrator, &rays, st).iter().enumerate() {
+                    sums[index(at(k))] += *c;
+                }
+            }
+        }
+    }
+    st.counts.primary += (sums.len() * offsets.len()) as u64;
+    let inv_spp = 1.0 / offsets.len() as f32;
+    Some(sums.into_iter().map(|s| Vec3::from(s * inv_spp)).collect())
+}
+
+/// Adaptive sampling's first pass over row `y`: one ray through every pixel centre, its
+/// radiance and hit primitive into `row`. False (and nothing traced) when packets do not
+/// apply. Counts the camera rays in `st`.
+pub fn trace_centres(
+    camera: &CameraRays,
+    integrator: &Integrator,
+    y: usize,
+    row: &mut [(Vec3A, u32)],
+    st: &mut TraceState,
+) -> bool {
+    if !packets_apply(integrator) {
+        return false;
+    }
+    let ray = |x: usize| camera.ray(x as f32 + 0.5, y as f32 + 0.5);
+    let done = row.len() - row.len() % ROW_RUN;
+    for (c, chunk) in row[..done].chunks_exact_mut(ROW_RUN).enumerate() {
+        let rays: [_; ROW_RUN] = std::array::from_fn(|k| ray(c * ROW_RUN + k));
+        chunk.copy_from_slice(&trace_primaries(integrator, &rays, st));
+    }
+    for (x, px) in row.iter_mut().enumerate().skip(done) {
+        *px = integrator.trace_primary(&ray(x), st);
+    }
+    st.counts.primary += row.len() as u64;
+    true
+}
