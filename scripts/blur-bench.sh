@@ -12,7 +12,8 @@
 #      `anim render` run. They are the midpoints of the exposure's 16 equal parts, taken from
 #      a copy of the spec at 32× the fps whose keys are all 1/64 of a frame later (so its
 #      frame 32i+k+1 shows the original at t_i + (k+½)/16 of the exposure).
-# Then the RMSE, in 8-bit levels, of the blurred frame against the mean of the 16 instants'
+# Then the rays each traced (deterministic, so a ratio of work free of the machine's noise),
+# and the RMSE, in 8-bit levels, of the blurred frame against the mean of the 16 instants'
 # radiance (`--hdr`), both tone-mapped with the renderer's rule round(255·c/(c+1)).
 #
 # Environment: ANIM (binary; default: build target/release/anim), ROUNDS, OUT (work folder,
@@ -63,6 +64,14 @@ cpu() {
   awk '{ printf "%.2f", $1 + $2 }' "$out/time"
 }
 
+# Rays traced (primary + shadow + reflected + refracted) by one anim render run: the same
+# every run, so a ratio of work free of the machine's noise.
+rays() {
+  "$anim" render "$@" ${ANIM_ARGS:-} 2>&1 >/dev/null |
+    sed -n 's/.*(primary \([0-9]*\), shadow \([0-9]*\), reflected \([0-9]*\), refracted \([0-9]*\)).*/\1 \2 \3 \4/p' |
+    awk '{ n += $1 + $2 + $3 + $4 } END { print n }'
+}
+
 rmse() {
   python3 - "$@" <<'EOF'
 import math, struct, sys
@@ -102,6 +111,10 @@ for f in "${frames[@]}"; do
       "$(awk -v a="$a" -v b="$b" 'BEGIN { printf "%.2f", a / b }')" \
       "$(awk -v c="$c" -v b="$b" 'BEGIN { printf "%.1f", c / b }')"
   done
+  ra=$(rays "$(name "$out/blurred" "$f")")
+  rb=$(rays "$(name "$out/still" "$f")")
+  rc=$(rays "${brute[@]}")
+  notes+=("frame $f: rays traced: blurred $ra, unblurred $rb, 16 instants $rc ($(awk -v a="$ra" -v b="$rb" -v c="$rc" 'BEGIN { printf "%.2f and %.1f times the unblurred frame", a / b, c / b }'))")
   pfms=()
   for p in "${brute[@]}"; do pfms+=("${p%.sdf}.pfm"); done
   notes+=("frame $f: RMSE against the mean of the 16 instants: blurred $(rmse "$out/blurred/$(printf 'frame_%04d.pfm' "$f")" "${pfms[@]}") levels, unblurred $(rmse "$out/still/$(printf 'frame_%04d.pfm' "$f")" "${pfms[@]}") levels")
