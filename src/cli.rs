@@ -93,6 +93,10 @@ pub struct RenderArgs {
     /// Write .ppm files as ASCII (P3) instead of binary (P6).
     #[arg(long)]
     pub ppm_ascii: bool,
+    /// Also write each image's linear radiance, before tone mapping, beside it as a PFM file
+    /// (NAME.pfm: little-endian 32-bit floats, bottom row first).
+    #[arg(long)]
+    pub hdr: bool,
     /// Write images where render lines say even outside the scene's folder (or --out):
     /// absolute paths and paths climbing out with `..`.
     #[arg(long)]
@@ -350,6 +354,7 @@ impl RenderArgs {
             out_dir: self.out.clone(),
             allow_any_output: self.allow_any_output,
             max_memory: self.scene.max_memory(),
+            hdr: self.hdr,
         }
     }
 }

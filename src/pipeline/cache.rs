@@ -182,6 +182,7 @@ mod tests {
             out_dir,
             allow_any_output,
             max_memory,
+            hdr,
         } = base.clone();
         let LoadOptions {
             strict,
@@ -261,6 +262,13 @@ mod tests {
             (
                 RenderSettings {
                     max_memory: max_memory / 2,
+                    ..base.clone()
+                },
+                load.clone(),
+            ),
+            (
+                RenderSettings {
+                    hdr: !hdr,
                     ..base.clone()
                 },
                 load.clone(),

@@ -163,6 +163,22 @@ pub fn render_scene_file(
             );
             continue;
         }
+        // Two images of one stem (`a.png`, `a.ppm`) would write one radiance file.
+        let pfm_taken = settings.hdr
+            && targets
+                .iter()
+                .any(|(t, _): &(PathBuf, _)| film::hdr_path(t) == film::hdr_path(&out));
+        if pfm_taken {
+            errors.push(job_error(
+                path,
+                job,
+                format!(
+                    "with --hdr, '{}' would overwrite the radiance file of an earlier render line",
+                    film::hdr_path(&out).display()
+                ),
+            ));
+            continue;
+        }
         match ImageFormat::for_path(&out, settings.ppm_ascii) {
             Some(format) => targets.push((out, format)),
             None => errors.push(
@@ -279,7 +295,21 @@ fn render_jobs(
             }
         };
         rays += counts;
+        let hdr = settings.hdr.then(|| film::hdr_path(&out));
         outputs.push(Output { path: out, bytes });
+        if let Some(pfm) = hdr {
+            match film::write_pfm(&pfm, &image) {
+                Ok(bytes) => outputs.push(Output { path: pfm, bytes }),
+                Err(e) => {
+                    diagnostics.push(job_error(
+                        path,
+                        job,
+                        format!("cannot write '{}': {e}", pfm.display()),
+                    ));
+                    return Err(());
+                }
+            }
+        }
     }
     Ok((outputs, rays))
 }

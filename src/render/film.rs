@@ -1,5 +1,6 @@
-//! From HDR radiance to files: `c/(c+1)` tone mapping, `round(255·c)`, PNG/PPM encoding and
-//! atomic writes (a reader never sees a half-written image).
+//! From HDR radiance to files: `c/(c+1)` tone mapping, `round(255·c)`, PNG/PPM encoding, the
+//! linear radiance itself as PFM (`--hdr`), and atomic writes (a reader never sees a
+//! half-written image).
 
 use super::HdrImage;
 
@@ -115,6 +116,40 @@ pub fn write_image(path: &Path, img: &HdrImage, format: ImageFormat) -> io::Resu
     })
 }
 
+/// Where `--hdr` writes the linear radiance of the image written to `image`: beside it, with
+/// the extension `.pfm`.
+pub fn hdr_path(image: &Path) -> std::path::PathBuf {
+    image.with_extension("pfm")
+}
+
+/// Portable float map of the radiance before tone mapping: `PF`, the size, then a scale whose
+/// negative sign declares little-endian floats, then RGB `f32` triples with the bottom row
+/// first, as the format defines (readers such as POV-Ray, pfstools and OpenCV expect it).
+pub fn encode_pfm(img: &HdrImage) -> Vec<u8> {
+    let header = format!("PF\n{} {}\n-1.0\n", img.width, img.height);
+    let mut out = Vec::with_capacity(header.len() + img.pixels.len() * 12);
+    out.extend_from_slice(header.as_bytes());
+    let width = img.width.max(1) as usize;
+    for row in img.pixels.chunks(width).rev() {
+        for p in row {
+            for c in [p.x, p.y, p.z] {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+    }
+    out
+}
+
+/// Writes `img`'s radiance to `path` as PFM, atomically.
+pub fn write_pfm(path: &Path, img: &HdrImage) -> io::Result<ImageBytes> {
+    let encoded = encode_pfm(img);
+    crate::util::write_atomically(path, |w| w.write_all(&encoded))?;
+    Ok(ImageBytes {
+        len: encoded.len() as u64,
+        hash: crate::util::Fnv64::of(&encoded),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -163,6 +198,42 @@ mod tests {
         assert_eq!(written.hash, crate::util::Fnv64::of(&bytes));
         assert_eq!(&bytes[..11], b"P6\n2 1\n255\n");
         assert_eq!(&bytes[11..], &[128, 0, 191, 0, 0, 0]);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn pfm_is_little_endian_with_the_bottom_row_first() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = hdr_path(&dir.path().join("x.png"));
+        assert_eq!(path, dir.path().join("x.pfm"));
+        // Two rows: the top one (written last) holds 1.5 and 0.25, the bottom one 3 and 0.
+        let img = HdrImage {
+            width: 2,
+            height: 2,
+            pixels: vec![
+                Vec3::new(1.5, 0.0, 0.25),
+                Vec3::new(0.0, 2.0, 0.0),
+                Vec3::new(3.0, 0.0, 0.0),
+                Vec3::ZERO,
+            ],
+        };
+        let written = write_pfm(&path, &img).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        assert_eq!(written.len, bytes.len() as u64);
+        assert_eq!(written.hash, crate::util::Fnv64::of(&bytes));
+        let header = b"PF\n2 2\n-1.0\n";
+        assert_eq!(&bytes[..header.len()], header);
+        let floats: Vec<f32> = bytes[header.len()..]
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        assert_eq!(
+            floats,
+            [3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.5, 0.0, 0.25, 0.0, 2.0, 0.0]
+        );
+        // 1.5 is 0x3FC00000: the low byte comes first.
+        let first_top = header.len() + 2 * 3 * 4;
+        assert_eq!(&bytes[first_top..first_top + 4], &[0x00, 0x00, 0xC0, 0x3F]);
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 }

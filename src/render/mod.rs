@@ -42,6 +42,8 @@ pub struct RenderSettings {
     /// Bytes one image may take while it is made; bigger images are refused before any
     /// allocation.
     pub max_memory: u64,
+    /// Also write each image's linear radiance beside it as PFM (`film::hdr_path`).
+    pub hdr: bool,
 }
 
 impl Default for RenderSettings {
@@ -57,6 +59,7 @@ impl Default for RenderSettings {
             out_dir: None,
             allow_any_output: false,
             max_memory: crate::limits::default_memory_budget(),
+            hdr: false,
         }
     }
 }

@@ -160,3 +160,5 @@ pub fn unit(a: V) -> V {
     let l = dot(a, a).sqrt();
     [a[0] / l, a[1] / l, a[2] / l]
 }
+
+pub mod hdr;
