@@ -1,7 +1,7 @@
 use super::{NearFaces, ShapeHit};
 use crate::math::aabb::slabs;
-use crate::math::{Aabb, Ray};
-use glam::Vec3A;
+use crate::math::{Aabb, Ray, SLAB_WIDEN};
+use glam::{Mat4, Vec3A, Vec4};
 
 /// Axis-aligned box; a zero extent on one axis is allowed and renders as a rectangle.
 #[derive(Clone, Debug)]
@@ -75,6 +75,81 @@ impl AaBox {
             out.normals[axis] = n;
         }
         out
+    }
+}
+
+/// One ray splatted over four lanes, to slab-test four boxes at once.
+pub struct BoxRay {
+    origin: [Vec4; 3],
+    /// `1 / dir`, as `AaBox::intersect` computes it.
+    inv: [Vec4; 3],
+}
+
+/// Four boxes against one ray ([`BoxRay::slabs4`]): per lane the largest entry and the
+/// smallest exit over the three slabs, and the `w` of each box's `min`.
+pub struct Slabs4 {
+    pub enter: Vec4,
+    pub exit: Vec4,
+    pub tag: Vec4,
+}
+
+impl BoxRay {
+    #[inline]
+    pub fn new(ray: &Ray) -> BoxRay {
+        let inv = ray.dir.recip();
+        BoxRay {
+            origin: [0, 1, 2].map(|i| Vec4::splat(ray.origin[i])),
+            inv: [0, 1, 2].map(|i| Vec4::splat(inv[i])),
+        }
+    }
+
+    /// The slabs of four boxes given by their corners (`xyz`; `min`'s `w` is passed through
+    /// as `tag`), lane by lane the same operations as `AaBox::intersect` up to its `enter`
+    /// and `exit`: the same floats, but for the sign of a zero, which decides nothing there.
+    #[inline(always)]
+    pub fn slabs4(&self, min: [Vec4; 4], max: [Vec4; 4]) -> Slabs4 {
+        let lo = Mat4::from_cols(min[0], min[1], min[2], min[3]).transpose();
+        let hi = Mat4::from_cols(max[0], max[1], max[2], max[3]).transpose();
+        let (lo, hi) = (
+            [lo.x_axis, lo.y_axis, lo.z_axis, lo.w_axis],
+            [hi.x_axis, hi.y_axis, hi.z_axis],
+        );
+        let mut near = [Vec4::ZERO; 3];
+        let mut far = [Vec4::ZERO; 3];
+        for axis in 0..3 {
+            let t0 = (lo[axis] - self.origin[axis]) * self.inv[axis];
+            let t1 = (hi[axis] - self.origin[axis]) * self.inv[axis];
+            let on_plane = t0.is_nan_mask() | t1.is_nan_mask();
+            near[axis] = Vec4::select(on_plane, Vec4::NEG_INFINITY, t0.min(t1));
+            far[axis] = Vec4::select(on_plane, Vec4::INFINITY, t0.max(t1));
+        }
+        Slabs4 {
+            enter: near[0].max(near[1]).max(near[2]),
+            exit: far[0].min(far[1]).min(far[2]),
+            tag: lo[3],
+        }
+    }
+}
+
+impl Slabs4 {
+    /// `AaBox::intersect`'s distance: `(mask, t)` with bit `i` set when box `i` is hit at
+    /// `0 < t[i] < t_max`.
+    #[inline(always)]
+    pub fn hits(&self, t_max: f32) -> (u32, Vec4) {
+        let (enter, exit) = (self.enter, self.exit);
+        let t = Vec4::select(enter.cmpgt(Vec4::ZERO), enter, exit);
+        let missed = enter.cmpgt(exit) | exit.cmple(Vec4::ZERO);
+        ((!missed & t.cmplt(Vec4::splat(t_max))).bitmask(), t)
+    }
+
+    /// Whether the ray meets each box within `[0, t_max]`, as a hierarchy's node test
+    /// answers it (widened, so round-off never rejects a box the ray grazes): a shape whose
+    /// bounds these are cannot be hit elsewhere.
+    #[inline(always)]
+    pub fn overlaps(&self, t_max: f32) -> u32 {
+        let enter = self.enter.max(Vec4::ZERO);
+        let exit = (self.exit * SLAB_WIDEN).min(Vec4::splat(t_max));
+        enter.cmple(exit).bitmask()
     }
 }
 
