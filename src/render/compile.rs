@@ -524,42 +524,70 @@ impl RenderScene {
     /// anything does; which one, of several, is left to the hierarchy.
     #[inline]
     pub fn occluder(&self, ray: &Ray, t_max: f32) -> Option<u32> {
-        if let Some(i) =
-            (self.unbounded..self.len() as u32).find(|&i| self.hit(i, ray, t_max).is_some())
-        {
-            return Some(i);
+        let mut found = None;
+        self.any_hit(ray, t_max, |i| {
+            found = Some(i);
+            true
+        });
+        found
+    }
+
+    /// What a shadow ray meets before `t_max`, looking past transparent primitives for an
+    /// opaque one (which one, of several, is left to the hierarchy).
+    #[inline]
+    pub fn shadow(&self, ray: &Ray, t_max: f32) -> Shadow {
+        let mut seen = Shadow::Clear;
+        self.any_hit(ray, t_max, |i| {
+            // As the walk in `Integrator::visibility` tells them apart.
+            if !self.any_transparent || self.materials[self.material_of(i) as usize].opacity >= 1.0
+            {
+                seen = Shadow::Blocked(i);
+                return true;
+            }
+            seen = match seen {
+                // Inside an instanced composite, what lies past `i` is not looked at.
+                Shadow::Clear if i < self.len() as u32 => Shadow::Through(i),
+                Shadow::Through(j) if j == i => Shadow::Through(i),
+                _ => Shadow::Walk,
+            };
+            false
+        });
+        seen
+    }
+
+    /// Offers each primitive hit before `t_max` (in an instanced composite, the first hit of
+    /// each use) to `stop`, in the hierarchy's near-first order, until it returns true.
+    #[inline(always)]
+    fn any_hit(&self, ray: &Ray, t_max: f32, mut stop: impl FnMut(u32) -> bool) {
+        for i in self.unbounded..self.len() as u32 {
+            if self.hit(i, ray, t_max).is_some() && stop(i) {
+                return;
+            }
         }
         let lanes = SphereRay::new(ray);
-        let mut found = None;
         if self.all_spheres {
             self.bvh.any_leaves(ray, t_max, |leaf| {
                 let first = leaf[0] as usize;
                 let end = first + leaf.len();
-                for start in (first..end).step_by(LANES) {
+                (first..end).step_by(LANES).any(|start| {
                     let live = (end - start).min(LANES);
                     let mask = lanes.hit4(self.four_spheres(start), t_max).0 & ((1 << live) - 1);
-                    if mask != 0 {
-                        found = Some((start + mask.trailing_zeros() as usize) as u32);
-                        return true;
-                    }
-                }
-                false
+                    offer(start, mask, &mut stop)
+                })
             });
-            return found;
+            return;
         }
         let boxes = BoxRay::new(ray);
         self.bvh.any_leaves(ray, t_max, |leaf| {
             let first = leaf[0] as usize;
             for start in (first..first + leaf.len()).step_by(LANES) {
                 let c = self.classify(&boxes, start, first + leaf.len(), t_max);
-                if c.boxes_hit != 0 {
-                    found = Some((start + c.boxes_hit.trailing_zeros() as usize) as u32);
+                if offer(start, c.boxes_hit, &mut stop) {
                     return true;
                 }
                 if c.spheres != 0 {
                     let mask = lanes.hit4(self.four_spheres(start), t_max).0 & c.spheres;
-                    if mask != 0 {
-                        found = Some((start + mask.trailing_zeros() as usize) as u32);
+                    if offer(start, mask, &mut stop) {
                         return true;
                     }
                 }
@@ -567,7 +595,7 @@ impl RenderScene {
                 while near != 0 {
                     let k = near.trailing_zeros() as usize;
                     near &= near - 1;
-                    found = match self.kind[start + k] {
+                    let hit = match self.kind[start + k] {
                         u if is_use(u) => self
                             .instances
                             .as_ref()
@@ -576,14 +604,13 @@ impl RenderScene {
                             .hit(ray, t_max)
                             .map(|_| (start + k) as u32),
                     };
-                    if found.is_some() {
+                    if hit.is_some_and(&mut stop) {
                         return true;
                     }
                 }
             }
             false
         });
-        found
     }
 
     /// Offers every primitive the ray may meet before `t_max` to `stop`, in no particular
@@ -621,12 +648,40 @@ impl RenderScene {
     }
 }
 
+/// What a shadow ray meets ([`RenderScene::shadow`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shadow {
+    /// Nothing.
+    Clear,
+    /// This opaque primitive (and maybe more).
+    Blocked(u32),
+    /// This transparent primitive, maybe more than once, and nothing else.
+    Through(u32),
+    /// Transparent primitives only, but more than one, or some inside an instanced
+    /// composite: which of them it crosses, and how often, is for the caller to find out.
+    Walk,
+}
+
 /// Four primitives sorted by [`RenderScene::classify`], as lane masks.
 struct Lanes {
     spheres: u32,
     boxes_hit: u32,
     box_t: Vec4,
     others_near: u32,
+}
+
+/// Offers the lanes set in `mask` of the four primitives from `start` on to `stop`, in
+/// lane order, until it returns true (then true).
+#[inline(always)]
+fn offer(start: usize, mut mask: u32, stop: &mut impl FnMut(u32) -> bool) -> bool {
+    while mask != 0 {
+        let k = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        if stop((start + k) as u32) {
+            return true;
+        }
+    }
+    false
 }
 
 /// The four entries from `i` on.
