@@ -83,6 +83,10 @@ pub struct BoxRay {
     origin: [Vec4; 3],
     /// `1 / dir`, as `AaBox::intersect` computes it.
     inv: [Vec4; 3],
+    /// Whether no slab test of this ray can make NaN: `(b − o) · (1/d)` is NaN only for
+    /// `0 · ∞` (or `∞ − ∞`), never with a finite origin and every `1/d` finite and non-zero
+    /// (box coordinates are finite; unused lanes may hold NaN, whose results are not read).
+    nan_free: bool,
 }
 
 /// Four boxes against one ray ([`BoxRay::slabs4`]): per lane the largest entry and the
@@ -100,6 +104,7 @@ impl BoxRay {
         BoxRay {
             origin: [0, 1, 2].map(|i| Vec4::splat(ray.origin[i])),
             inv: [0, 1, 2].map(|i| Vec4::splat(inv[i])),
+            nan_free: ray.origin.is_finite() && inv.is_finite() && inv.cmpne(Vec3A::ZERO).all(),
         }
     }
 
@@ -108,6 +113,17 @@ impl BoxRay {
     /// and `exit`: the same floats, but for the sign of a zero, which decides nothing there.
     #[inline(always)]
     pub fn slabs4(&self, min: [Vec4; 4], max: [Vec4; 4]) -> Slabs4 {
+        if self.nan_free {
+            self.slabs::<true>(min, max)
+        } else {
+            self.slabs::<false>(min, max)
+        }
+    }
+
+    /// `slabs4`; `NAN_FREE` skips the repair of NaN for rays that cannot make it, where it
+    /// changes nothing.
+    #[inline(always)]
+    fn slabs<const NAN_FREE: bool>(&self, min: [Vec4; 4], max: [Vec4; 4]) -> Slabs4 {
         let lo = Mat4::from_cols(min[0], min[1], min[2], min[3]).transpose();
         let hi = Mat4::from_cols(max[0], max[1], max[2], max[3]).transpose();
         let (lo, hi) = (
@@ -119,6 +135,11 @@ impl BoxRay {
         for axis in 0..3 {
             let t0 = (lo[axis] - self.origin[axis]) * self.inv[axis];
             let t1 = (hi[axis] - self.origin[axis]) * self.inv[axis];
+            if NAN_FREE {
+                near[axis] = t0.min(t1);
+                far[axis] = t0.max(t1);
+                continue;
+            }
             let on_plane = t0.is_nan_mask() | t1.is_nan_mask();
             near[axis] = Vec4::select(on_plane, Vec4::NEG_INFINITY, t0.min(t1));
             far[axis] = Vec4::select(on_plane, Vec4::INFINITY, t0.max(t1));
