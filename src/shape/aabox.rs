@@ -225,6 +225,38 @@ mod tests {
     }
 
     #[test]
+    fn four_at_a_time_gives_the_scalar_distances() {
+        // Rays from inside, outside, parallel to slabs and on their planes (NaN there).
+        let boxes = [
+            AaBox::new(Vec3A::splat(-1.0), Vec3A::splat(1.0)).unwrap(),
+            AaBox::new(Vec3A::new(0.0, -2.0, 3.0), Vec3A::new(0.5, 2.0, 3.0)).unwrap(),
+            AaBox::new(Vec3A::new(-6.0, 0.0, -14.0), Vec3A::new(6.0, 0.2, 4.0)).unwrap(),
+            AaBox::new(Vec3A::new(2.0, 2.0, 2.0), Vec3A::new(4.0, 3.0, 2.5)).unwrap(),
+        ];
+        let min = boxes.each_ref().map(|b| b.min.extend(0.0));
+        let max = boxes.each_ref().map(|b| b.max.extend(0.0));
+        let coords = [-3.0f32, -1.0, 0.0, 0.25, 1.0, 3.0];
+        let mut checked = 0;
+        for (i, &ox) in coords.iter().enumerate() {
+            for &oy in &coords {
+                for (k, &dz) in coords.iter().enumerate() {
+                    let o = Vec3A::new(ox, oy, coords[(i + k) % 6]);
+                    let d = Vec3A::new(coords[k], dz - oy, 1.0 - ox);
+                    let ray = Ray::new(o, d);
+                    let (mask, t) = BoxRay::new(&ray).slabs4(min, max).hits(10.0);
+                    for (lane, b) in boxes.iter().enumerate() {
+                        let scalar = b.intersect(&ray, 10.0).map(|h| h.t);
+                        let packed = (mask & (1 << lane) != 0).then_some(t[lane]);
+                        assert_eq!(packed, scalar, "box {lane}, {ray:?}");
+                        checked += usize::from(scalar.is_some());
+                    }
+                }
+            }
+        }
+        assert!(checked > 100, "{checked} hits");
+    }
+
+    #[test]
     fn flat_box_is_a_rectangle() {
         let b = AaBox::new(Vec3A::new(-1.0, -1.0, 0.0), Vec3A::new(1.0, 1.0, 0.0)).unwrap();
         let h = b
