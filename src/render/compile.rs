@@ -9,7 +9,7 @@ use super::primitive::{Primitive, SurfaceHit};
 use crate::accel::Bvh;
 use crate::math::Ray;
 use crate::scene::{Material, Scene};
-use crate::shape::{Shape, ShapeHit, Sphere, SphereRay};
+use crate::shape::{BoxRay, Shape, ShapeHit, Sphere, SphereRay};
 use glam::{Vec3A, Vec4};
 use instance::{Best, Instances};
 use motion::Moving;
@@ -56,8 +56,14 @@ const USE: u32 = 1 << 31;
 /// `RenderScene::kind` of a shape that moves during the exposure: these bits, and its index
 /// among the moving entries (`motion::Moving`).
 const MOVING: u32 = USE | 1 << 30;
-/// Spheres tested at once.
+/// Spheres (or boxes) tested at once.
 const LANES: usize = 4;
+/// `w` of `RenderScene::bounds_min` for a world-space box (its bounds are the box itself,
+/// and their slab test gives its hit), for any other kind whose bounds are tested before its
+/// own test, and for a packed sphere (tested by `SphereRay::hit4` instead).
+const BOUNDS_OF_BOX: f32 = 1.0;
+const BOUNDS_OF_OTHER: f32 = 0.0;
+const BOUNDS_OF_SPHERE: f32 = -1.0;
 
 /// Primitives are numbered in the BVH's leaf order (so a leaf reads consecutive entries),
 /// then the unbounded ones. World-space spheres, the common case, are packed into 16 bytes
@@ -72,6 +78,12 @@ pub struct RenderScene {
     /// sphere test hits), then `LANES - 1` NaN entries so a leaf can always load four.
     spheres: Vec<Vec4>,
     objects: Vec<Primitive>,
+    /// Per primitive: its world bounds, `w` telling its kind (`BOUNDS_OF_BOX` ...), then
+    /// `LANES - 1` NaN entries, so that a leaf slab-tests four at once (world-space boxes are
+    /// hit by that test alone, other kinds only tested where it passes). Empty when every
+    /// primitive is a packed sphere.
+    bounds_min: Vec<Vec4>,
+    bounds_max: Vec<Vec4>,
     /// Per primitive: its depth-first number in the flattened composite tree, which breaks
     /// ties between equally close hits (the first in the tree wins), whatever order the
     /// hierarchy offers them in.
@@ -113,6 +125,7 @@ impl RenderScene {
         let mut spheres = Vec::with_capacity(n + LANES - 1);
         let mut bounds = Vec::with_capacity(n);
         let mut objects = Vec::new();
+        let mut tags = Vec::with_capacity(n);
         let mut dropped = Vec::new();
         let mut key = Vec::with_capacity(n);
         let offsets = &scene.instanced.offsets;
@@ -122,6 +135,7 @@ impl RenderScene {
                 let (k, b) = m.add(index);
                 key.push(offsets.get(index).copied().unwrap_or(index as u32));
                 bounds.push(b);
+                tags.push(BOUNDS_OF_OTHER);
                 material.push(inst.material as u32);
                 kind.push(MOVING | k);
                 spheres.push(Vec4::NAN);
@@ -136,6 +150,13 @@ impl RenderScene {
                     key.push(offsets.get(index).copied().unwrap_or(index as u32));
                     bounds.push(p.bounds);
                     material.push(p.material);
+                    tags.push(if p.world_box().is_some() {
+                        BOUNDS_OF_BOX
+                    } else if p.world_sphere().is_some() {
+                        BOUNDS_OF_SPHERE
+                    } else {
+                        BOUNDS_OF_OTHER
+                    });
                     if let Some(s) = p.world_sphere() {
                         spheres.push(s.packed());
                         kind.push(SPHERE);
@@ -161,6 +182,7 @@ impl RenderScene {
         if let Some(inst) = &instances {
             for (k, (b, u)) in inst.use_bounds().zip(&scene.instanced.uses).enumerate() {
                 bounds.push(b);
+                tags.push(BOUNDS_OF_OTHER);
                 material.push(0);
                 kind.push(USE | k as u32);
                 spheres.push(Vec4::NAN);
@@ -170,10 +192,26 @@ impl RenderScene {
         let (bounded, unbounded): (Vec<u32>, Vec<u32>) =
             (0..material.len() as u32).partition(|&i| bounds[i as usize].is_finite());
         let mut bvh = Bvh::build(&bounds, bounded);
-        drop(bounds);
         let mut order = bvh.renumber_in_leaf_order();
         let first_unbounded = order.len() as u32;
         order.extend(unbounded);
+        let all_spheres = tags.iter().all(|&t| t == BOUNDS_OF_SPHERE);
+        let (mut bounds_min, mut bounds_max) = if all_spheres {
+            (Vec::new(), Vec::new())
+        } else {
+            order
+                .iter()
+                .map(|&i| {
+                    let (b, tag) = (bounds[i as usize], tags[i as usize]);
+                    (b.min.extend(tag), b.max.extend(tag))
+                })
+                .unzip()
+        };
+        if !all_spheres {
+            bounds_min.resize(order.len() + LANES - 1, Vec4::NAN);
+            bounds_max.resize(order.len() + LANES - 1, Vec4::NAN);
+        }
+        drop((bounds, tags));
         let permute = |v: &[u32]| order.iter().map(|&i| v[i as usize]).collect::<Vec<u32>>();
         let (material, kind, key) = (permute(&material), permute(&kind), permute(&key));
         let mut spheres: Vec<Vec4> = order.iter().map(|&i| spheres[i as usize]).collect();
@@ -222,13 +260,14 @@ impl RenderScene {
             })
             .fold(0.0f32, f32::max);
         let max_radiance = max_local.max(background.max_element());
-        let all_spheres = kind.iter().all(|&k| k == SPHERE);
         let scene = RenderScene {
             all_spheres,
             material,
             kind,
             spheres,
             objects,
+            bounds_min,
+            bounds_max,
             key,
             instances,
             moving,
@@ -315,8 +354,7 @@ impl RenderScene {
     /// The four packed spheres from primitive `i` on.
     #[inline(always)]
     fn four_spheres(&self, i: usize) -> [Vec4; LANES] {
-        let s = &self.spheres[i..i + LANES];
-        [s[0], s[1], s[2], s[3]]
+        four(&self.spheres, i)
     }
 
     /// Distance to primitive `i` along the ray, if it is hit with `0 < t < t_max`.
@@ -366,8 +404,9 @@ impl RenderScene {
                 self.closest_in_sphere_leaf(&lanes, leaf, t_max, &mut best)
             });
         } else {
+            let boxes = BoxRay::new(ray);
             self.bvh.closest_leaves(ray, t_best, |leaf, t_max| {
-                self.closest_in_leaf(&lanes, ray, leaf, t_max, &mut best, &mut won)
+                self.closest_in_leaf(&lanes, &boxes, ray, leaf, t_max, &mut best, &mut won)
             });
         }
         self.surface_of(ray, best?, won)
@@ -415,6 +454,12 @@ impl RenderScene {
         let surface = match (self.kind.get(i as usize).copied(), hit) {
             (Some(SPHERE), _) => sphere_surface(&self.sphere(i as usize).hit_at(ray, t)),
             (Some(o), Some(h)) if !is_moving(o) => self.objects[o as usize].surface(&h),
+            // A box hit by the four-at-a-time test: its own test finds the same `t`, and the
+            // rest of the hit, for the winner alone.
+            (Some(o), None) if !is_moving(o) => {
+                let p = &self.objects[o as usize];
+                p.surface(&p.hit(ray, t.next_up())?)
+            }
             (_, Some(h)) => {
                 let p = won?;
                 match p.world_sphere() {
@@ -422,7 +467,7 @@ impl RenderScene {
                     None => p.surface(&h),
                 }
             }
-            (_, None) => unreachable!("objects keep their hit"),
+            (_, None) => unreachable!("instanced and moving shapes keep their hit"),
         };
         Some((i, surface))
     }
@@ -463,11 +508,15 @@ impl RenderScene {
         t_max
     }
 
-    /// Tests one leaf's primitives (see `closest`); returns the new `t_max`.
+    /// Tests one leaf's primitives (see `closest`); returns the new `t_max`. Of each four,
+    /// only those hit (spheres, boxes) or whose bounds the ray meets (other kinds) are looked
+    /// at, in lane order, which is the order the leaf lists them in.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn closest_in_leaf(
         &self,
         lanes: &SphereRay,
+        boxes: &BoxRay,
         ray: &Ray,
         leaf: &[u32],
         mut t_max: f32,
@@ -475,30 +524,26 @@ impl RenderScene {
         won: &mut Option<Primitive>,
     ) -> f32 {
         let first = leaf[0] as usize;
+        let end = first + leaf.len();
         // A hit as close as the kept one is found too, to be judged by its number.
         let limit = t_max.next_up();
-        for start in (first..first + leaf.len()).step_by(LANES) {
-            // Tested when the first sphere comes up, so leaves of other kinds skip it.
-            let mut four = None;
-            for k in 0..(first + leaf.len() - start).min(LANES) {
+        for start in (first..end).step_by(LANES) {
+            let c = self.classify(boxes, start, end, limit);
+            let (sphere_hit, sphere_t) = if c.spheres != 0 {
+                lanes.hit4(self.four_spheres(start), limit)
+            } else {
+                (0, Vec4::ZERO)
+            };
+            let mut todo = (sphere_hit & c.spheres) | c.boxes_hit | c.others_near;
+            while todo != 0 {
+                let k = todo.trailing_zeros() as usize;
+                todo &= todo - 1;
                 let i = start + k;
-                match self.kind[i] {
-                    SPHERE => {
-                        let (mask, t) = *four
-                            .get_or_insert_with(|| lanes.hit4(self.four_spheres(start), limit));
-                        if mask & (1 << k) != 0 && Best::loses_to(best, t_max, t[k], self.key[i]) {
-                            t_max = t[k];
-                            *best = Some(Best {
-                                id: i as u32,
-                                t: t_max,
-                                key: self.key[i],
-                                hit: None,
-                            });
-                        }
-                    }
-                    m if is_moving(m) => {
+                let (t, hit) = if c.others_near & (1 << k) != 0 {
+                    let kind = self.kind[i];
+                    if is_moving(kind) {
                         let h = self
-                            .moving_with(m, ray, |p| p.hit(ray, t_max.next_up()))
+                            .moving_with(kind, ray, |p| p.hit(ray, t_max.next_up()))
                             .flatten();
                         if let Some(h) = h.filter(|h| Best::loses_to(best, t_max, h.t, self.key[i]))
                         {
@@ -509,31 +554,54 @@ impl RenderScene {
                                 key: self.key[i],
                                 hit: Some(h),
                             });
-                            *won = self.moving_with(m, ray, Primitive::clone);
+                            *won = self.moving_with(kind, ray, Primitive::clone);
                         }
+                        continue;
                     }
-                    u if is_use(u) => {
+                    if is_use(kind) {
                         if let Some(inst) = &self.instances {
-                            inst.closest(u & !USE, ray, &mut t_max, best, won);
+                            inst.closest(kind & !USE, ray, &mut t_max, best, won);
                         }
+                        continue;
                     }
-                    o => {
-                        if let Some(h) = self.objects[o as usize].hit(ray, t_max.next_up()) {
-                            if Best::loses_to(best, t_max, h.t, self.key[i]) {
-                                t_max = h.t;
-                                *best = Some(Best {
-                                    id: i as u32,
-                                    t: t_max,
-                                    key: self.key[i],
-                                    hit: Some(h),
-                                });
-                            }
-                        }
+                    match self.objects[kind as usize].hit(ray, t_max.next_up()) {
+                        Some(h) => (h.t, Some(h)),
+                        None => continue,
                     }
+                } else if c.spheres & (1 << k) != 0 {
+                    (sphere_t[k], None)
+                } else {
+                    (c.box_t[k], None)
+                };
+                if Best::loses_to(best, t_max, t, self.key[i]) {
+                    t_max = t;
+                    *best = Some(Best {
+                        id: i as u32,
+                        t,
+                        key: self.key[i],
+                        hit,
+                    });
                 }
             }
         }
         t_max
+    }
+
+    /// The four primitives from `start` on (those before `end`), sorted by the slab test of
+    /// their bounds: the packed spheres; the boxes hit before `t_max`, and where; the other
+    /// kinds whose bounds the ray meets before `t_max`.
+    #[inline(always)]
+    fn classify(&self, boxes: &BoxRay, start: usize, end: usize, t_max: f32) -> Lanes {
+        let s = boxes.slabs4(four(&self.bounds_min, start), four(&self.bounds_max, start));
+        let live = (1 << (end - start).min(LANES)) - 1;
+        let tagged = |tag: f32| s.tag.cmpeq(Vec4::splat(tag)).bitmask() & live;
+        let (hit, box_t) = s.hits(t_max);
+        Lanes {
+            spheres: tagged(BOUNDS_OF_SPHERE),
+            boxes_hit: hit & tagged(BOUNDS_OF_BOX),
+            box_t,
+            others_near: s.overlaps(t_max) & tagged(BOUNDS_OF_OTHER),
+        }
     }
 
     #[inline]
@@ -555,45 +623,78 @@ impl RenderScene {
     /// anything does; which one, of several, is left to the hierarchy.
     #[inline]
     pub fn occluder(&self, ray: &Ray, t_max: f32) -> Option<u32> {
-        if let Some(i) =
-            (self.unbounded..self.len() as u32).find(|&i| self.hit(i, ray, t_max).is_some())
-        {
-            return Some(i);
+        let mut found = None;
+        self.any_hit(ray, t_max, |i| {
+            found = Some(i);
+            true
+        });
+        found
+    }
+
+    /// What a shadow ray meets before `t_max`, looking past transparent primitives for an
+    /// opaque one (which one, of several, is left to the hierarchy).
+    #[inline]
+    pub fn shadow(&self, ray: &Ray, t_max: f32) -> Shadow {
+        let mut seen = Shadow::Clear;
+        self.any_hit(ray, t_max, |i| {
+            // As the walk in `Integrator::visibility` tells them apart.
+            if !self.any_transparent || self.materials[self.material_of(i) as usize].opacity >= 1.0
+            {
+                seen = Shadow::Blocked(i);
+                return true;
+            }
+            seen = match seen {
+                // Inside an instanced composite, what lies past `i` is not looked at.
+                Shadow::Clear if i < self.len() as u32 => Shadow::Through(i),
+                Shadow::Through(j) if j == i => Shadow::Through(i),
+                _ => Shadow::Walk,
+            };
+            false
+        });
+        seen
+    }
+
+    /// Offers each primitive hit before `t_max` (in an instanced composite, the first hit of
+    /// each use) to `stop`, in the hierarchy's near-first order, until it returns true.
+    #[inline(always)]
+    fn any_hit(&self, ray: &Ray, t_max: f32, mut stop: impl FnMut(u32) -> bool) {
+        for i in self.unbounded..self.len() as u32 {
+            if self.hit(i, ray, t_max).is_some() && stop(i) {
+                return;
+            }
         }
         let lanes = SphereRay::new(ray);
-        let mut found = None;
         if self.all_spheres {
             self.bvh.any_leaves(ray, t_max, |leaf| {
                 let first = leaf[0] as usize;
                 let end = first + leaf.len();
-                for start in (first..end).step_by(LANES) {
+                (first..end).step_by(LANES).any(|start| {
                     let live = (end - start).min(LANES);
                     let mask = lanes.hit4(self.four_spheres(start), t_max).0 & ((1 << live) - 1);
-                    if mask != 0 {
-                        found = Some((start + mask.trailing_zeros() as usize) as u32);
-                        return true;
-                    }
-                }
-                false
+                    offer(start, mask, &mut stop)
+                })
             });
-            return found;
+            return;
         }
+        let boxes = BoxRay::new(ray);
         self.bvh.any_leaves(ray, t_max, |leaf| {
             let first = leaf[0] as usize;
             for start in (first..first + leaf.len()).step_by(LANES) {
-                let live = (first + leaf.len() - start).min(LANES);
-                let kinds = &self.kind[start..start + live];
-                // Other kinds hold NaN, which no sphere test hits.
-                if kinds.contains(&SPHERE) {
-                    let mask = lanes.hit4(self.four_spheres(start), t_max).0 & ((1 << live) - 1);
-                    if mask != 0 {
-                        found = Some((start + mask.trailing_zeros() as usize) as u32);
+                let c = self.classify(&boxes, start, first + leaf.len(), t_max);
+                if offer(start, c.boxes_hit, &mut stop) {
+                    return true;
+                }
+                if c.spheres != 0 {
+                    let mask = lanes.hit4(self.four_spheres(start), t_max).0 & c.spheres;
+                    if offer(start, mask, &mut stop) {
                         return true;
                     }
                 }
-                for (k, &kind) in kinds.iter().enumerate() {
-                    found = match kind {
-                        SPHERE => None,
+                let mut near = c.others_near;
+                while near != 0 {
+                    let k = near.trailing_zeros() as usize;
+                    near &= near - 1;
+                    let hit = match self.kind[start + k] {
                         m if is_moving(m) => self
                             .moving_with(m, ray, |p| p.hit(ray, t_max).is_some())
                             .filter(|&hit| hit)
@@ -606,14 +707,13 @@ impl RenderScene {
                             .hit(ray, t_max)
                             .map(|_| (start + k) as u32),
                     };
-                    if found.is_some() {
+                    if hit.is_some_and(&mut stop) {
                         return true;
                     }
                 }
             }
             false
         });
-        found
     }
 
     /// Offers every primitive the ray may meet before `t_max` to `stop`, in no particular
@@ -635,7 +735,8 @@ impl RenderScene {
     pub fn geometry_bytes(&self) -> usize {
         self.material.capacity() * 4
             + self.kind.capacity() * 4
-            + self.spheres.capacity() * std::mem::size_of::<Vec4>()
+            + (self.spheres.capacity() + self.bounds_min.capacity() + self.bounds_max.capacity())
+                * std::mem::size_of::<Vec4>()
             + self.objects.capacity() * std::mem::size_of::<Primitive>()
             + self.key.capacity() * 4
             + self.bvh.memory_bytes()
@@ -657,6 +758,49 @@ impl RenderScene {
 #[inline(always)]
 fn is_moving(kind: u32) -> bool {
     kind != SPHERE && kind & MOVING == MOVING
+}
+
+/// What a shadow ray meets ([`RenderScene::shadow`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shadow {
+    /// Nothing.
+    Clear,
+    /// This opaque primitive (and maybe more).
+    Blocked(u32),
+    /// This transparent primitive, maybe more than once, and nothing else.
+    Through(u32),
+    /// Transparent primitives only, but more than one, or some inside an instanced
+    /// composite: which of them it crosses, and how often, is for the caller to find out.
+    Walk,
+}
+
+/// Four primitives sorted by [`RenderScene::classify`], as lane masks.
+struct Lanes {
+    spheres: u32,
+    boxes_hit: u32,
+    box_t: Vec4,
+    others_near: u32,
+}
+
+/// Offers the lanes set in `mask` of the four primitives from `start` on to `stop`, in
+/// lane order, until it returns true (then true).
+#[inline(always)]
+fn offer(start: usize, mut mask: u32, stop: &mut impl FnMut(u32) -> bool) -> bool {
+    while mask != 0 {
+        let k = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        if stop((start + k) as u32) {
+            return true;
+        }
+    }
+    false
+}
+
+/// The four entries from `i` on.
+#[inline(always)]
+fn four(v: &[Vec4], i: usize) -> [Vec4; LANES] {
+    let s = &v[i..i + LANES];
+    [s[0], s[1], s[2], s[3]]
 }
 
 /// Whether a `kind` is a top-level use of a prototype.

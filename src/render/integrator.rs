@@ -1,7 +1,7 @@
 //! Whitted-style shading: the local Phong model of docs/shading.md §2 with hard shadows, mirror
 //! reflection and Fresnel refraction.
 
-use super::compile::{RenderScene, ShadeMaterial};
+use super::compile::{RenderScene, ShadeMaterial, Shadow};
 use super::primitive::SurfaceHit;
 use super::RayCounts;
 use crate::math::{reflect, Ray};
@@ -219,19 +219,26 @@ impl Integrator<'_> {
                 return 0.0;
             }
         }
-        // Most shadow rays meet nothing at all; the plain any-hit query (packed spheres four
-        // at a time) says so for them. Only a ray that meets something needs the walk below,
-        // which tells glass from opaque and names the blocker for the next ray.
-        let Some(first) = scene.occluder(&ray, remaining) else {
-            return 1.0;
-        };
-        // Without glass, what it met is opaque: no light, and the blocker to try next time.
-        if !scene.any_transparent {
-            if let Some(b) = blocker {
-                *b = first;
+        // Most shadow rays meet nothing at all, or one glass object: the any-hit query
+        // (packed primitives four at a time) says so, looking past glass for an opaque
+        // blocker, which means no light whatever else the ray crosses.
+        match scene.shadow(&ray, remaining) {
+            Shadow::Clear => return 1.0,
+            Shadow::Blocked(first) => {
+                if let Some(b) = blocker {
+                    *b = first;
+                }
+                return 0.0;
             }
-            return 0.0;
+            // One object's crossings alone: the walk below would multiply the same factors
+            // in the same order, and nothing else.
+            Shadow::Through(i) => {
+                return self.transmittance(&ray, i, l, light, remaining, 1.0);
+            }
+            Shadow::Walk => {}
         }
+        // Glass of several objects: the walk tells glass from opaque, and names the blocker
+        // for the next ray.
         let mut transmit = 1.0f32;
         let blocked = scene.any_candidate(&ray, remaining, |i| {
             let opacity = scene.materials[scene.material_of(i) as usize].opacity;
@@ -242,30 +249,46 @@ impl Integrator<'_> {
                 }
                 return hit;
             }
-            // Count this object's crossings along the segment, stepping past each one.
-            let mut segment = ray;
-            let mut left = remaining;
-            for _ in 0..MAX_SHADOW_CROSSINGS {
-                let Some(hit) = scene.intersect(i, &segment, left) else {
-                    break;
-                };
-                transmit *= 1.0 - opacity;
-                if transmit == 0.0 {
-                    return true;
-                }
-                segment = hit.spawn_ray(l).at_time(time);
-                left = (light - segment.origin).dot(l);
-                if left <= 0.0 {
-                    break;
-                }
-            }
-            false
+            transmit = self.transmittance(&ray, i, l, light, remaining, transmit);
+            transmit == 0.0
         });
         if blocked {
             0.0
         } else {
             transmit
         }
+    }
+
+    /// `transmit` times `1 − α` for every crossing of transparent primitive `i` along `ray`
+    /// (unit direction `l`) before `remaining`, the distance to `light`, stepping past each.
+    fn transmittance(
+        &self,
+        ray: &Ray,
+        i: u32,
+        l: Vec3A,
+        light: Vec3A,
+        remaining: f32,
+        mut transmit: f32,
+    ) -> f32 {
+        let scene = self.scene;
+        let opacity = scene.materials[scene.material_of(i) as usize].opacity;
+        let mut segment = *ray;
+        let mut left = remaining;
+        for _ in 0..MAX_SHADOW_CROSSINGS {
+            let Some(hit) = scene.intersect(i, &segment, left) else {
+                break;
+            };
+            transmit *= 1.0 - opacity;
+            if transmit == 0.0 {
+                break;
+            }
+            segment = hit.spawn_ray(l).at_time(ray.time);
+            left = (light - segment.origin).dot(l);
+            if left <= 0.0 {
+                break;
+            }
+        }
+        transmit
     }
 }
 

@@ -394,6 +394,14 @@ impl Primitive {
     /// `quadric_apex_and_rims_are_watertight`).
     #[inline]
     pub fn surface(&self, hit: &ShapeHit) -> SurfaceHit {
+        if let Some(lift) = self.world_box_face_lift(hit) {
+            return SurfaceHit {
+                t: hit.t,
+                point: hit.point,
+                normal: lift.inward,
+                lift,
+            };
+        }
         let mut near = self.shape.faces_near(hit);
         let (point, normal, lift) = match &self.object {
             None => {
@@ -445,6 +453,34 @@ impl Primitive {
         }
     }
 
+    /// The lift `surface` gives a hit on a world-space box away from its edges, without the
+    /// general path's work (most hits of a room's walls). There every face normal is a unit
+    /// axis, so `world_faces` maps them exactly and the normal of the hit face is
+    /// perpendicular to the others: `lift_off` keeps the hit face alone, its normal both ways
+    /// by the error bound, as long as each other face lies farther than `error` and does not
+    /// join on the inward move (`dist < error + per·s`). Then it returns the same `Lift`;
+    /// otherwise `None`, and the general path decides.
+    #[inline]
+    fn world_box_face_lift(&self, hit: &ShapeHit) -> Option<Lift> {
+        let (Shape::Box(b), None) = (&self.shape, &self.object) else {
+            return None;
+        };
+        let normal = hit.normal.normalize_or_zero();
+        let (error, per) = world_space_error(hit.point);
+        let min = error / (1.0 - per);
+        let s = relative_offset(hit.point).max(min);
+        let clear = |axis: usize| {
+            let p = hit.point[axis];
+            let dist = (p - b.min[axis]).min(b.max[axis] - p).max(0.0);
+            hit.normal[axis] != 0.0 || (dist > error && dist >= error + per * s)
+        };
+        (clear(0) && clear(1) && clear(2)).then_some(Lift {
+            outward_min: min,
+            inward: normal,
+            inward_min: min,
+        })
+    }
+
     /// The apex's way out for a hit at shape-space point `at` (world point `world`) next to a
     /// cone's apex, where the inward move `lift` makes (mapped to shape space by `to_shape`)
     /// would cross the thin tip (`Shape::apex_escape_near`).
@@ -492,6 +528,15 @@ impl Primitive {
     pub fn world_sphere(&self) -> Option<&Sphere> {
         match (&self.shape, &self.object) {
             (Shape::Sphere(s), None) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// The box, when this is one baked into world space (the render scene slab-tests those
+    /// four at a time).
+    pub fn world_box(&self) -> Option<&AaBox> {
+        match (&self.shape, &self.object) {
+            (Shape::Box(b), None) => Some(b),
             _ => None,
         }
     }

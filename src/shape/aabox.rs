@@ -1,7 +1,7 @@
 use super::{NearFaces, ShapeHit};
 use crate::math::aabb::slabs;
-use crate::math::{Aabb, Ray};
-use glam::Vec3A;
+use crate::math::{Aabb, Ray, SLAB_WIDEN};
+use glam::{Mat4, Vec3A, Vec4};
 
 /// Axis-aligned box; a zero extent on one axis is allowed and renders as a rectangle.
 #[derive(Clone, Debug)]
@@ -78,6 +78,102 @@ impl AaBox {
     }
 }
 
+/// One ray splatted over four lanes, to slab-test four boxes at once.
+pub struct BoxRay {
+    origin: [Vec4; 3],
+    /// `1 / dir`, as `AaBox::intersect` computes it.
+    inv: [Vec4; 3],
+    /// Whether no slab test of this ray can make NaN: `(b − o) · (1/d)` is NaN only for
+    /// `0 · ∞` (or `∞ − ∞`), never with a finite origin and every `1/d` finite and non-zero
+    /// (box coordinates are finite; unused lanes may hold NaN, whose results are not read).
+    nan_free: bool,
+}
+
+/// Four boxes against one ray ([`BoxRay::slabs4`]): per lane the largest entry and the
+/// smallest exit over the three slabs, and the `w` of each box's `min`.
+pub struct Slabs4 {
+    pub enter: Vec4,
+    pub exit: Vec4,
+    pub tag: Vec4,
+}
+
+impl BoxRay {
+    #[inline]
+    pub fn new(ray: &Ray) -> BoxRay {
+        let inv = ray.dir.recip();
+        BoxRay {
+            origin: [0, 1, 2].map(|i| Vec4::splat(ray.origin[i])),
+            inv: [0, 1, 2].map(|i| Vec4::splat(inv[i])),
+            nan_free: ray.origin.is_finite() && inv.is_finite() && inv.cmpne(Vec3A::ZERO).all(),
+        }
+    }
+
+    /// The slabs of four boxes given by their corners (`xyz`; `min`'s `w` is passed through
+    /// as `tag`), lane by lane the same operations as `AaBox::intersect` up to its `enter`
+    /// and `exit`: the same floats, but for the sign of a zero, which decides nothing there.
+    #[inline(always)]
+    pub fn slabs4(&self, min: [Vec4; 4], max: [Vec4; 4]) -> Slabs4 {
+        if self.nan_free {
+            self.slabs::<true>(min, max)
+        } else {
+            self.slabs::<false>(min, max)
+        }
+    }
+
+    /// `slabs4`; `NAN_FREE` skips the repair of NaN for rays that cannot make it, where it
+    /// changes nothing.
+    #[inline(always)]
+    fn slabs<const NAN_FREE: bool>(&self, min: [Vec4; 4], max: [Vec4; 4]) -> Slabs4 {
+        let lo = Mat4::from_cols(min[0], min[1], min[2], min[3]).transpose();
+        let hi = Mat4::from_cols(max[0], max[1], max[2], max[3]).transpose();
+        let (lo, hi) = (
+            [lo.x_axis, lo.y_axis, lo.z_axis, lo.w_axis],
+            [hi.x_axis, hi.y_axis, hi.z_axis],
+        );
+        let mut near = [Vec4::ZERO; 3];
+        let mut far = [Vec4::ZERO; 3];
+        for axis in 0..3 {
+            let t0 = (lo[axis] - self.origin[axis]) * self.inv[axis];
+            let t1 = (hi[axis] - self.origin[axis]) * self.inv[axis];
+            if NAN_FREE {
+                near[axis] = t0.min(t1);
+                far[axis] = t0.max(t1);
+                continue;
+            }
+            let on_plane = t0.is_nan_mask() | t1.is_nan_mask();
+            near[axis] = Vec4::select(on_plane, Vec4::NEG_INFINITY, t0.min(t1));
+            far[axis] = Vec4::select(on_plane, Vec4::INFINITY, t0.max(t1));
+        }
+        Slabs4 {
+            enter: near[0].max(near[1]).max(near[2]),
+            exit: far[0].min(far[1]).min(far[2]),
+            tag: lo[3],
+        }
+    }
+}
+
+impl Slabs4 {
+    /// `AaBox::intersect`'s distance: `(mask, t)` with bit `i` set when box `i` is hit at
+    /// `0 < t[i] < t_max`.
+    #[inline(always)]
+    pub fn hits(&self, t_max: f32) -> (u32, Vec4) {
+        let (enter, exit) = (self.enter, self.exit);
+        let t = Vec4::select(enter.cmpgt(Vec4::ZERO), enter, exit);
+        let missed = enter.cmpgt(exit) | exit.cmple(Vec4::ZERO);
+        ((!missed & t.cmplt(Vec4::splat(t_max))).bitmask(), t)
+    }
+
+    /// Whether the ray meets each box within `[0, t_max]`, as a hierarchy's node test
+    /// answers it (widened, so round-off never rejects a box the ray grazes): a shape whose
+    /// bounds these are cannot be hit elsewhere.
+    #[inline(always)]
+    pub fn overlaps(&self, t_max: f32) -> u32 {
+        let enter = self.enter.max(Vec4::ZERO);
+        let exit = (self.exit * SLAB_WIDEN).min(Vec4::splat(t_max));
+        enter.cmple(exit).bitmask()
+    }
+}
+
 fn max_axis(v: Vec3A) -> usize {
     if v.x >= v.y && v.x >= v.z {
         0
@@ -126,6 +222,38 @@ mod tests {
             .unwrap();
         assert_eq!(inside.t, 1.0);
         assert_eq!(inside.normal, Vec3A::X);
+    }
+
+    #[test]
+    fn four_at_a_time_gives_the_scalar_distances() {
+        // Rays from inside, outside, parallel to slabs and on their planes (NaN there).
+        let boxes = [
+            AaBox::new(Vec3A::splat(-1.0), Vec3A::splat(1.0)).unwrap(),
+            AaBox::new(Vec3A::new(0.0, -2.0, 3.0), Vec3A::new(0.5, 2.0, 3.0)).unwrap(),
+            AaBox::new(Vec3A::new(-6.0, 0.0, -14.0), Vec3A::new(6.0, 0.2, 4.0)).unwrap(),
+            AaBox::new(Vec3A::new(2.0, 2.0, 2.0), Vec3A::new(4.0, 3.0, 2.5)).unwrap(),
+        ];
+        let min = boxes.each_ref().map(|b| b.min.extend(0.0));
+        let max = boxes.each_ref().map(|b| b.max.extend(0.0));
+        let coords = [-3.0f32, -1.0, 0.0, 0.25, 1.0, 3.0];
+        let mut checked = 0;
+        for (i, &ox) in coords.iter().enumerate() {
+            for &oy in &coords {
+                for (k, &dz) in coords.iter().enumerate() {
+                    let o = Vec3A::new(ox, oy, coords[(i + k) % 6]);
+                    let d = Vec3A::new(coords[k], dz - oy, 1.0 - ox);
+                    let ray = Ray::new(o, d);
+                    let (mask, t) = BoxRay::new(&ray).slabs4(min, max).hits(10.0);
+                    for (lane, b) in boxes.iter().enumerate() {
+                        let scalar = b.intersect(&ray, 10.0).map(|h| h.t);
+                        let packed = (mask & (1 << lane) != 0).then_some(t[lane]);
+                        assert_eq!(packed, scalar, "box {lane}, {ray:?}");
+                        checked += usize::from(scalar.is_some());
+                    }
+                }
+            }
+        }
+        assert!(checked > 100, "{checked} hits");
     }
 
     #[test]

@@ -18,7 +18,7 @@ mod plane;
 mod sphere;
 mod triangle;
 
-pub use aabox::AaBox;
+pub use aabox::{AaBox, BoxRay, Slabs4};
 pub use cone::Cone;
 pub use cylinder::Cylinder;
 pub use geometry::{degeneracy, Geometry};

@@ -7,7 +7,7 @@ use super::{RenderScene, SurfaceHit};
 use crate::accel::Packet;
 use crate::math::Ray;
 use crate::render::primitive::Primitive;
-use crate::shape::SphereRay;
+use crate::shape::{BoxRay, SphereRay};
 
 /// Wide nodes below which a scene's camera rays go one by one: with a hierarchy of a few
 /// nodes (a room of ten shapes) the walk costs little, and gathering a packet's answers cost
@@ -43,10 +43,12 @@ impl RenderScene {
                     self.closest_in_sphere_leaf(&lanes[r], leaf, t_max, &mut best[r])
                 });
         } else {
+            let boxes: [BoxRay; N] = std::array::from_fn(|r| BoxRay::new(&rays[r]));
             self.bvh
                 .closest_leaves_packet(&packet, &mut t_best, |r, leaf, t_max| {
                     self.closest_in_leaf(
                         &lanes[r],
+                        &boxes[r],
                         &rays[r],
                         leaf,
                         t_max,
