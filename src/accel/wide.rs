@@ -421,17 +421,18 @@ mod tests {
     use super::*;
     use glam::Vec3A;
 
-    struct Rng(u64);
+    /// Test numbers (xorshift), shared with the packet tests.
+    pub(super) struct Rng(pub(super) u64);
 
     impl Rng {
-        fn next(&mut self) -> f32 {
+        pub(super) fn next(&mut self) -> f32 {
             self.0 ^= self.0 << 13;
             self.0 ^= self.0 >> 7;
             self.0 ^= self.0 << 17;
             (self.0 >> 40) as f32 / (1u64 << 24) as f32
         }
 
-        fn vec(&mut self, scale: f32) -> Vec3A {
+        pub(super) fn vec(&mut self, scale: f32) -> Vec3A {
             Vec3A::new(self.next(), self.next(), self.next()) * scale
         }
     }
@@ -462,7 +463,7 @@ mod tests {
             .collect()
     }
 
-    fn box_t(b: &Aabb, ray: &Ray) -> Option<f32> {
+    pub(super) fn box_t(b: &Aabb, ray: &Ray) -> Option<f32> {
         b.hit_range(ray, ray.dir.recip(), 0.0, f32::INFINITY)
             .map(|(t, _)| t)
     }

@@ -317,26 +317,7 @@ mod tests {
     use crate::math::Aabb;
     use glam::Vec3A;
 
-    struct Rng(u64);
-
-    impl Rng {
-        fn next(&mut self) -> f32 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 40) as f32 / (1u64 << 24) as f32
-        }
-
-        fn vec(&mut self, scale: f32) -> Vec3A {
-            Vec3A::new(self.next(), self.next(), self.next()) * scale
-        }
-    }
-
-    fn box_t(b: &Aabb, ray: &Ray, t_max: f32) -> Option<f32> {
-        b.hit_range(ray, ray.dir.recip(), 0.0, f32::INFINITY)
-            .map(|(t, _)| t)
-            .filter(|&t| t < t_max)
-    }
+    use super::super::tests::{box_t, Rng};
 
     /// Packets of rays from one origin towards nearby targets (some axis-parallel, some with
     /// origins on box faces, some with limits): each ray is offered the same leaves in the
@@ -381,7 +362,7 @@ mod tests {
             bvh.closest_leaves_packet(&p, &mut t_max, |r, prims, mut t| {
                 for &k in prims {
                     seen[r].push((k, t));
-                    if let Some(h) = box_t(&boxes[k as usize], &rays[r], t) {
+                    if let Some(h) = box_t(&boxes[k as usize], &rays[r]).filter(|&h| h < t) {
                         t = h;
                     }
                 }
@@ -392,14 +373,14 @@ mod tests {
                 met[r].extend_from_slice(prims);
                 prims
                     .iter()
-                    .any(|&k| box_t(&boxes[k as usize], &rays[r], limit).is_some())
+                    .any(|&k| box_t(&boxes[k as usize], &rays[r]).is_some_and(|h| h < limit))
             });
             for (r, ray) in rays.iter().enumerate() {
                 let mut single = Vec::new();
                 let t = bvh.closest_leaves(ray, limit, |prims, mut t| {
                     for &k in prims {
                         single.push((k, t));
-                        if let Some(h) = box_t(&boxes[k as usize], ray, t) {
+                        if let Some(h) = box_t(&boxes[k as usize], ray).filter(|&h| h < t) {
                             t = h;
                         }
                     }
@@ -412,7 +393,7 @@ mod tests {
                     single.extend_from_slice(prims);
                     prims
                         .iter()
-                        .any(|&k| box_t(&boxes[k as usize], ray, limit).is_some())
+                        .any(|&k| box_t(&boxes[k as usize], ray).is_some_and(|h| h < limit))
                 });
                 assert_eq!(any, blocked & (1 << r) != 0, "packet {i} ray {r}");
                 assert_eq!(single, met[r], "packet {i} ray {r}");
