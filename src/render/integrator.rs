@@ -73,9 +73,15 @@ impl Integrator<'_> {
     /// which adaptive sampling compares between neighbouring pixels. The uniform path keeps
     /// calling [`Integrator::trace`].
     pub fn trace_primary(&self, ray: &Ray, st: &mut TraceState) -> (Vec3A, u32) {
+        let (colour, prim, _) = self.trace_primary_hit(ray, st);
+        (colour, prim)
+    }
+
+    /// `trace_primary`, and how far along the ray the surface is (`None`: the background).
+    pub fn trace_primary_hit(&self, ray: &Ray, st: &mut TraceState) -> (Vec3A, u32, Option<f32>) {
         match self.scene.closest(ray, f32::INFINITY) {
-            Some((prim, hit)) => (self.shade(ray, prim, &hit, 0, 1.0, st), prim),
-            None => (self.scene.background, NO_HIT),
+            Some((prim, hit)) => (self.shade(ray, prim, &hit, 0, 1.0, st), prim, Some(hit.t)),
+            None => (self.scene.background, NO_HIT, None),
         }
     }
 

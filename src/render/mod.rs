@@ -302,7 +302,7 @@ fn render_uniform(
 /// How a pixel's centre ray saw the motion of a frame (adaptive sampling's first pass).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Sweep {
-    /// It met the swept bounds of a moving shape, and changes during the exposure
+    /// Its rays may meet a moving shape (`Moving::met_by`), and it changes during the exposure
     /// (`Shutter::changes`).
     touched: bool,
     /// The ends of the streak the camera's motion draws its hit point along (pixels from
@@ -344,9 +344,10 @@ fn add_counts(mut a: RayCounts, b: RayCounts) -> RayCounts {
 /// frame to frame of an animation.
 ///
 /// In a frame with motion, the first pass takes the middle of the exposure and the samples of
-/// pass 2 carry instants (`PixelPattern::time`). A pixel is not flat when a centre ray around
-/// it met the swept bounds of a moving shape, nor when the camera's motion sweeps its hit
-/// point across a neighbourhood that is not flat.
+/// pass 2 carry instants (`PixelPattern::time`). A pixel is not flat when the rays of a centre
+/// sample around it may meet a moving shape at some instant, nor when the camera's motion
+/// sweeps its hit point across a neighbourhood whose two halves do not average to its centre
+/// (docs/scene-language.md §10).
 fn render_adaptive(
     camera: &CameraRays,
     shutter: Option<&Shutter>,
@@ -385,8 +386,9 @@ fn render_adaptive(
                 let mut st = TraceState::default();
                 for (x, (px, sw)) in row.iter_mut().zip(sweep_row).enumerate() {
                     let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
-                    compile::motion::take_touched();
-                    *px = integrator.trace_primary(&ray, &mut st);
+                    compile::motion::watch();
+                    let (colour, prim, t) = integrator.trace_primary_hit(&ray, &mut st);
+                    *px = (colour, prim);
                     let swept = compile::motion::take_touched();
                     sw.touched = swept > 0.0
                         && s.changes(
@@ -398,10 +400,6 @@ fn render_adaptive(
                             &mut st,
                         );
                     if s.camera_moves() {
-                        let t = integrator
-                            .scene
-                            .closest(&ray, f32::INFINITY)
-                            .map(|(_, h)| h.t);
                         sw.streak = s.camera_sweep(camera, x as u32, y as u32, t);
                     }
                 }
@@ -413,11 +411,15 @@ fn render_adaptive(
 
     let base = &base;
     let sweeps = &sweeps;
+    // Each centre tone-mapped once: a pixel's neighbourhood, and its streak under a moving
+    // camera, read many of them.
+    let tones: Vec<Vec3A> = base.par_iter().map(|(c, _)| sampling::tone3(*c)).collect();
+    let tones = &tones;
     // The largest tone-mapped difference (8-bit levels) between the centre of (x, y) and the
     // centres around it, or None if the pixel is flat and keeps its centre sample.
     let edge_contrast = |x: usize, y: usize| -> Option<f32> {
-        let (colour, prim) = base[y * w + x];
-        let tone = sampling::tone3(colour);
+        let prim = base[y * w + x].1;
+        let tone = tones[y * w + x];
         let mut contrast = 0.0f32;
         let mut other_surface = false;
         // In a moving frame, a pixel next to one whose centre ray met something moving is not
@@ -425,33 +427,49 @@ fn render_adaptive(
         let mut moving = false;
         for ny in y.saturating_sub(1)..(y + 2).min(h) {
             let row = ny * w;
-            for (c, p) in &base[row + x.saturating_sub(1)..row + (x + 2).min(w)] {
+            let near = row + x.saturating_sub(1)..row + (x + 2).min(w);
+            for (t, (_, p)) in tones[near.clone()].iter().zip(&base[near.clone()]) {
                 other_surface |= *p != prim;
-                contrast = contrast.max((sampling::tone3(*c) - tone).abs().max_element());
+                contrast = contrast.max((*t - tone).abs().max_element());
             }
             if !sweeps.is_empty() {
-                let near = &sweeps[row + x.saturating_sub(1)..row + (x + 2).min(w)];
-                moving |= near.iter().any(|s| s.touched);
+                moving |= sweeps[near].iter().any(|s| s.touched);
             }
         }
+        // Along the streak, the pixel's value is the mean of what its two halves show: flat
+        // when every pair of points that far along the two halves averages to the centre
+        // (a steady gradient does), though the points themselves may differ more.
+        let mut streak_bias = 0.0f32;
+        let mut streak_contrast = 0.0f32;
         match sweeps.get(y * w + x).map(|s| s.streak) {
             None => {}
             Some(None) => moving = true,
             Some(Some(ends)) => {
-                for end in ends {
-                    for (px, py) in Shutter::streak_pixels(x, y, end) {
-                        if px < 0 || py < 0 || px >= w as i64 || py >= h as i64 {
-                            continue;
-                        }
-                        let (c, p) = &base[py as usize * w + px as usize];
-                        other_surface |= *p != prim;
-                        contrast = contrast.max((sampling::tone3(*c) - tone).abs().max_element());
-                    }
+                let at = |(px, py): (i64, i64)| {
+                    (px >= 0 && py >= 0 && px < w as i64 && py < h as i64)
+                        .then(|| py as usize * w + px as usize)
+                };
+                let mut seen = |i: usize| {
+                    other_surface |= base[i].1 != prim;
+                    let d = tones[i] - tone;
+                    streak_contrast = streak_contrast.max(d.abs().max_element());
+                    d
+                };
+                for [a, b] in Shutter::streak_pairs(x, y, ends) {
+                    let (a, b) = (at(a).map(&mut seen), at(b).map(&mut seen));
+                    let bias = match (a, b) {
+                        (Some(a), Some(b)) => (a + b) * 0.5,
+                        (Some(d), None) | (None, Some(d)) => d,
+                        (None, None) => Vec3A::ZERO,
+                    };
+                    streak_bias = streak_bias.max(bias.abs().max_element());
                 }
             }
         }
-        let contrast = 255.0 * contrast;
-        (moving || other_surface || contrast > sampling::FLAT_CONTRAST).then_some(contrast)
+        let flat = !moving
+            && !other_surface
+            && 255.0 * contrast.max(streak_bias) <= sampling::FLAT_CONTRAST;
+        (!flat).then_some(255.0 * contrast.max(streak_contrast))
     };
 
     let mut pixels = vec![Vec3::ZERO; w * h];

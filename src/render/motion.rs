@@ -6,6 +6,7 @@
 use super::camera::CameraRays;
 use super::integrator::{Integrator, TraceState};
 use super::sampling::{tone3, FLAT_CONTRAST};
+use crate::limits::MOTION_TIME_STEPS;
 use crate::math::Ray;
 use crate::scene::motion::Motion;
 use crate::scene::Camera;
@@ -36,6 +37,9 @@ pub struct Shutter {
     height: u32,
     /// The camera at instants spread over the exposure, when it moves.
     sweep: Vec<CameraRays>,
+    /// The camera at each instant camera samples are rounded to, when it moves (`None` where
+    /// it is degenerate then): placed once per frame, not once per sample.
+    at_step: Vec<Option<CameraRays>>,
     /// The angle one pixel spans at the image centre (radians).
     pixel_angle: f32,
 }
@@ -50,6 +54,7 @@ impl Shutter {
             width,
             height,
             sweep: Vec::new(),
+            at_step: Vec::new(),
             pixel_angle: (2.0 * (camera.fov_x_deg.to_radians() / 2.0).tan() / width.max(1) as f64)
                 as f32,
         };
@@ -63,6 +68,9 @@ impl Shutter {
             shutter.sweep = instants
                 .into_iter()
                 .filter_map(|u| shutter.camera_at(u as f32))
+                .collect();
+            shutter.at_step = (0..MOTION_TIME_STEPS)
+                .map(|i| shutter.camera_at((i as f32 + 0.5) / MOTION_TIME_STEPS as f32))
                 .collect();
         }
         shutter
@@ -85,15 +93,15 @@ impl Shutter {
     /// (`compile::motion::quantize`), so every thing of the scene is seen at one instant.
     #[inline]
     pub fn ray(&self, still: &CameraRays, x: f32, y: f32, time: f32) -> Ray {
-        let time = super::compile::motion::quantize(time);
-        let ray = if self.camera_moves() {
-            self.camera_at(time)
-                .unwrap_or_else(|| still.clone())
-                .ray(x, y)
-        } else {
-            still.ray(x, y)
-        };
-        ray.at_time(time)
+        let step = super::compile::motion::step(time);
+        let camera = self
+            .at_step
+            .get(step as usize)
+            .and_then(Option::as_ref)
+            .unwrap_or(still);
+        camera
+            .ray(x, y)
+            .at_time(super::compile::motion::quantize(time))
     }
 
     /// Where (pixels, from the centre of (`x`, `y`)) the point its middle-instant centre ray
@@ -178,22 +186,90 @@ impl Shutter {
         false
     }
 
-    /// The pixels along a streak from the centre of (`x`, `y`) to offset `end` (pixels), a pixel
-    /// apart, each with its neighbours across the streak: what must be flat for the pixel to keep
-    /// its centre sample under a moving camera.
-    pub fn streak_pixels(x: usize, y: usize, end: (f32, f32)) -> impl Iterator<Item = (i64, i64)> {
-        let steps = end.0.abs().max(end.1.abs()).ceil() as i64;
-        // Across the streak: ±1 along the axis it runs less along.
-        let across = if end.0.abs() >= end.1.abs() {
-            (0, 1)
-        } else {
-            (1, 0)
+    /// Pairs of pixels along the two halves of a streak from the centre of (`x`, `y`) to its
+    /// ends `ends` (pixels), at the same fraction of each half, about a pixel apart along the
+    /// longer one, each with its neighbours across its half: what must be flat for the pixel
+    /// to keep its centre sample under a moving camera.
+    #[inline]
+    pub fn streak_pairs(
+        x: usize,
+        y: usize,
+        ends: [(f32, f32); 2],
+    ) -> impl Iterator<Item = [(i64, i64); 2]> {
+        let span = |e: (f32, f32)| e.0.abs().max(e.1.abs());
+        let steps = span(ends[0]).max(span(ends[1])).ceil() as i64;
+        // Across a half: ±1 along the axis it runs less along.
+        let across = |e: (f32, f32)| {
+            if e.0.abs() >= e.1.abs() {
+                (0, 1)
+            } else {
+                (1, 0)
+            }
         };
+        let (a0, a1) = (across(ends[0]), across(ends[1]));
+        let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
         (1..=steps).flat_map(move |s| {
             let f = s as f32 / steps as f32;
-            let px = (x as f32 + 0.5 + end.0 * f).floor() as i64;
-            let py = (y as f32 + 0.5 + end.1 * f).floor() as i64;
-            (-1..=1).map(move |k| (px + k * across.0, py + k * across.1))
+            let p0 = (floor(cx + ends[0].0 * f), floor(cy + ends[0].1 * f));
+            let p1 = (floor(cx + ends[1].0 * f), floor(cy + ends[1].1 * f));
+            (-1..=1).map(move |k| {
+                [
+                    (p0.0 + k * a0.0, p0.1 + k * a0.1),
+                    (p1.0 + k * a1.0, p1.1 + k * a1.1),
+                ]
+            })
         })
+    }
+}
+
+/// `v.floor()` as an integer, without the library call `f32::floor` makes on CPUs the build
+/// does not assume to round in hardware (the streak walk takes several per pixel).
+#[inline]
+fn floor(v: f32) -> i64 {
+    let t = v as i64;
+    t - ((t as f32) > v) as i64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn floor_is_the_library_floor() {
+        for v in [
+            -3.0f32,
+            -2.5,
+            -1e-7,
+            -0.0,
+            0.0,
+            1e-7,
+            0.5,
+            0.999_999_9,
+            1.0,
+            95.5,
+            1e6 + 0.5,
+        ] {
+            assert_eq!(floor(v), v.floor() as i64, "{v}");
+        }
+    }
+
+    #[test]
+    fn a_streak_pairs_points_at_the_same_fraction_of_its_halves() {
+        // Halves of 4 and 2 pixels: four steps, the shorter half at half-pixel strides.
+        let pairs: Vec<_> = Shutter::streak_pairs(10, 10, [(-4.0, 0.0), (2.0, 0.0)]).collect();
+        assert_eq!(pairs.len(), 4 * 3);
+        let middles: Vec<_> = pairs.iter().skip(1).step_by(3).copied().collect();
+        assert_eq!(
+            middles,
+            [
+                [(9, 10), (11, 10)],
+                [(8, 10), (11, 10)],
+                [(7, 10), (12, 10)],
+                [(6, 10), (12, 10)]
+            ]
+        );
+        // Across a horizontal half: the rows above and below.
+        assert_eq!(pairs[0][0], (9, 9));
+        assert_eq!(pairs[2][0], (9, 11));
     }
 }

@@ -13,7 +13,7 @@ use crate::math::{Aabb, Ray, Transform};
 use crate::render::primitive::Primitive;
 use crate::scene::motion::Motion;
 use crate::scene::{Instance, Scene};
-use glam::{DVec3, Vec3A};
+use glam::{Affine3A, DVec3, Vec3A, Vec4};
 use std::cell::{Cell, RefCell};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
@@ -23,11 +23,56 @@ use std::sync::{Arc, OnceLock};
 /// curved that twice the longest chord bounds how far they stray (see [`swept_bounds`]).
 const BOUND_STEPS: usize = 64;
 
+/// Parts of the exposure in each of which a moving shape has one pose ([`Pose`]): what
+/// adaptive sampling's first pass asks a ray about, to tell the pixels that see the motion
+/// from those that only look through its bounds over the whole exposure.
+const POSE_PARTS: usize = 32;
+
+/// Steps per half part over which a pose's drift is measured (and at the keys' instants).
+const DRIFT_STEPS: usize = 2;
+
+/// A moving shape over one part of the exposure: the map into its own space at the part's
+/// middle, and there its own bounds, and for a sphere the sphere, grown by how far any of its
+/// points drifts within the part (in its own units). A ray that misses what is grown misses
+/// the shape all through the part.
+#[derive(Clone, Copy, Debug)]
+struct Pose {
+    object_from_world: Affine3A,
+    grown: Aabb,
+    /// Centre and grown radius, when the shape is a sphere in its own space.
+    sphere: Option<Vec4>,
+}
+
+impl Pose {
+    #[inline]
+    fn met_by(&self, ray: &Ray) -> bool {
+        let origin = self.object_from_world.transform_point3a(ray.origin);
+        let dir = self.object_from_world.transform_vector3a(ray.dir);
+        if self
+            .grown
+            .hit_range(&Ray::new(origin, dir), dir.recip(), 0.0, f32::INFINITY)
+            .is_none()
+        {
+            return false;
+        }
+        // Whether the line comes within the radius, and not wholly behind the origin: the
+        // closest approach of the line to the centre, clamped to the ray.
+        self.sphere.is_none_or(|s| {
+            let to_centre = Vec3A::from(s.truncate()) - origin;
+            let along = (to_centre.dot(dir) / dir.length_squared()).max(0.0);
+            let miss = to_centre - dir * along;
+            // NaN (a degenerate map) counts as met.
+            miss.length_squared().partial_cmp(&(s.w * s.w)) != Some(std::cmp::Ordering::Greater)
+        })
+    }
+}
+
 thread_local! {
-    /// The largest angle (radians, as the eye sees it) swept by the moving entries this
-    /// thread's queries met since it was last cleared: adaptive sampling's first pass asks it
-    /// per pixel ([`take_touched`]).
-    static TOUCHED: Cell<f32> = const { Cell::new(0.0) };
+    /// While adaptive sampling's first pass watches a centre sample ([`watch`]): the largest
+    /// angle (radians, as the eye sees it) swept by the moving shapes its rays may have met at
+    /// some instant of the exposure. NaN while nobody watches, so that the test in
+    /// [`Moving::with`] is one comparison that fails.
+    static TOUCHED: Cell<f32> = const { Cell::new(f32::NAN) };
     /// The moving entries this thread placed at the time of its latest ray: every ray of a
     /// camera sample (primary, shadow, reflected) has that sample's time, so each entry is
     /// placed once per sample, not once per test. Only saves work: an entry placed again at
@@ -48,10 +93,16 @@ struct Placed {
     entries: Vec<(u64, Option<Primitive>)>,
 }
 
-/// The largest angle (radians) swept, as the eye sees it, by the moving shapes whose swept
-/// bounds this thread's queries met since the last call; 0 when they met none.
+/// Starts watching which moving shapes this thread's queries meet ([`take_touched`]).
+pub fn watch() {
+    TOUCHED.with(|t| t.set(0.0));
+}
+
+/// The largest angle (radians) swept, as the eye sees it, by the moving shapes that this
+/// thread's queries may have met at some instant since [`watch`] (see [`Moving::met_by`]);
+/// 0 when they met none. Stops watching.
 pub fn take_touched() -> f32 {
-    TOUCHED.with(|t| t.replace(0.0))
+    TOUCHED.with(|t| t.replace(f32::NAN)).max(0.0)
 }
 
 /// The moving shapes and lights of a scene.
@@ -66,6 +117,9 @@ pub struct Moving {
     sweep: Vec<f32>,
     /// Per moving entry: its bounds over the exposure.
     bounds: Vec<Aabb>,
+    /// Entry `k`'s pose in part `i` of the exposure in cell `k·POSE_PARTS + i`; `None` where
+    /// it cannot be told (degenerate or unbounded), which counts as met.
+    poses: Vec<Option<Pose>>,
     /// Scene light positions (moved with the scene), for moving lights.
     lights: Vec<DVec3>,
     /// Entry `k` placed at instant `i` (of `MOTION_TIME_STEPS`) in cell `k·steps + i`, made
@@ -81,9 +135,9 @@ pub fn quantize(time: f32) -> f32 {
     (step(time) as f32 + 0.5) / MOTION_TIME_STEPS as f32
 }
 
-/// The part of the exposure `time` falls in.
+/// The part of the exposure `time` falls in (of `limits::MOTION_TIME_STEPS`).
 #[inline]
-fn step(time: f32) -> u32 {
+pub fn step(time: f32) -> u32 {
     ((time * MOTION_TIME_STEPS as f32) as u32).min(MOTION_TIME_STEPS - 1)
 }
 
@@ -101,6 +155,7 @@ impl Moving {
             entries: Vec::new(),
             sweep: Vec::new(),
             bounds: Vec::new(),
+            poses: Vec::new(),
             lights: scene.lights.iter().map(|l| l.position).collect(),
             placed: Vec::new(),
         })
@@ -138,7 +193,124 @@ impl Moving {
         self.sweep
             .push(if angle.is_nan() { f32::INFINITY } else { angle });
         self.bounds.push(b);
+        let poses = self.poses_of(k);
+        self.poses.extend(poses);
         (k, swept.bounds)
+    }
+
+    /// Whether `ray` (from its origin on, however far) may meet entry `k` at some instant of
+    /// the exposure: `false` only where its poses say it surely does not.
+    fn met_by(&self, k: u32, ray: &Ray) -> bool {
+        let k = k as usize;
+        if self.bounds.get(k).is_some_and(|b| {
+            b.hit_range(ray, ray.dir.recip(), 0.0, f32::INFINITY)
+                .is_none()
+        }) {
+            return false;
+        }
+        self.poses
+            .get(k * POSE_PARTS..(k + 1) * POSE_PARTS)
+            .is_none_or(|poses| poses.iter().any(|p| p.is_none_or(|p| p.met_by(ray))))
+    }
+
+    /// Entry `k` placed at instant `step` (of `MOTION_TIME_STEPS`), from the table that keeps
+    /// them; `None` when the scene has too many moving shapes for the table. The inner `None`:
+    /// degenerate at that instant.
+    #[inline]
+    fn placed_at(&self, k: u32, step: u32) -> Option<Option<&Primitive>> {
+        let cell = self
+            .placed
+            .get(k as usize * MOTION_TIME_STEPS as usize + step as usize)?;
+        Some(
+            cell.get_or_init(|| self.place(k, (step as f32 + 0.5) / MOTION_TIME_STEPS as f32))
+                .as_ref(),
+        )
+    }
+
+    /// Entry `k`'s poses, one per part of the exposure (see [`Pose`]).
+    ///
+    /// Why a grown box holds the shape through its part: a point of the shape is an affine
+    /// combination of its own bounds' corners, so it drifts from where it is at the part's
+    /// middle by at most the longest way a corner travels from there to either end of the part.
+    /// That way is measured as twice the sum of the chords between instants 1/128 of the
+    /// exposure apart (and the keys' instants), as in [`swept_bounds`]. A drift `d` in the world
+    /// is at most `d·|M⁻¹|` in the shape's own space, `M⁻¹` the map into it, whose Frobenius
+    /// norm bounds its stretch.
+    fn poses_of(&self, k: u32) -> Vec<Option<Pose>> {
+        let unknown = vec![None; POSE_PARTS];
+        let Some(inst) = self
+            .entries
+            .get(k as usize)
+            .and_then(|&i| self.instances.get(i as usize))
+        else {
+            return unknown;
+        };
+        let Ok(local) = Primitive::new(&inst.geometry, &Transform::IDENTITY, 0) else {
+            return unknown;
+        };
+        let sphere = local.world_sphere().map(|s| s.packed());
+        let local = local.bounds;
+        if !local.is_finite() || local.is_empty() {
+            return unknown;
+        }
+        let steps = 2 * POSE_PARTS * DRIFT_STEPS;
+        let mut instants: Vec<f64> = (0..=steps).map(|s| s as f64 / steps as f64).collect();
+        instants.extend(
+            self.motion
+                .slot_instants(inst.transform)
+                .into_iter()
+                .filter(|u| (0.0..=1.0).contains(u)),
+        );
+        instants.sort_by(f64::total_cmp);
+        instants.dedup();
+        let corners: Vec<[DVec3; 8]> = instants
+            .iter()
+            .map(|&u| {
+                let m = self.motion.slot_matrix(inst.transform, u);
+                local.corners().map(|c| m.transform_point3(c.as_dvec3()))
+            })
+            .collect();
+        // The longest way a corner travels between instants `a` and `b` (indices), chord by chord.
+        let way = |a: usize, b: usize| -> f64 {
+            let (a, b) = (a.min(b), a.max(b));
+            (0..8)
+                .map(|c| {
+                    (a..b)
+                        .map(|i| corners[i][c].distance(corners[i + 1][c]))
+                        .sum::<f64>()
+                })
+                .fold(0.0, f64::max)
+        };
+        let at = |u: f64| instants.partition_point(|&v| v < u).min(instants.len() - 1);
+        (0..POSE_PARTS)
+            .map(|i| {
+                let middle = (i as f64 + 0.5) / POSE_PARTS as f64;
+                let (lo, mid, hi) = (
+                    at(i as f64 / POSE_PARTS as f64),
+                    at(middle),
+                    at((i + 1) as f64 / POSE_PARTS as f64),
+                );
+                let drift = 2.0 * way(lo, mid).max(way(mid, hi));
+                let xf = self.motion.slot_at(inst.transform, instants[mid]);
+                let inverse = xf.object_from_world;
+                let stretch = (inverse.x_axis.truncate().length_squared()
+                    + inverse.y_axis.truncate().length_squared()
+                    + inverse.z_axis.truncate().length_squared())
+                .sqrt();
+                let grow = drift * stretch;
+                if !(grow.is_finite() && inverse.is_finite()) {
+                    return None;
+                }
+                // And a relative margin for the f32 rounding of the ray's map.
+                let pad = Vec3A::splat(grow as f32)
+                    + (local.min.abs().max(local.max.abs()) + local.extent()) * 1e-4;
+                Some(Pose {
+                    object_from_world: Affine3A::from_mat4(inverse.as_mat4()),
+                    grown: Aabb::new(local.min - pad, local.max + pad),
+                    sphere: sphere.map(|s| s.truncate().extend(s.w + pad.max_element())),
+                })
+            })
+            .collect()
     }
 
     /// Entry `k` at time `u`: its transform.
@@ -161,24 +333,12 @@ impl Moving {
         let time = ray.time;
         let swept = self.sweep.get(k as usize).copied().unwrap_or(f32::INFINITY);
         // Asked also outside a traversal (a shadow ray tries the last blocker first): only a
-        // ray that meets the swept bounds counts.
-        if TOUCHED.with(Cell::get) < swept
-            && self.bounds.get(k as usize).is_some_and(|b| {
-                b.hit_range(ray, ray.dir.recip(), 0.0, f32::INFINITY)
-                    .is_some()
-            })
-        {
+        // ray that meets the shape at some instant counts.
+        if TOUCHED.with(Cell::get) < swept && self.met_by(k, ray) {
             TOUCHED.with(|t| t.set(swept));
         }
         if !self.placed.is_empty() {
-            let i = step(time);
-            let cell = self
-                .placed
-                .get(k as usize * MOTION_TIME_STEPS as usize + i as usize)?;
-            return cell
-                .get_or_init(|| self.place(k, (i as f32 + 0.5) / MOTION_TIME_STEPS as f32))
-                .as_ref()
-                .map(f);
+            return self.placed_at(k, step(time))?.map(f);
         }
         PLACED.with_borrow_mut(|c| {
             if c.owner != self.id || c.time != time.to_bits() {
@@ -237,6 +397,9 @@ impl Moving {
 
     pub fn memory_bytes(&self) -> usize {
         self.entries.capacity() * 4
+            + self.sweep.capacity() * 4
+            + self.bounds.capacity() * std::mem::size_of::<Aabb>()
+            + self.poses.capacity() * std::mem::size_of::<Option<Pose>>()
             + self.lights.capacity() * 24
             + self.placed.capacity() * std::mem::size_of::<OnceLock<Option<Primitive>>>()
     }
@@ -363,6 +526,96 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A bar spinning 60° about z through its centre, a ball shooting 20 units along x (rising a little), a tilted
+    /// cylinder swinging: the moving part of the scene, every shape added.
+    fn moving_things() -> Moving {
+        let text = "define material m 1 1 1 0 0 0 0 0 0 1\n\
+            define shape box bar -1 -0.2 -0.2 1 0.2 0.2 m\n\
+            define shape sphere ball 3 0 0 0.5 m\n\
+            define shape cylinder post -3 -1 0 -2.5 1 0.3 0.25 m\n\
+            define camera eye 40 0 0 10 0 0 -1 0 1 0\n\
+            motion bar 0 rotate -30 0 0 1\nmotion bar 0.5\nmotion bar 1 rotate 30 0 0 1\n\
+            motion ball 0 translate -10 -0.5 0\nmotion ball 0.5\nmotion ball 1 translate 10 0.5 1\n\
+            motion post 0 rotate -20 1 0 0\nmotion post 0.5\nmotion post 1 rotate 40 1 0 0\n\
+            render eye m.ppm 8 8\n";
+        let loaded = crate::scene::load_str(
+            text,
+            std::path::Path::new("m.sdf"),
+            &crate::sdf::LoadOptions::default(),
+        )
+        .expect("loads");
+        let scene = &loaded.jobs[0].scene;
+        let mut moving = Moving::new(scene).expect("things move");
+        for (i, inst) in scene.instances.iter().enumerate() {
+            if moving.moves(inst) {
+                moving.add(i);
+            }
+        }
+        moving.finish();
+        assert_eq!(moving.entries.len(), 3);
+        moving
+    }
+
+    proptest! {
+        /// A ray that meets a moving shape at any instant rays are placed at is never told it
+        /// does not ([`Moving::met_by`] is what adaptive sampling's first pass trusts): rays
+        /// from all sides (across the path of the fast ball) through a point inside the shape
+        /// at a random instant, most of them near its surface, where its motion carries it
+        /// out of its poses soonest.
+        #[test]
+        fn a_ray_that_meets_a_moving_shape_is_seen_to(
+            origin in prop::array::uniform3(-6.0f64..6.0),
+            k in 0u32..3,
+            step in 0..MOTION_TIME_STEPS,
+            along in -1.0f64..1.0,
+            across in prop::array::uniform2(-1.0f64..1.0),
+        ) {
+            let moving = moving_things();
+            // A point of the shape in its own space: in the bar, in the ball, on the post's axis.
+            let edge = |v: f64| v.signum() * v.abs().powf(0.1);
+            let (along, across) = (edge(along), across.map(edge));
+            let inside = match k {
+                0 => DVec3::new(along, 0.19 * across[0], 0.19 * across[1]),
+                1 => DVec3::new(3.0, 0.0, 0.0) + 0.49 * DVec3::new(along, across[0], across[1]) / 3f64.sqrt(),
+                _ => DVec3::new(-3.0, -1.0, 0.0).lerp(DVec3::new(-2.5, 1.0, 0.3), 0.5 + 0.499 * along),
+            };
+            let u = (step as f64 + 0.5) / MOTION_TIME_STEPS as f64;
+            let (_, xf) = moving.transform(k, u).expect("entry");
+            let target = Vec3A::from(xf.point(inside).as_vec3());
+            // Across the ball's path, so that a ray grazing it meets it for a moment only.
+            let from = DVec3::from(origin);
+            let from = if k == 1 { DVec3::new(0.0, from.y, from.z) } else { from };
+            prop_assume!(from.length() > 1e-3);
+            let origin = target + Vec3A::from((8.0 * from.normalize()).as_vec3());
+            let ray = Ray::new(origin, (target - origin).normalize());
+            let placed = moving.placed_at(k, step).flatten().expect("placed");
+            prop_assume!(placed.hit(&ray, f32::INFINITY).is_some());
+            prop_assert!(moving.met_by(k, &ray), "entry {k} hit at step {step}, not met");
+        }
+    }
+
+    #[test]
+    fn rays_through_the_swept_bounds_that_never_meet_the_shape_are_told_so() {
+        let moving = moving_things();
+        // Along z past the spinning bar, inside its bounds over the exposure (they reach
+        // x = ±1, y = ±0.67) but 1.12 from its axis, beyond its reach of 1.02.
+        let past = Ray::new(Vec3A::new(0.95, 0.6, 5.0), Vec3A::NEG_Z);
+        assert!(moving.bounds[0]
+            .hit_range(&past, past.dir.recip(), 0.0, f32::INFINITY)
+            .is_some());
+        assert!(!moving.met_by(0, &past));
+        // Through the bar's centre, it meets it at every instant.
+        let through = Ray::new(Vec3A::new(0.0, 0.0, 5.0), Vec3A::NEG_Z);
+        assert!(moving.met_by(0, &through));
+        // Through a corner of the ball's box over the exposure, far from its path.
+        let b = moving.bounds[1];
+        let corner = Ray::new(Vec3A::new(b.max.x - 0.05, b.max.y - 0.05, -5.0), Vec3A::Z);
+        assert!(b
+            .hit_range(&corner, corner.dir.recip(), 0.0, f32::INFINITY)
+            .is_some());
+        assert!(!moving.met_by(1, &corner));
     }
 
     #[test]
