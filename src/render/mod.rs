@@ -459,7 +459,7 @@ fn render_adaptive(
         .par_chunks_mut(w)
         .enumerate()
         .map(|(y, row)| {
-            let mut st = TraceState::default();
+            let mut st = TraceState::refining();
             for (x, out) in row.iter_mut().enumerate() {
                 let Some(contrast) = edge_contrast(x, y).filter(|_| max_spp > 1) else {
                     *out = Vec3::from(base[y * w + x].0);
