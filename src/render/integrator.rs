@@ -32,6 +32,13 @@ pub struct TraceState {
     /// its shadow ray: 0 (every shadow ray traced) except for adaptive sampling's refining
     /// samples ([`TraceState::refining`]).
     shadow_cut: f32,
+    /// Bit k: a shadow ray towards light k found it not fully visible (blocked, or through
+    /// glass) since this was last cleared (adaptive sampling's first pass reads it per pixel).
+    pub not_clear: u32,
+    /// Bit k: light k is taken as fully visible at the surface a camera ray hits, without a
+    /// shadow ray, because no shadow ray of the first pass around this pixel found otherwise
+    /// (set by adaptive sampling for the samples it adds).
+    pub known_clear: u32,
 }
 
 impl Default for TraceState {
@@ -40,6 +47,8 @@ impl Default for TraceState {
             counts: RayCounts::default(),
             blockers: [NO_HIT; CACHED_LIGHTS],
             shadow_cut: 0.0,
+            not_clear: 0,
+            known_clear: 0,
         }
     }
 }
@@ -119,7 +128,7 @@ impl Integrator<'_> {
         let n = if entering { hit.normal } else { -hit.normal };
         let (rho, alpha) = (mat.reflectivity, mat.opacity);
         if rho == 0.0 && alpha == 1.0 {
-            return self.local(mat, hit, n, -ray.dir, ray.time, weight, st);
+            return self.local(mat, hit, n, -ray.dir, ray.time, (weight, depth), st);
         }
 
         // c = α·((1−ρ)·c_local + ρ·c_r) + (1−α)·(F·c_r + (1−F)·c_t)
@@ -142,7 +151,15 @@ impl Integrator<'_> {
         let mut c = if w_local == 0.0 {
             Vec3A::ZERO
         } else {
-            self.local(mat, hit, n, -ray.dir, ray.time, weight * w_local, st) * w_local
+            self.local(
+                mat,
+                hit,
+                n,
+                -ray.dir,
+                ray.time,
+                (weight * w_local, depth),
+                st,
+            ) * w_local
         };
         let can_recurse = depth < self.max_depth;
         let worth =
@@ -173,9 +190,10 @@ impl Integrator<'_> {
         n: Vec3A,
         v: Vec3A,
         time: f32,
-        weight: f32,
+        (weight, depth): (f32, u32),
         st: &mut TraceState,
     ) -> Vec3A {
+        let known_clear = if depth == 0 { st.known_clear } else { 0 };
         let scene = self.scene;
         let mut c = mat.ka * scene.ambient;
         // `ks·spec` is exactly zero without a specular colour (spec is at most 1 for m ≥ 0).
@@ -209,12 +227,15 @@ impl Integrator<'_> {
                 continue;
             }
             let lit = light.intensity * unshadowed;
-            if lit.max_element() * weight < st.shadow_cut {
+            if lit.max_element() * weight < st.shadow_cut || (known_clear >> k.min(31)) & 1 != 0 {
                 c += lit;
                 continue;
             }
             st.counts.shadow += 1;
             let vis = self.visibility(hit, l, dist, time, st.blockers.get_mut(k));
+            if vis < 1.0 {
+                st.not_clear |= 1 << k.min(31);
+            }
             if vis == 0.0 {
                 continue;
             }
