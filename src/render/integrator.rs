@@ -347,6 +347,77 @@ impl Integrator<'_> {
 mod tests {
     use super::*;
 
+    /// A grey floor under an opaque ball, one light straight above: the point of the floor
+    /// below the ball is in its shadow. Traced straight down from between the two.
+    fn shadowed_floor(kd: f32) -> (f32, f32, f32, u64) {
+        use crate::scene::{Geometry, Instance, Light, Material, Scene};
+        use glam::{DVec3, Vec3};
+        let scene = Scene {
+            materials: vec![Material::phong(
+                "grey",
+                Vec3::splat(0.1),
+                Vec3::splat(kd),
+                Vec3::ZERO,
+                1.0,
+            )],
+            instances: vec![
+                Instance::new(
+                    Geometry::Box {
+                        p1: DVec3::new(-10.0, -1.0, -10.0),
+                        p2: DVec3::new(10.0, 0.0, 10.0),
+                    },
+                    0,
+                ),
+                Instance::new(
+                    Geometry::Sphere {
+                        center: DVec3::new(0.0, 2.0, 0.0),
+                        radius: 0.5,
+                    },
+                    0,
+                ),
+            ]
+            .into(),
+            lights: vec![Light {
+                name: "top".into(),
+                position: DVec3::new(0.0, 5.0, 0.0),
+                intensity: Vec3::ONE,
+            }],
+            ambient: Vec3::splat(0.2),
+            ..Scene::default()
+        };
+        let (scene, _) = RenderScene::compile(&scene);
+        let integrator = Integrator {
+            scene: &scene,
+            max_depth: 4,
+        };
+        let ray = Ray::new(Vec3A::new(0.0, 1.0, 0.0), Vec3A::new(0.0, -1.0, 0.0));
+        let mut exact = TraceState::default();
+        let mut refining = TraceState::refining();
+        let mut known = TraceState::refining();
+        known.known_clear = 1;
+        let shadowed = integrator.trace(&ray, 0, 1.0, &mut exact).x;
+        let refined = integrator.trace(&ray, 0, 1.0, &mut refining).x;
+        let assumed = integrator.trace(&ray, 0, 1.0, &mut known).x;
+        (shadowed, refined, assumed, refining.counts.shadow)
+    }
+
+    #[test]
+    fn refining_samples_skip_shadow_rays_only_for_negligible_or_known_clear_lights() {
+        let ambient = 0.1 * 0.2;
+        // A term that matters: the refining sample traces its shadow ray and agrees; a light
+        // known clear around the pixel is taken as lit at the camera hit (N·L = 1).
+        let (shadowed, refined, assumed, rays) = shadowed_floor(0.5);
+        assert!((shadowed - ambient).abs() < 1e-6, "{shadowed}");
+        assert_eq!((refined, rays), (shadowed, 1));
+        assert!((assumed - (ambient + 0.5)).abs() < 1e-6, "{assumed}");
+        // A term below NEGLIGIBLE even fully lit is added lit, without a shadow ray.
+        let kd = 0.5 * NEGLIGIBLE;
+        let (shadowed, refined, _, rays) = shadowed_floor(kd);
+        assert!((shadowed - ambient).abs() < 1e-6, "{shadowed}");
+        assert_eq!(rays, 0);
+        assert!((refined - (ambient + kd)).abs() < 1e-6, "{refined}");
+    }
+
     #[test]
     fn fresnel_at_normal_incidence() {
         for ior in [1.0f32, 1.33, 1.5, 2.4] {
