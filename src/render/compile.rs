@@ -65,6 +65,22 @@ const BOUNDS_OF_BOX: f32 = 1.0;
 const BOUNDS_OF_OTHER: f32 = 0.0;
 const BOUNDS_OF_SPHERE: f32 = -1.0;
 
+/// Most bounded primitives a scene may have for every ray to test them all instead of
+/// walking the hierarchy (`RenderScene::flat_leaf`): four groups of four. The room of
+/// scenes/bench/mirror-glass.sdf has ten, which its hierarchy puts in three leaves that
+/// most rays inside the room meet.
+const FLAT_MAX: usize = 16;
+/// The primitive numbers `0..FLAT_MAX`, for a leaf of them all.
+const FLAT: [u32; FLAT_MAX] = {
+    let mut all = [0; FLAT_MAX];
+    let mut i = 0;
+    while i < FLAT_MAX {
+        all[i] = i as u32;
+        i += 1;
+    }
+    all
+};
+
 /// Primitives are numbered in the BVH's leaf order (so a leaf reads consecutive entries),
 /// then the unbounded ones. World-space spheres, the common case, are packed into 16 bytes
 /// and tested four at a time with no dispatch; everything else is a [`Primitive`].
@@ -397,33 +413,67 @@ impl RenderScene {
     /// primitive's wins (the first of them), else the first in the flattened tree's order.
     #[inline]
     pub fn closest(&self, ray: &Ray, t_max: f32) -> Option<(u32, SurfaceHit)> {
-        let (mut best, t_best, mut won) = self.closest_unbounded(ray, t_max);
+        // Filled in place, not returned: a `Primitive` is 240 bytes, and moving even a `None`
+        // of it in and out of calls cost 5 % of a render of the mirror-and-glass room.
+        let mut won = None;
+        let (mut best, t_best) = self.closest_unbounded_into(ray, t_max, &mut won);
         let lanes = SphereRay::new(ray);
+        let flat = self.flat_leaf();
         if self.all_spheres {
-            self.bvh.closest_leaves(ray, t_best, |leaf, t_max| {
-                self.closest_in_sphere_leaf(&lanes, leaf, t_max, &mut best)
-            });
+            let mut leaf =
+                |leaf: &[u32], t_max| self.closest_in_sphere_leaf(&lanes, leaf, t_max, &mut best);
+            match flat {
+                Some(all) => _ = leaf(all, t_best),
+                None => _ = self.bvh.closest_leaves(ray, t_best, leaf),
+            }
         } else {
             let boxes = BoxRay::new(ray);
-            self.bvh.closest_leaves(ray, t_best, |leaf, t_max| {
+            let mut leaf = |leaf: &[u32], t_max| {
                 self.closest_in_leaf(&lanes, &boxes, ray, leaf, t_max, &mut best, &mut won)
-            });
+            };
+            match flat {
+                Some(all) => _ = leaf(all, t_best),
+                None => _ = self.bvh.closest_leaves(ray, t_best, leaf),
+            }
         }
-        self.surface_of(ray, best?, won)
+        self.surface_of(ray, best?, won.as_ref())
+    }
+
+    /// All bounded primitives as one leaf, when there are so few that testing them all, four
+    /// at a time, costs less than walking the hierarchy to them; `None` otherwise (or when
+    /// there are none). In a closed room every ray's box overlaps most of the few leaves
+    /// anyway. The answers are the hierarchy's: the closest hit is judged by distance and
+    /// number, not by the order of the tests, and `any_hit`'s callers take any order.
+    #[inline(always)]
+    fn flat_leaf(&self) -> Option<&'static [u32]> {
+        let n = self.unbounded as usize;
+        (n > 0 && n <= FLAT_MAX).then(|| &FLAT[..n])
     }
 
     /// The nearest unbounded primitive's hit before `t_max`, the new `t_max`, and the placed
-    /// primitive when the winner moves: what `closest` starts from. The winner's object-space hit is kept for its surface (spheres
-    /// recompute theirs).
+    /// primitive when the winner moves: what `closest` starts from. The winner's object-space
+    /// hit is kept for its surface (spheres recompute theirs).
     #[inline(always)]
     fn closest_unbounded(&self, ray: &Ray, t_max: f32) -> (Option<Best>, f32, Option<Primitive>) {
+        let mut won = None;
+        let (best, t_best) = self.closest_unbounded_into(ray, t_max, &mut won);
+        (best, t_best, won)
+    }
+
+    /// `closest_unbounded` with the placed primitive left in `won`.
+    #[inline(always)]
+    fn closest_unbounded_into(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        won: &mut Option<Primitive>,
+    ) -> (Option<Best>, f32) {
         let mut best: Option<Best> = None;
         let mut t_best = t_max;
-        let mut won = None;
         for i in self.unbounded..self.len() as u32 {
             let h = match self.kind[i as usize] {
                 k if is_moving(k) => self.moving_hit(k, ray, t_best).map(|(h, p)| {
-                    won = Some(p);
+                    *won = Some(p);
                     h
                 }),
                 _ => self.shape_hit(i, ray, t_best),
@@ -438,17 +488,17 @@ impl RenderScene {
                 });
             }
         }
-        (best, t_best, won)
+        (best, t_best)
     }
 
     /// The world-space surface of `closest`'s winner (`won`: the placed instanced primitive
     /// when the winner is one).
     #[inline(always)]
-    fn surface_of(
+    fn surface_of<P: std::borrow::Borrow<Primitive>>(
         &self,
         ray: &Ray,
         best: Best,
-        won: Option<Primitive>,
+        won: Option<P>,
     ) -> Option<(u32, SurfaceHit)> {
         let Best { id: i, t, hit, .. } = best;
         let surface = match (self.kind.get(i as usize).copied(), hit) {
@@ -461,7 +511,8 @@ impl RenderScene {
                 p.surface(&p.hit(ray, t.next_up())?)
             }
             (_, Some(h)) => {
-                let p = won?;
+                let won = won?;
+                let p = won.borrow();
                 match p.world_sphere() {
                     Some(s) => sphere_surface(&s.hit_at(ray, t)),
                     None => p.surface(&h),
@@ -664,8 +715,9 @@ impl RenderScene {
             }
         }
         let lanes = SphereRay::new(ray);
+        let flat = self.flat_leaf();
         if self.all_spheres {
-            self.bvh.any_leaves(ray, t_max, |leaf| {
+            let leaf = |leaf: &[u32]| {
                 let first = leaf[0] as usize;
                 let end = first + leaf.len();
                 (first..end).step_by(LANES).any(|start| {
@@ -673,11 +725,15 @@ impl RenderScene {
                     let mask = lanes.hit4(self.four_spheres(start), t_max).0 & ((1 << live) - 1);
                     offer(start, mask, &mut stop)
                 })
-            });
+            };
+            match flat {
+                Some(all) => _ = { leaf }(all),
+                None => _ = self.bvh.any_leaves(ray, t_max, leaf),
+            }
             return;
         }
         let boxes = BoxRay::new(ray);
-        self.bvh.any_leaves(ray, t_max, |leaf| {
+        let leaf = |leaf: &[u32]| {
             let first = leaf[0] as usize;
             for start in (first..first + leaf.len()).step_by(LANES) {
                 let c = self.classify(&boxes, start, first + leaf.len(), t_max);
@@ -713,7 +769,11 @@ impl RenderScene {
                 }
             }
             false
-        });
+        };
+        match flat {
+            Some(all) => _ = { leaf }(all),
+            None => _ = self.bvh.any_leaves(ray, t_max, leaf),
+        }
     }
 
     /// Offers every primitive the ray may meet before `t_max` to `stop`, in no particular
