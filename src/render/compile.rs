@@ -447,7 +447,9 @@ impl RenderScene {
     #[inline(always)]
     fn flat_leaf(&self) -> Option<&'static [u32]> {
         let n = self.unbounded as usize;
-        (n > 0 && n <= FLAT_MAX).then(|| &FLAT[..n])
+        // Not with moving shapes: their bounds span the whole exposure, and the hierarchy
+        // skips them where a flat leaf would test them (1.5 % fewer instructions, blur frame 10).
+        (n > 0 && n <= FLAT_MAX && self.moving.is_none()).then(|| &FLAT[..n])
     }
 
     /// The nearest unbounded primitive's hit before `t_max`, the new `t_max`, and the placed

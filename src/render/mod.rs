@@ -387,15 +387,25 @@ fn render_adaptive(
         Some(s) => base
             .par_chunks_mut(w)
             .zip(sweeps.par_chunks_mut(w))
+            .zip(not_clear.par_chunks_mut(w))
             .enumerate()
-            .map(|(y, (row, sweep_row))| {
+            .map(|(y, ((row, sweep_row), not_clear_row))| {
                 let mut st = TraceState::default();
-                for (x, (px, sw)) in row.iter_mut().zip(sweep_row).enumerate() {
+                // A light a centre's shadow rays saw fully stays so all through the exposure
+                // when none of its rays may meet anything moving and the light holds still; and
+                // the refined samples hit near the centres only while the camera holds still.
+                let shadows_hold = !s.camera_moves() && !s.lights_move();
+                let pixels = row.iter_mut().zip(sweep_row).zip(not_clear_row);
+                for (x, ((px, sw), nc)) in pixels.enumerate() {
                     let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
                     compile::motion::watch();
+                    st.not_clear = 0;
                     let (colour, prim, t) = integrator.trace_primary_hit(&ray, &mut st);
                     *px = (colour, prim);
                     let swept = compile::motion::take_touched();
+                    if shadows_hold && swept == 0.0 {
+                        *nc = st.not_clear;
+                    }
                     sw.touched = swept > 0.0
                         && s.changes(
                             integrator,

@@ -81,6 +81,11 @@ impl Shutter {
         self.motion.camera.is_some()
     }
 
+    /// Whether a light moves.
+    pub fn lights_move(&self) -> bool {
+        self.motion.moves_lights()
+    }
+
     fn camera_at(&self, time: f32) -> Option<CameraRays> {
         let cam = self.motion.camera_at(&self.camera, time as f64);
         CameraRays::new(&cam, self.width, self.height).ok()
