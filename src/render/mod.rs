@@ -371,7 +371,7 @@ fn render_adaptive(
             .enumerate()
             .map(|(y, (row, not_clear_row))| {
                 let mut st = TraceState::default();
-                if packet::trace_centres(camera, integrator, y, row, &mut st) {
+                if packet::trace_centres(camera, integrator, y, row, not_clear_row, &mut st) {
                     return st.counts;
                 }
                 for (x, (px, nc)) in row.iter_mut().zip(not_clear_row).enumerate() {

@@ -24,17 +24,22 @@ pub fn packets_apply(integrator: &Integrator) -> bool {
 
 /// Radiance and hit primitive ([`NO_HIT`] for the background) of each camera ray, as
 /// `Integrator::trace_primary` gives them one by one.
+/// Each ray's radiance and primitive, and in `not_clear` the lights some shadow ray of its
+/// tree did not see fully (`TraceState::not_clear`), as `Integrator::trace_primary` leaves it.
 fn trace_primaries<const N: usize>(
     integrator: &Integrator,
     rays: &[crate::math::Ray; N],
     st: &mut TraceState,
+    not_clear: &mut [u32; N],
 ) -> [(Vec3A, u32); N] {
     let hits = integrator.scene.closest_packet(rays, f32::INFINITY);
     let mut out = [(integrator.scene.background, NO_HIT); N];
     for (r, hit) in hits.iter().enumerate() {
+        st.not_clear = 0;
         if let Some((prim, hit)) = hit {
             out[r] = (integrator.shade(&rays[r], *prim, hit, 0, 1.0, st), *prim);
         }
+        not_clear[r] = st.not_clear;
     }
     out
 }
@@ -76,7 +81,8 @@ pub fn render_tile(
                     let (x, y) = at(k);
                     camera.ray(x as f32 + dx, y as f32 + dy)
                 });
-                for (k, (c, _)) in trace_primaries(integrator, &rays, st).iter().enumerate() {
+                let traced = trace_primaries(integrator, &rays, st, &mut [0; BLOCK]);
+                for (k, (c, _)) in traced.iter().enumerate() {
                     sums[index(at(k))] += *c;
                 }
             }
@@ -88,13 +94,16 @@ pub fn render_tile(
 }
 
 /// Adaptive sampling's first pass over row `y`: one ray through every pixel centre, its
-/// radiance and hit primitive into `row`. False (and nothing traced) when packets do not
+/// radiance and hit primitive into `row`, the lights its tree did not see fully into
+/// `not_clear` (as the ray-by-ray pass records them, so that refinement does not depend on
+/// which pass traced the row). False (and nothing traced) when packets do not
 /// apply. Counts the camera rays in `st`.
 pub fn trace_centres(
     camera: &CameraRays,
     integrator: &Integrator,
     y: usize,
     row: &mut [(Vec3A, u32)],
+    not_clear: &mut [u32],
     st: &mut TraceState,
 ) -> bool {
     if !packets_apply(integrator) {
@@ -102,12 +111,18 @@ pub fn trace_centres(
     }
     let ray = |x: usize| camera.ray(x as f32 + 0.5, y as f32 + 0.5);
     let done = row.len() - row.len() % ROW_RUN;
-    for (c, chunk) in row[..done].chunks_exact_mut(ROW_RUN).enumerate() {
+    let runs = row[..done]
+        .chunks_exact_mut(ROW_RUN)
+        .zip(not_clear.chunks_exact_mut(ROW_RUN));
+    for (c, (chunk, nc)) in runs.enumerate() {
         let rays: [_; ROW_RUN] = std::array::from_fn(|k| ray(c * ROW_RUN + k));
-        chunk.copy_from_slice(&trace_primaries(integrator, &rays, st));
+        let nc: &mut [u32; ROW_RUN] = nc.try_into().expect("a run of ROW_RUN");
+        chunk.copy_from_slice(&trace_primaries(integrator, &rays, st, nc));
     }
-    for (x, px) in row.iter_mut().enumerate().skip(done) {
+    for (x, (px, nc)) in row.iter_mut().zip(not_clear).enumerate().skip(done) {
+        st.not_clear = 0;
         *px = integrator.trace_primary(&ray(x), st);
+        *nc = st.not_clear;
     }
     st.counts.primary += row.len() as u64;
     true
