@@ -68,8 +68,8 @@ impl RayLanes {
         // 1/0 = ±inf for zero components; `Node::hit` deals with the NaNs they can make.
         let inv = ray.dir.recip();
         RayLanes {
-            origin: [0, 1, 2].map(|a| Vec4::splat(ray.origin[a])),
-            inv_dir: [0, 1, 2].map(|a| Vec4::splat(inv[a])),
+            origin: crate::math::splat3(ray.origin),
+            inv_dir: crate::math::splat3(inv),
         }
     }
 }

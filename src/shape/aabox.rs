@@ -102,8 +102,8 @@ impl BoxRay {
     pub fn new(ray: &Ray) -> BoxRay {
         let inv = ray.dir.recip();
         BoxRay {
-            origin: [0, 1, 2].map(|i| Vec4::splat(ray.origin[i])),
-            inv: [0, 1, 2].map(|i| Vec4::splat(inv[i])),
+            origin: crate::math::splat3(ray.origin),
+            inv: crate::math::splat3(inv),
             nan_free: ray.origin.is_finite() && inv.is_finite() && inv.cmpne(Vec3A::ZERO).all(),
         }
     }

@@ -82,8 +82,8 @@ impl SphereRay {
     #[inline]
     pub fn new(ray: &Ray) -> SphereRay {
         SphereRay {
-            origin: [0, 1, 2].map(|i| Vec4::splat(ray.origin[i])),
-            dir: [0, 1, 2].map(|i| Vec4::splat(ray.dir[i])),
+            origin: crate::math::splat3(ray.origin),
+            dir: crate::math::splat3(ray.dir),
             a: Vec4::splat(ray.dir.length_squared()),
         }
     }

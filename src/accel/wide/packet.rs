@@ -65,9 +65,9 @@ impl<const N: usize> Packet<N> {
             let lo = inv.iter().fold(inv[0], |a, &b| a.min(b));
             let hi = inv.iter().fold(inv[0], |a, &b| a.max(b));
             Bounds {
-                origin: [0, 1, 2].map(|a| Vec4::splat(origin[a])),
-                inv_lo: [0, 1, 2].map(|a| Vec4::splat(lo[a])),
-                inv_hi: [0, 1, 2].map(|a| Vec4::splat(hi[a])),
+                origin: crate::math::splat3(origin),
+                inv_lo: crate::math::splat3(lo),
+                inv_hi: crate::math::splat3(hi),
             }
         });
         Some(Packet {
