@@ -238,14 +238,7 @@ impl Moving {
     /// norm bounds its stretch.
     fn poses_of(&self, k: u32) -> Vec<Option<Pose>> {
         let unknown = vec![None; POSE_PARTS];
-        let Some(inst) = self
-            .entries
-            .get(k as usize)
-            .and_then(|&i| self.instances.get(i as usize))
-        else {
-            return unknown;
-        };
-        let Ok(local) = Primitive::new(&inst.geometry, &Transform::IDENTITY, 0) else {
+        let Some((inst, local)) = self.own(k) else {
             return unknown;
         };
         let sphere = local.world_sphere().map(|s| s.packed());
@@ -313,11 +306,21 @@ impl Moving {
             .collect()
     }
 
+    /// Entry `k`'s instance.
+    fn instance(&self, k: u32) -> Option<&Instance> {
+        self.instances.get(*self.entries.get(k as usize)? as usize)
+    }
+
+    /// Entry `k`'s instance and its shape in its own space (where its motion places it from).
+    fn own(&self, k: u32) -> Option<(&Instance, Primitive)> {
+        let inst = self.instance(k)?;
+        let shape = Primitive::new(&inst.geometry, &Transform::IDENTITY, 0).ok()?;
+        Some((inst, shape))
+    }
+
     /// Entry `k` at time `u`: its transform.
     fn transform(&self, k: u32, u: f64) -> Option<(&Instance, Transform)> {
-        let inst = self
-            .instances
-            .get(*self.entries.get(k as usize)? as usize)?;
+        let inst = self.instance(k)?;
         Some((inst, self.motion.slot_at(inst.transform, u)))
     }
 
@@ -361,11 +364,7 @@ impl Moving {
 
     /// Entry `k`'s bounds over the whole exposure.
     fn swept(&self, k: u32) -> Swept {
-        let Some(inst) = self
-            .entries
-            .get(k as usize)
-            .and_then(|&i| self.instances.get(i as usize))
-        else {
+        let Some((inst, local)) = self.own(k) else {
             return Swept {
                 bounds: Aabb::EMPTY,
                 path: 0.0,
@@ -375,12 +374,6 @@ impl Moving {
             .map(|s| s as f64 / BOUND_STEPS as f64)
             .collect();
         instants.extend(self.motion.slot_instants(inst.transform));
-        let Ok(local) = Primitive::new(&inst.geometry, &Transform::IDENTITY, 0) else {
-            return Swept {
-                bounds: Aabb::EMPTY,
-                path: 0.0,
-            };
-        };
         swept_bounds(&instants, |u| {
             Some((local.bounds, self.motion.slot_at(inst.transform, u)))
         })
