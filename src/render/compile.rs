@@ -338,6 +338,28 @@ impl RenderScene {
         }
     }
 
+    /// The moving entry primitive `i` (as `closest` names it) is, if it moves.
+    #[inline]
+    pub fn moving_entry(&self, i: u32) -> Option<u32> {
+        self.moving.as_ref()?;
+        let k = *self.kind.get(i as usize)?;
+        is_moving(k).then_some(k & !MOVING)
+    }
+
+    /// Whether [`RenderScene::moving_blocks`] answers.
+    pub fn answers_moving_blocks(&self) -> bool {
+        self.moving.as_ref().is_none_or(|m| m.answers_blocks())
+    }
+
+    /// Whether a moving shape blocks a shadow ray before `t_max` at the ray's time, leaving
+    /// moving entry `from` outwards (see `Moving::blocks`); `Some(false)` when nothing moves.
+    #[inline]
+    pub fn moving_blocks(&self, ray: &Ray, t_max: f32, from: Option<u32>) -> Option<bool> {
+        self.moving
+            .as_ref()
+            .map_or(Some(false), |m| m.blocks(ray, t_max, from))
+    }
+
     /// Whether a shape or light moves during the exposure.
     pub fn has_motion(&self) -> bool {
         self.moving.is_some()

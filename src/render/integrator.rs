@@ -39,6 +39,14 @@ pub struct TraceState {
     /// shadow ray, because no shadow ray of the first pass around this pixel found otherwise
     /// (set by adaptive sampling for the samples it adds).
     pub known_clear: u32,
+    /// In a frame with motion, `known_clear` speaks for the shapes that hold still only: a
+    /// sample still asks the moving shapes at its own instant. And it holds for camera hits
+    /// between these distances only (those of the first pass's hits around the pixel): a
+    /// hit nearer or farther than all of them, on a shape that has moved there, may see the
+    /// lights past shapes theirs did not.
+    pub known_clear_near: Option<(f32, f32)>,
+    /// The moving entry the latest camera ray hit, whose shadow rays leave it.
+    lit_from: Option<u32>,
 }
 
 impl Default for TraceState {
@@ -49,6 +57,8 @@ impl Default for TraceState {
             shadow_cut: 0.0,
             not_clear: 0,
             known_clear: 0,
+            known_clear_near: None,
+            lit_from: None,
         }
     }
 }
@@ -133,8 +143,17 @@ impl Integrator<'_> {
         // Shading normal faces the incoming ray; the geometric one decides inside/outside.
         let n = if entering { hit.normal } else { -hit.normal };
         let (rho, alpha) = (mat.reflectivity, mat.opacity);
+        let near = |(lo, hi): (f32, f32)| hit.t >= lo && hit.t <= hi;
+        let known_clear = if depth == 0 && st.known_clear_near.is_none_or(near) {
+            if st.known_clear_near.is_some() {
+                st.lit_from = scene.moving_entry(prim);
+            }
+            st.known_clear
+        } else {
+            0
+        };
         if rho == 0.0 && alpha == 1.0 {
-            return self.local(mat, hit, n, -ray.dir, ray.time, (weight, depth), st);
+            return self.local(mat, hit, n, -ray.dir, ray.time, (weight, known_clear), st);
         }
 
         // c = α·((1−ρ)·c_local + ρ·c_r) + (1−α)·(F·c_r + (1−F)·c_t)
@@ -163,7 +182,7 @@ impl Integrator<'_> {
                 n,
                 -ray.dir,
                 ray.time,
-                (weight * w_local, depth),
+                (weight * w_local, known_clear),
                 st,
             ) * w_local
         };
@@ -186,7 +205,9 @@ impl Integrator<'_> {
 
     /// `Ka·I_ambient + Σ vis·I·(Kd·max(N·L,0) + Ks·max(R·V,0)^m)`, specular only where N·L > 0.
     /// Lights and shadowing geometry are taken at `time`, the instant of the exposure;
-    /// `weight` is the result's share of the pixel (for `TraceState::shadow_cut`).
+    /// `weight` is the result's share of the pixel (for `TraceState::shadow_cut`), and
+    /// `known_clear` the lights taken as visible here without a shadow ray
+    /// (`TraceState::known_clear`, at camera hits only).
     #[inline]
     #[allow(clippy::too_many_arguments)]
     fn local(
@@ -196,10 +217,9 @@ impl Integrator<'_> {
         n: Vec3A,
         v: Vec3A,
         time: f32,
-        (weight, depth): (f32, u32),
+        (weight, known_clear): (f32, u32),
         st: &mut TraceState,
     ) -> Vec3A {
-        let known_clear = if depth == 0 { st.known_clear } else { 0 };
         let scene = self.scene;
         let mut c = mat.ka * scene.ambient;
         // `ks·spec` is exactly zero without a specular colour (spec is at most 1 for m ≥ 0).
@@ -233,7 +253,11 @@ impl Integrator<'_> {
                 continue;
             }
             let lit = light.intensity * unshadowed;
-            if lit.max_element() * weight < st.shadow_cut || (known_clear >> k.min(31)) & 1 != 0 {
+            if lit.max_element() * weight < st.shadow_cut
+                || ((known_clear >> k.min(31)) & 1 != 0
+                    && !(st.known_clear_near.is_some()
+                        && self.moving_blocks(hit, l, dist, time, st.lit_from)))
+            {
                 c += lit;
                 continue;
             }
@@ -248,6 +272,22 @@ impl Integrator<'_> {
             c += light.intensity * vis * unshadowed;
         }
         c
+    }
+
+    /// Whether a moving shape may block the light at distance `dist` along `l` from `hit` (on
+    /// moving entry `from`, if any), at `time`: then the shadow ray is traced in full (as also when the moving shapes are too
+    /// many to ask one by one).
+    fn moving_blocks(
+        &self,
+        hit: &SurfaceHit,
+        l: Vec3A,
+        dist: f32,
+        time: f32,
+        from: Option<u32>,
+    ) -> bool {
+        let ray = hit.spawn_ray(l).at_time(time);
+        let remaining = (hit.point + l * dist - ray.origin).dot(l);
+        self.scene.moving_blocks(&ray, remaining, from) != Some(false)
     }
 
     /// Fraction of a light's intensity reaching `p`: 0 behind an opaque object, attenuated by

@@ -17,6 +17,7 @@ use glam::{DVec3, Vec3, Vec3A};
 use integrator::{Integrator, TraceState, NO_HIT};
 use motion::Shutter;
 use rayon::prelude::*;
+use sampling::PixelPattern;
 use std::path::PathBuf;
 
 /// Tile edge in pixels: small enough to balance two to many cores, big enough that the
@@ -309,6 +310,9 @@ struct Sweep {
     /// its centre), along which the image must be flat for it to keep its centre sample;
     /// `None` when it sweeps too far for that (`Shutter::camera_sweep`).
     streak: Option<[(f32, f32); 2]>,
+    /// How far along its centre ray the surface it hit lies, where its shadow rays' findings
+    /// are kept for the shapes that hold still (NaN where they are not).
+    depth: f32,
 }
 
 impl Default for Sweep {
@@ -316,6 +320,7 @@ impl Default for Sweep {
         Sweep {
             touched: false,
             streak: Some([(0.0, 0.0); 2]),
+            depth: f32::NAN,
         }
     }
 }
@@ -325,7 +330,7 @@ fn add_counts(mut a: RayCounts, b: RayCounts) -> RayCounts {
     a
 }
 
-/// Adaptive sampling (see `sampling`), in two passes over the image.
+/// Adaptive sampling (see `sampling`), in two passes over the image (three with motion).
 ///
 /// 1. One ray through every pixel centre (exactly `--spp 1`), keeping the primitive it hit.
 /// 2. A pixel whose 3×3 neighbourhood of centres shows one surface and at most
@@ -346,7 +351,9 @@ fn add_counts(mut a: RayCounts, b: RayCounts) -> RayCounts {
 /// In a frame with motion, the first pass takes the middle of the exposure and the samples of
 /// pass 2 carry instants (`PixelPattern::time`). A pixel is not flat when the rays of a centre
 /// sample around it may meet a moving shape at some instant, nor when the camera's motion
-/// sweeps its hit point across a neighbourhood whose two halves do not average to its centre
+/// sweeps its hit point across a neighbourhood whose two halves do not average to its centre.
+/// Such a pixel takes at least `MOTION_MIN_SAMPLES`, and pass 3 (`recheck_motion`) goes on
+/// with those whose samples all agreed but whose neighbours show otherwise
 /// (docs/scene-language.md §10).
 fn render_adaptive(
     camera: &CameraRays,
@@ -391,10 +398,14 @@ fn render_adaptive(
             .enumerate()
             .map(|(y, ((row, sweep_row), not_clear_row))| {
                 let mut st = TraceState::default();
-                // A light a centre's shadow rays saw fully stays so all through the exposure
-                // when none of its rays may meet anything moving and the light holds still; and
-                // the refined samples hit near the centres only while the camera holds still.
+                // The refined samples hit near the centres only while the camera holds still,
+                // and a light a centre's shadow rays saw fully stays so only while it holds
+                // still. Then, where the moving shapes are few enough to ask at each sample's
+                // instant, what they saw is kept as news of the shapes that hold still, with
+                // how far the centre's hit is (see `known_clear_near`); otherwise only for
+                // centres none of whose rays may meet anything moving.
                 let shadows_hold = !s.camera_moves() && !s.lights_move();
+                let of_still = integrator.scene.answers_moving_blocks();
                 let pixels = row.iter_mut().zip(sweep_row).zip(not_clear_row);
                 for (x, ((px, sw), nc)) in pixels.enumerate() {
                     let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
@@ -403,8 +414,11 @@ fn render_adaptive(
                     let (colour, prim, t) = integrator.trace_primary_hit(&ray, &mut st);
                     *px = (colour, prim);
                     let swept = compile::motion::take_touched();
-                    if shadows_hold && swept == 0.0 {
+                    if shadows_hold && (of_still || swept == 0.0) {
                         *nc = st.not_clear;
+                        if of_still {
+                            sw.depth = t.unwrap_or(f32::NAN);
+                        }
                     }
                     sw.touched = swept > 0.0
                         && s.changes(
@@ -432,6 +446,8 @@ fn render_adaptive(
     let tones: Vec<Vec3A> = base.par_iter().map(|(c, _)| sampling::tone3(*c)).collect();
     let tones = &tones;
     let not_clear = &not_clear;
+    let known_of_still = shutter.is_some_and(|s| !s.camera_moves() && !s.lights_move())
+        && integrator.scene.answers_moving_blocks();
     // The lights that every shadow ray of the centres around (x, y) saw fully: a refined
     // pixel's samples take them as visible, without shadow rays, where their camera rays
     // hit. A shadow edge inside the pixel that none of the nine centres' trees met is lost,
@@ -448,9 +464,27 @@ fn render_adaptive(
         }
         !seen
     };
+    // In a frame with motion whose centres kept their shadow rays' findings for the shapes
+    // that hold still: the range of distances of the hits of the centres around (x, y). A
+    // sample that hits nearer or farther than every one of them may see the lights past other
+    // shapes, so it takes none as known (`TraceState::known_clear_near`).
+    let known_clear_near = |x: usize, y: usize| -> Option<(f32, f32)> {
+        if !known_of_still {
+            return None;
+        }
+        let mut near = (f32::INFINITY, f32::NEG_INFINITY);
+        for ny in y.saturating_sub(1)..(y + 2).min(h) {
+            let row = ny * w;
+            for s in &sweeps[row + x.saturating_sub(1)..row + (x + 2).min(w)] {
+                // NaN (no depth kept) leaves the range as it is.
+                near = (near.0.min(s.depth), near.1.max(s.depth));
+            }
+        }
+        Some(near)
+    };
     // The largest tone-mapped difference (8-bit levels) between the centre of (x, y) and the
     // centres around it, or None if the pixel is flat and keeps its centre sample.
-    let edge_contrast = |x: usize, y: usize| -> Option<f32> {
+    let edge_contrast = |x: usize, y: usize| -> Option<(f32, bool)> {
         let prim = base[y * w + x].1;
         let tone = tones[y * w + x];
         let mut contrast = 0.0f32;
@@ -502,32 +536,48 @@ fn render_adaptive(
         let flat = !moving
             && !other_surface
             && 255.0 * contrast.max(streak_bias) <= sampling::FLAT_CONTRAST;
-        (!flat).then_some(255.0 * contrast.max(streak_contrast))
+        (!flat).then_some((255.0 * contrast.max(streak_contrast), moving))
+    };
+
+    // Sample `i` of pixel (x, y)'s own pattern, after `know`.
+    let sample = |(x, y): (usize, usize), pattern: &PixelPattern, i: u32, st: &mut TraceState| {
+        let (dx, dy) = pattern.sample(i);
+        let (px, py) = (x as f32 + dx, y as f32 + dy);
+        let ray = match shutter {
+            None => camera.ray(px, py),
+            Some(s) => s.ray(camera, px, py, pattern.time(i)),
+        };
+        integrator.trace(&ray, 0, 1.0, st)
+    };
+    // What a pixel's samples know of the lights before they trace (`TraceState`).
+    let know = |x: usize, y: usize, st: &mut TraceState| {
+        st.known_clear = known_clear(x, y);
+        st.known_clear_near = known_clear_near(x, y);
     };
 
     let mut pixels = vec![Vec3::ZERO; w * h];
+    // Per pixel: the samples pass 2 took, up to 255 (0: it kept its centre), for pass 3.
+    let mut taken = vec![0u8; w * h];
     let refine_counts = pixels
         .par_chunks_mut(w)
+        .zip(taken.par_chunks_mut(w))
         .enumerate()
-        .map(|(y, row)| {
+        .map(|(y, (row, taken_row))| {
             let mut st = TraceState::refining();
             for (x, out) in row.iter_mut().enumerate() {
-                let Some(contrast) = edge_contrast(x, y).filter(|_| max_spp > 1) else {
+                let Some((contrast, moving)) = edge_contrast(x, y).filter(|_| max_spp > 1) else {
                     *out = Vec3::from(base[y * w + x].0);
                     continue;
                 };
-                let at_least = sampling::min_samples(contrast, error, max_spp);
-                let pattern = sampling::PixelPattern::new(x as u32, y as u32);
-                st.known_clear = known_clear(x, y);
+                let mut at_least = sampling::min_samples(contrast, error, max_spp);
+                if moving {
+                    at_least = at_least.max(sampling::MOTION_MIN_SAMPLES).min(max_spp);
+                }
+                know(x, y, &mut st);
+                let pattern = PixelPattern::new(x as u32, y as u32);
                 let mut m = sampling::Moments::default();
                 while m.n < max_spp {
-                    let (dx, dy) = pattern.sample(m.n);
-                    let (px, py) = (x as f32 + dx, y as f32 + dy);
-                    let ray = match shutter {
-                        None => camera.ray(px, py),
-                        Some(s) => s.ray(camera, px, py, pattern.time(m.n)),
-                    };
-                    m.add(integrator.trace(&ray, 0, 1.0, &mut st));
+                    m.add(sample((x, y), &pattern, m.n, &mut st));
                     // Checked at powers of two only: there every prefix is a full net.
                     if m.n >= at_least && m.n.is_power_of_two() && m.error() <= error {
                         break;
@@ -535,12 +585,98 @@ fn render_adaptive(
                 }
                 st.counts.primary += m.n as u64;
                 *out = Vec3::from(m.mean());
+                taken_row[x] = m.n.min(u8::MAX as u32) as u8;
             }
             on_tile(row.len() as u64);
             st.counts
         })
         .reduce(RayCounts::default, add_counts);
-    (pixels, add_counts(base_counts, refine_counts))
+    let mut counts = add_counts(base_counts, refine_counts);
+    if shutter.is_some() && max_spp > 1 {
+        let motion_contrast = |x: usize, y: usize| {
+            edge_contrast(x, y)
+                .filter(|&(_, moving)| moving)
+                .map(|(contrast, _)| contrast)
+        };
+        let frame = (&taken[..], (w, h));
+        counts += recheck_motion(
+            &mut pixels,
+            frame,
+            error,
+            max_spp,
+            motion_contrast,
+            (&know, &sample),
+        );
+    }
+    (pixels, counts)
+}
+
+/// Sets what a pixel's samples know of the lights (`TraceState::known_clear`).
+type Know<'a> = dyn Fn(usize, usize, &mut TraceState) + Sync + 'a;
+/// Sample `i` of a pixel's own pattern: its radiance.
+type Sample<'a> = dyn Fn((usize, usize), &PixelPattern, u32, &mut TraceState) -> Vec3A + Sync + 'a;
+
+/// Pass 3 of adaptive sampling in a frame with motion. A pixel that motion touches and whose
+/// samples all agreed stops at `MOTION_MIN_SAMPLES`, though something moving may have covered
+/// it for a part of the exposure that none of its instants fell in (a shadow's blurred end, a
+/// thin edge). Its neighbours' samples tell: where its mean differs from a neighbour's by
+/// more than the first pass's contrast around it (`motion_contrast`, levels; `None` where
+/// motion does not touch it) and twice the error target, it goes on with its own pattern
+/// (`sample`, after `know`), doubling its samples until the new half agrees with the old
+/// (`Moments::resume`) or it reaches `max_spp`. Reads only pass 2's finished image, so the result
+/// does not depend on the order pixels are visited in.
+fn recheck_motion(
+    pixels: &mut [Vec3],
+    (taken, (w, h)): (&[u8], (usize, usize)),
+    error: f32,
+    max_spp: u32,
+    motion_contrast: impl Fn(usize, usize) -> Option<f32> + Sync,
+    (know, sample): (&Know<'_>, &Sample<'_>),
+) -> RayCounts {
+    let tones: Vec<Vec3A> = pixels
+        .par_iter()
+        .map(|c| sampling::tone3(Vec3A::from(*c)))
+        .collect();
+    let tones = &tones;
+    pixels
+        .par_chunks_mut(w)
+        .enumerate()
+        .map(|(y, row)| {
+            let mut st = TraceState::refining();
+            for (x, out) in row.iter_mut().enumerate() {
+                let n = taken[y * w + x] as u32;
+                if n == 0 || n > sampling::MOTION_MIN_SAMPLES || n >= max_spp {
+                    continue;
+                }
+                let Some(contrast) = motion_contrast(x, y) else {
+                    continue;
+                };
+                let tone = tones[y * w + x];
+                let mut differs = 0.0f32;
+                for ny in y.saturating_sub(1)..(y + 2).min(h) {
+                    let near = ny * w + x.saturating_sub(1)..ny * w + (x + 2).min(w);
+                    for t in &tones[near] {
+                        differs = differs.max((*t - tone).abs().max_element());
+                    }
+                }
+                if 255.0 * differs <= contrast + 2.0 * error {
+                    continue;
+                }
+                know(x, y, &mut st);
+                let pattern = PixelPattern::new(x as u32, y as u32);
+                let mut m = sampling::Moments::resume(Vec3A::from(*out), n);
+                while m.n < max_spp {
+                    m.add(sample((x, y), &pattern, m.n, &mut st));
+                    if m.n.is_power_of_two() && m.error() <= error {
+                        break;
+                    }
+                }
+                st.counts.primary += (m.n - n) as u64;
+                *out = Vec3::from(m.mean());
+            }
+            st.counts
+        })
+        .reduce(RayCounts::default, add_counts)
 }
 
 #[cfg(test)]

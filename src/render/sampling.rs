@@ -16,6 +16,14 @@ use glam::Vec3A;
 /// points) can be compared, one sample per quadrant.
 pub const MIN_SAMPLES: u32 = 4;
 
+/// Fewest samples of a pixel that motion touches. Its instants are stratified, one in each
+/// 1/n of the exposure, so n samples all miss only what covers the pixel for less than about
+/// 1/n of it: at 4, a moving shadow's blurred end went unseen often enough to leave the
+/// blurred frames of animations/blur.ron at 0.92–0.98 levels RMS from the mean of 16
+/// instants; at 8, 0.54–0.59 (BENCHMARKS.md §14.2). What 8 still miss, pass 3 of
+/// `render_adaptive` looks for in the neighbours.
+pub const MOTION_MIN_SAMPLES: u32 = 8;
+
 /// Largest contrast (8-bit levels) between a pixel's centre sample and its 8 neighbours'
 /// for the pixel to be flat and keep its centre sample, if all nine hit the same surface.
 /// Smooth shading changes by about a level from pixel to pixel; a shadow or highlight edge,
@@ -227,6 +235,21 @@ impl Moments {
                 self.changes = [self.changes[1], 255.0 * change.max_element()];
             }
             self.tone_at_half = self.tone_sum;
+        }
+    }
+
+    /// The sums of `n` samples that agreed (a pixel that stopped at its first check) whose
+    /// mean was `mean`, to take more of them: the next check compares the mean of `2n`
+    /// with `mean`, as if every one of the `n` had been `mean`.
+    pub fn resume(mean: Vec3A, n: u32) -> Moments {
+        let n_f = n as f32;
+        let tone_sum = tone3(mean) * n_f;
+        Moments {
+            n,
+            sum: mean * n_f,
+            tone_sum,
+            tone_at_half: tone_sum,
+            changes: [0.0; 2],
         }
     }
 

@@ -13,6 +13,7 @@ use crate::math::{Aabb, Ray, Transform};
 use crate::render::primitive::Primitive;
 use crate::scene::motion::Motion;
 use crate::scene::{Instance, Scene};
+use crate::shape::{BoxRay, Geometry};
 use glam::{Affine3A, DVec3, Vec3A, Vec4};
 use std::cell::{Cell, RefCell};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -30,6 +31,11 @@ const POSE_PARTS: usize = 32;
 
 /// Steps per half part over which a pose's drift is measured (and at the keys' instants).
 const DRIFT_STEPS: usize = 2;
+/// Most moving shapes a shadow ray asks one by one whether they block it
+/// ([`Moving::blocks`]); past this, asking them costs about what the hierarchy does.
+const BLOCKS_MAX: usize = 16;
+/// Boxes slab-tested at once by [`Moving::blocks`].
+const LANES: usize = 4;
 
 /// A moving shape over one part of the exposure: the map into its own space at the part's
 /// middle, and there its own bounds, and for a sphere the sphere, grown by how far any of its
@@ -39,6 +45,9 @@ const DRIFT_STEPS: usize = 2;
 struct Pose {
     object_from_world: Affine3A,
     grown: Aabb,
+    /// World bounds of `grown` placed at the part's middle: the shape stays inside all
+    /// through the part.
+    world: Aabb,
     /// Centre and grown radius, when the shape is a sphere in its own space.
     sphere: Option<Vec4>,
 }
@@ -117,6 +126,8 @@ pub struct Moving {
     sweep: Vec<f32>,
     /// Per moving entry: its bounds over the exposure.
     bounds: Vec<Aabb>,
+    /// Per moving entry: whether its shape is convex.
+    convex: Vec<bool>,
     /// Entry `k`'s pose in part `i` of the exposure in cell `k·POSE_PARTS + i`; `None` where
     /// it cannot be told (degenerate or unbounded), which counts as met.
     poses: Vec<Option<Pose>>,
@@ -126,6 +137,11 @@ pub struct Moving {
     /// by the first ray that needs it; empty when the scene has too many moving shapes for
     /// it (each worker then places them per camera sample).
     placed: Vec<OnceLock<Option<Primitive>>>,
+    /// Where [`Moving::blocks`] answers: per part of the exposure, the world box of each
+    /// entry's pose there (its bounds over the exposure where it has none), in groups of
+    /// four (`min`, `max`; NaN past the last entry), for [`BoxRay::slabs4`].
+    part_min: Vec<Vec4>,
+    part_max: Vec<Vec4>,
 }
 
 /// The instant camera samples at `time` are taken at: the middle of its part of the
@@ -156,6 +172,9 @@ impl Moving {
             sweep: Vec::new(),
             bounds: Vec::new(),
             poses: Vec::new(),
+            convex: Vec::new(),
+            part_min: Vec::new(),
+            part_max: Vec::new(),
             lights: scene.lights.iter().map(|l| l.position).collect(),
             placed: Vec::new(),
         })
@@ -166,6 +185,21 @@ impl Moving {
         let cells = self.entries.len() * MOTION_TIME_STEPS as usize;
         if cells <= MOTION_MAX_PLACED {
             self.placed = (0..cells).map(|_| OnceLock::new()).collect();
+        }
+        if self.answers_blocks() {
+            let lanes = self.entries.len().next_multiple_of(LANES);
+            let unused = Vec4::splat(f32::NAN);
+            (self.part_min, self.part_max) = (0..POSE_PARTS)
+                .flat_map(|part| (0..lanes).map(move |k| (part, k)))
+                .map(|(part, k)| match self.poses.get(k * POSE_PARTS + part) {
+                    _ if k >= self.entries.len() => (unused, unused),
+                    Some(Some(pose)) => (pose.world.min.extend(0.0), pose.world.max.extend(0.0)),
+                    _ => (
+                        self.bounds[k].min.extend(0.0),
+                        self.bounds[k].max.extend(0.0),
+                    ),
+                })
+                .unzip();
         }
     }
 
@@ -193,6 +227,10 @@ impl Moving {
         self.sweep
             .push(if angle.is_nan() { f32::INFINITY } else { angle });
         self.bounds.push(b);
+        let convex = self
+            .instance(k)
+            .is_some_and(|inst| !matches!(inst.geometry, Geometry::Mesh(_)));
+        self.convex.push(convex);
         let poses = self.poses_of(k);
         self.poses.extend(poses);
         (k, swept.bounds)
@@ -225,6 +263,48 @@ impl Moving {
             cell.get_or_init(|| self.place(k, (step as f32 + 0.5) / MOTION_TIME_STEPS as f32))
                 .as_ref(),
         )
+    }
+
+    /// Whether [`Moving::blocks`] answers.
+    pub fn answers_blocks(&self) -> bool {
+        self.entries.len() <= BLOCKS_MAX
+    }
+
+    /// Whether some moving shape blocks (wholly or in part) a ray before `t_max`, at the
+    /// ray's time, leaving the surface of entry `from` (if any) outwards; `None` when there
+    /// are more moving shapes than it pays to ask one by one.
+    /// For shadow rays whose light no static shape blocks (adaptive sampling's known-clear
+    /// lights in frames with motion), which need not walk the whole hierarchy.
+    pub fn blocks(&self, ray: &Ray, t_max: f32, from: Option<u32>) -> Option<bool> {
+        if !self.answers_blocks() {
+            return None;
+        }
+        // The part of the exposure the ray's instant lies in: the shapes' bounds in it are
+        // much tighter than over the whole exposure.
+        let part = ((ray.time * POSE_PARTS as f32) as usize).min(POSE_PARTS - 1);
+        let boxes = BoxRay::new(ray);
+        let n = self.entries.len();
+        let first = part * n.next_multiple_of(LANES);
+        for group in (0..n).step_by(LANES) {
+            let at = first + group;
+            let four = |v: &[Vec4]| [v[at], v[at + 1], v[at + 2], v[at + 3]];
+            let live = (1u32 << (n - group).min(LANES)) - 1;
+            let slabs = boxes.slabs4(four(&self.part_min), four(&self.part_max));
+            let mut near = slabs.overlaps(t_max) & live;
+            while near != 0 {
+                let k = group + near.trailing_zeros() as usize;
+                near &= near - 1;
+                // A ray leaving the surface of a convex shape (every kind but a mesh) outwards,
+                // as a shadow ray towards a light on its lit side does, cannot meet it again.
+                if from == Some(k as u32) && self.convex[k] {
+                    continue;
+                }
+                if self.with(k as u32, ray, |p| p.hit(ray, t_max).is_some()) == Some(true) {
+                    return Some(true);
+                }
+            }
+        }
+        Some(false)
     }
 
     /// Entry `k`'s poses, one per part of the exposure (see [`Pose`]).
@@ -297,9 +377,24 @@ impl Moving {
                 // And a relative margin for the f32 rounding of the ray's map.
                 let pad = Vec3A::splat(grow as f32)
                     + (local.min.abs().max(local.max.abs()) + local.extent()) * 1e-4;
+                let grown = Aabb::new(local.min - pad, local.max + pad);
+                let world = Aabb::from_points(grown.corners().map(|c| {
+                    Vec3A::from(
+                        xf.world_from_object
+                            .transform_point3(c.as_dvec3())
+                            .as_vec3(),
+                    )
+                }));
+                // The f32 rounding of the corners, outwards.
+                let slack = (world.min.abs().max(world.max.abs()) + world.extent()) * 1e-4;
+                let world = Aabb::new(world.min - slack, world.max + slack);
+                if !world.is_finite() {
+                    return None;
+                }
                 Some(Pose {
                     object_from_world: Affine3A::from_mat4(inverse.as_mat4()),
-                    grown: Aabb::new(local.min - pad, local.max + pad),
+                    grown,
+                    world,
                     sphere: sphere.map(|s| s.truncate().extend(s.w + pad.max_element())),
                 })
             })
@@ -395,6 +490,7 @@ impl Moving {
             + self.poses.capacity() * std::mem::size_of::<Option<Pose>>()
             + self.lights.capacity() * 24
             + self.placed.capacity() * std::mem::size_of::<OnceLock<Option<Primitive>>>()
+            + (self.part_min.capacity() + self.part_max.capacity()) * std::mem::size_of::<Vec4>()
     }
 }
 
@@ -586,6 +682,9 @@ mod tests {
             let placed = moving.placed_at(k, step).flatten().expect("placed");
             prop_assume!(placed.hit(&ray, f32::INFINITY).is_some());
             prop_assert!(moving.met_by(k, &ray), "entry {k} hit at step {step}, not met");
+            // And a shadow ray at that instant asks it (its bounds in that part hold it).
+            let at = ray.at_time(u as f32);
+            prop_assert_eq!(moving.blocks(&at, f32::INFINITY, None), Some(true), "entry {} at step {}", k, step);
         }
     }
 
@@ -609,6 +708,21 @@ mod tests {
             .hit_range(&corner, corner.dir.recip(), 0.0, f32::INFINITY)
             .is_some());
         assert!(!moving.met_by(1, &corner));
+    }
+
+    #[test]
+    fn a_shadow_ray_asks_the_moving_shapes_where_they_are_at_its_instant() {
+        let moving = moving_things();
+        // Down through the ball's centre at the middle of the exposure, (3, 0, 0).
+        let at = |time: f32| Ray::new(Vec3A::new(3.0, 0.0, 5.0), Vec3A::NEG_Z).at_time(time);
+        assert_eq!(moving.blocks(&at(0.5), f32::INFINITY, None), Some(true));
+        // Early on the ball is 8 units to the left; the bar and the post are never there.
+        assert_eq!(moving.blocks(&at(0.1), f32::INFINITY, None), Some(false));
+        // The light is nearer than the ball.
+        assert_eq!(moving.blocks(&at(0.5), 4.0, None), Some(false));
+        // A ray said to leave the ball's own surface (entry 1) does not ask the ball.
+        assert_eq!(moving.blocks(&at(0.5), f32::INFINITY, Some(1)), Some(false));
+        assert!(moving.answers_blocks());
     }
 
     #[test]
