@@ -37,6 +37,8 @@ struct Node {
     order: [u8; 8],
     /// Number of children (1 only for a root that is a single leaf).
     len: u8,
+    /// `len` low bits set: the lanes that hold a child (kept, not derived per visit).
+    live: u8,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -100,8 +102,7 @@ impl Node {
             }
         }
         let exit = (exit * SLAB_WIDEN).min(Vec4::splat(t_max));
-        let live = (1u32 << self.len) - 1;
-        (enter.cmple(exit).bitmask() & live, enter)
+        (enter.cmple(exit).bitmask() & u32::from(self.live), enter)
     }
 }
 
@@ -176,6 +177,7 @@ impl Bvh {
             child: [0; WIDTH],
             order,
             len: len as u8,
+            live: (1u8 << len) - 1,
         });
         let mut min = [[f32::INFINITY; WIDTH]; 3];
         let mut max = [[f32::NEG_INFINITY; WIDTH]; 3];

@@ -222,7 +222,7 @@ impl Bvh {
                     _ => u32::MAX,
                 };
                 let mut met = 0u32;
-                for slot in bits(maybe & ((1 << node.len) - 1)) {
+                for slot in bits(maybe & u32::from(node.live)) {
                     hit[slot] =
                         node.hit_packet::<N, NAN_FREE>(slot, p, t_max, &mut enter[slot]) & mask;
                     met |= u32::from(hit[slot] != 0) << slot;
@@ -313,7 +313,7 @@ impl Bvh {
                 Some(b) if NAN_FREE => node.maybe_hit(b, t_max_hi),
                 _ => u32::MAX,
             };
-            for slot in bits(maybe & ((1 << node.len) - 1)) {
+            for slot in bits(maybe & u32::from(node.live)) {
                 hit[slot] = node.hit_packet::<N, NAN_FREE>(slot, p, t_max, &mut enter) & mask;
             }
             let order = node.order[p.octant];
