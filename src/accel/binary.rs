@@ -247,8 +247,17 @@ fn find_split(items: &mut [BuildItem], extent: &Extent) -> Option<Split> {
         // Sweep from the right to get the area and count of everything right of each split.
         let mut right_area = [0.0f32; BINS];
         let mut right_count = [0usize; BINS];
+        // An empty bin (its box is `Aabb::EMPTY`, which a union leaves unchanged) adds
+        // nothing: the sums right of it are those right of the next bin, and the split
+        // after it costs exactly what the split before it did, which it could not beat.
+        // Small nodes leave most bins empty.
         let (mut acc_b, mut acc_n) = (Aabb::EMPTY, 0);
         for b in (1..BINS).rev() {
+            if bin_counts[b] == 0 && b + 1 < BINS {
+                right_area[b] = right_area[b + 1];
+                right_count[b] = acc_n;
+                continue;
+            }
             acc_b = acc_b.union(bin_bounds[b]);
             acc_n += bin_counts[b];
             right_area[b] = acc_b.surface_area();
@@ -256,6 +265,9 @@ fn find_split(items: &mut [BuildItem], extent: &Extent) -> Option<Split> {
         }
         let (mut left_b, mut left_n) = (Aabb::EMPTY, 0);
         for split in 1..BINS {
+            if bin_counts[split - 1] == 0 {
+                continue;
+            }
             left_b = left_b.union(bin_bounds[split - 1]);
             left_n += bin_counts[split - 1];
             if left_n == 0 || right_count[split] == 0 {
