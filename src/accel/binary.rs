@@ -201,6 +201,15 @@ fn build_subtree(
     bvh
 }
 
+/// The bin of a centroid `x` bin widths from the lowest: `(x as usize).min(BINS - 1)` for
+/// every float (NaN and negatives to bin 0, large ones to the last), without that
+/// float-to-u64 conversion, which with an array map was a fifth of a 100k-sphere build's
+/// instructions.
+#[inline(always)]
+fn bin(x: f32) -> usize {
+    (x as i32).clamp(0, BINS as i32 - 1) as usize
+}
+
 /// Binned surface-area heuristic: the best (axis, split position) over `BINS` centroid bins,
 /// or `None` when a leaf is cheaper (or unavoidable). Partitions `items` in place.
 ///
@@ -217,8 +226,8 @@ fn find_split(items: &mut [BuildItem], extent: &Extent) -> Option<Split> {
     let scale =
         Vec3A::from_array([0, 1, 2].map(|a| if live[a] { BINS as f32 / size[a] } else { 0.0 }));
     let bin_of = |c: Vec3A| {
-        let b = ((c - centroid_bounds.min) * scale).to_array();
-        b.map(|x| (x as usize).min(BINS - 1))
+        let b = (c - centroid_bounds.min) * scale;
+        [bin(b.x), bin(b.y), bin(b.z)]
     };
     let mut bin_bounds = [[Aabb::EMPTY; BINS]; 3];
     let mut bin_counts = [[0usize; BINS]; 3];
@@ -238,8 +247,17 @@ fn find_split(items: &mut [BuildItem], extent: &Extent) -> Option<Split> {
         // Sweep from the right to get the area and count of everything right of each split.
         let mut right_area = [0.0f32; BINS];
         let mut right_count = [0usize; BINS];
+        // An empty bin (its box is `Aabb::EMPTY`, which a union leaves unchanged) adds
+        // nothing: the sums right of it are those right of the next bin, and the split
+        // after it costs exactly what the split before it did, which it could not beat.
+        // Small nodes leave most bins empty.
         let (mut acc_b, mut acc_n) = (Aabb::EMPTY, 0);
         for b in (1..BINS).rev() {
+            if bin_counts[b] == 0 && b + 1 < BINS {
+                right_area[b] = right_area[b + 1];
+                right_count[b] = acc_n;
+                continue;
+            }
             acc_b = acc_b.union(bin_bounds[b]);
             acc_n += bin_counts[b];
             right_area[b] = acc_b.surface_area();
@@ -247,6 +265,9 @@ fn find_split(items: &mut [BuildItem], extent: &Extent) -> Option<Split> {
         }
         let (mut left_b, mut left_n) = (Aabb::EMPTY, 0);
         for split in 1..BINS {
+            if bin_counts[split - 1] == 0 {
+                continue;
+            }
             left_b = left_b.union(bin_bounds[split - 1]);
             left_n += bin_counts[split - 1];
             if left_n == 0 || right_count[split] == 0 {
@@ -291,7 +312,7 @@ fn find_split(items: &mut [BuildItem], extent: &Extent) -> Option<Split> {
     let mut mid = 0;
     for i in 0..items.len() {
         let c = items[i].centroid;
-        if bin_of(c)[axis] < split {
+        if bin(((c - centroid_bounds.min) * scale)[axis]) < split {
             left.centroids = left.centroids.union_point(c);
             items.swap(i, mid);
             mid += 1;
@@ -389,6 +410,32 @@ impl BinaryBvh {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `bin` is the saturating `as usize` conversion it replaced, capped at the last bin.
+    #[test]
+    fn bin_is_the_capped_usize_conversion() {
+        let mut xs = vec![
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::MAX,
+            f32::MIN,
+            -0.0,
+            0.0,
+            2f32.powi(31),
+            2f32.powi(63),
+            2f32.powi(64),
+        ];
+        xs.extend((-200..200).map(|i| i as f32 * 0.1));
+        xs.extend(
+            [15.0f32, 16.0]
+                .iter()
+                .flat_map(|&x| [x.next_down(), x, x.next_up()]),
+        );
+        for x in xs {
+            assert_eq!(bin(x), (x as usize).min(BINS - 1), "{x}");
+        }
+    }
 
     /// Every node's box is exactly the union of its primitives' boxes (no level measures its
     /// items: a split hands each side the union of its bins), and every primitive is in one

@@ -37,6 +37,8 @@ struct Node {
     order: [u8; 8],
     /// Number of children (1 only for a root that is a single leaf).
     len: u8,
+    /// `len` low bits set: the lanes that hold a child (kept, not derived per visit).
+    live: u8,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -100,8 +102,7 @@ impl Node {
             }
         }
         let exit = (exit * SLAB_WIDEN).min(Vec4::splat(t_max));
-        let live = (1u32 << self.len) - 1;
-        (enter.cmple(exit).bitmask() & live, enter)
+        (enter.cmple(exit).bitmask() & u32::from(self.live), enter)
     }
 }
 
@@ -176,6 +177,7 @@ impl Bvh {
             child: [0; WIDTH],
             order,
             len: len as u8,
+            live: (1u8 << len) - 1,
         });
         let mut min = [[f32::INFINITY; WIDTH]; 3];
         let mut max = [[f32::NEG_INFINITY; WIDTH]; 3];
@@ -282,31 +284,42 @@ impl Bvh {
         // Not zero-filled: clearing a whole fixed-size stack per ray cost about 5 % of the
         // render time (perf, 10k-sphere grid).
         let mut stack: ArrayVec<(u32, f32), STACK_SIZE> = ArrayVec::new();
-        stack.push((0, f32::NEG_INFINITY));
-        while let Some((reference, enter)) = stack.pop() {
-            if enter > t_max {
-                continue;
-            }
+        let mut reference = 0;
+        loop {
             if reference & LEAF != 0 {
                 t_max = leaf(self.leaf(reference), t_max);
-                continue;
-            }
-            let node = &self.nodes[reference as usize];
-            let (mask, enter) = node.hit::<NAN_FREE>(&lanes, t_max);
-            if mask == 0 {
-                continue;
-            }
-            let enter = enter.to_array();
-            let order = node.order[octant];
-            // Farthest pushed first, so the nearest is visited next.
-            for k in (0..node.len).rev() {
-                let slot = usize::from((order >> (2 * k)) & 3);
-                if mask & (1 << slot) != 0 {
-                    stack.push((node.child[slot], enter[slot]));
+            } else {
+                let node = &self.nodes[reference as usize];
+                let (mask, enter) = node.hit::<NAN_FREE>(&lanes, t_max);
+                if mask.is_power_of_two() {
+                    // One child met: visited next without a trip through the stack (its
+                    // entry lies within `t_max`, so popping it would not drop it).
+                    reference = node.child[mask.trailing_zeros() as usize];
+                    continue;
+                }
+                if mask != 0 {
+                    let enter = enter.to_array();
+                    let order = node.order[octant];
+                    // Farthest pushed first, so the nearest is visited next.
+                    for k in (0..node.len).rev() {
+                        let slot = usize::from((order >> (2 * k)) & 3);
+                        if mask & (1 << slot) != 0 {
+                            stack.push((node.child[slot], enter[slot]));
+                        }
+                    }
                 }
             }
+            loop {
+                let Some((next, enter)) = stack.pop() else {
+                    return t_max;
+                };
+                if enter > t_max {
+                    continue;
+                }
+                reference = next;
+                break;
+            }
         }
-        t_max
     }
 
     /// Any hit before `t_max`: stops as soon as `occludes(prim)` says yes. Children are
@@ -347,8 +360,8 @@ impl Bvh {
         let lanes = RayLanes::new(ray);
         let octant = octant(ray);
         let mut stack: ArrayVec<u32, STACK_SIZE> = ArrayVec::new();
-        stack.push(0);
-        while let Some(reference) = stack.pop() {
+        let mut next = Some(0);
+        while let Some(reference) = next.take().or_else(|| stack.pop()) {
             if reference & LEAF != 0 {
                 if occludes(self.leaf(reference)) {
                     return true;
@@ -357,6 +370,11 @@ impl Bvh {
             }
             let node = &self.nodes[reference as usize];
             let (mask, _) = node.hit::<NAN_FREE>(&lanes, t_max);
+            if mask.is_power_of_two() {
+                // One child met: visited next without a trip through the stack.
+                next = Some(node.child[mask.trailing_zeros() as usize]);
+                continue;
+            }
             if mask == 0 {
                 continue;
             }

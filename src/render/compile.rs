@@ -474,17 +474,9 @@ impl RenderScene {
         (n > 0 && n <= FLAT_MAX && self.moving.is_none()).then(|| &FLAT[..n])
     }
 
-    /// The nearest unbounded primitive's hit before `t_max`, the new `t_max`, and the placed
-    /// primitive when the winner moves: what `closest` starts from. The winner's object-space
-    /// hit is kept for its surface (spheres recompute theirs).
-    #[inline(always)]
-    fn closest_unbounded(&self, ray: &Ray, t_max: f32) -> (Option<Best>, f32, Option<Primitive>) {
-        let mut won = None;
-        let (best, t_best) = self.closest_unbounded_into(ray, t_max, &mut won);
-        (best, t_best, won)
-    }
-
-    /// `closest_unbounded` with the placed primitive left in `won`.
+    /// The nearest unbounded primitive's hit before `t_max` and the new `t_max`, with the
+    /// placed primitive left in `won` when the winner moves: what `closest` starts from. The
+    /// winner's object-space hit is kept for its surface (spheres recompute theirs).
     #[inline(always)]
     fn closest_unbounded_into(
         &self,

@@ -204,37 +204,54 @@ impl Bvh {
         }
         // Entries: a reference, the rays that take part, and their entry distances.
         let mut stack: ArrayVec<(u32, u32, [f32; N]), STACK_SIZE> = ArrayVec::new();
-        stack.push((0, Packet::<N>::all(), [f32::NEG_INFINITY; N]));
         let mut enter = [[0.0f32; N]; WIDTH];
-        while let Some((reference, mask, entered)) = stack.pop() {
-            let mask = mask & !beyond(&entered, t_max);
-            if mask == 0 {
-                continue;
-            }
+        let (mut reference, mut mask) = (0, Packet::<N>::all());
+        loop {
             if reference & LEAF != 0 {
                 let prims = self.leaf(reference);
                 for r in bits(mask) {
                     t_max[r] = leaf(r, prims, t_max[r]);
                 }
-                continue;
-            }
-            let node = &self.nodes[reference as usize];
-            let mut hit = [0u32; WIDTH];
-            let maybe = match &p.bounds {
-                Some(b) if NAN_FREE => {
-                    node.maybe_hit(b, t_max.iter().fold(f32::NEG_INFINITY, |a, &t| a.max(t)))
+            } else {
+                let node = &self.nodes[reference as usize];
+                let mut hit = [0u32; WIDTH];
+                let maybe = match &p.bounds {
+                    Some(b) if NAN_FREE => {
+                        node.maybe_hit(b, t_max.iter().fold(f32::NEG_INFINITY, |a, &t| a.max(t)))
+                    }
+                    _ => u32::MAX,
+                };
+                let mut met = 0u32;
+                for slot in bits(maybe & u32::from(node.live)) {
+                    hit[slot] =
+                        node.hit_packet::<N, NAN_FREE>(slot, p, t_max, &mut enter[slot]) & mask;
+                    met |= u32::from(hit[slot] != 0) << slot;
                 }
-                _ => u32::MAX,
-            };
-            for slot in bits(maybe & ((1 << node.len) - 1)) {
-                hit[slot] = node.hit_packet::<N, NAN_FREE>(slot, p, t_max, &mut enter[slot]) & mask;
+                if met.is_power_of_two() {
+                    // One child met by any ray: visited next without a trip through the
+                    // stack (each of its rays entered it within its `t_max`, so popping it
+                    // would not drop them).
+                    let slot = met.trailing_zeros() as usize;
+                    (reference, mask) = (node.child[slot], hit[slot]);
+                    continue;
+                }
+                let order = node.order[p.octant];
+                // Farthest pushed first, so the nearest is visited next.
+                for k in (0..node.len).rev() {
+                    let slot = usize::from((order >> (2 * k)) & 3);
+                    if hit[slot] != 0 {
+                        stack.push((node.child[slot], hit[slot], enter[slot]));
+                    }
+                }
             }
-            let order = node.order[p.octant];
-            // Farthest pushed first, so the nearest is visited next.
-            for k in (0..node.len).rev() {
-                let slot = usize::from((order >> (2 * k)) & 3);
-                if hit[slot] != 0 {
-                    stack.push((node.child[slot], hit[slot], enter[slot]));
+            loop {
+                let Some((next, rays, entered)) = stack.pop() else {
+                    return;
+                };
+                let rays = rays & !beyond(&entered, t_max);
+                if rays != 0 {
+                    (reference, mask) = (next, rays);
+                    break;
                 }
             }
         }
@@ -296,7 +313,7 @@ impl Bvh {
                 Some(b) if NAN_FREE => node.maybe_hit(b, t_max_hi),
                 _ => u32::MAX,
             };
-            for slot in bits(maybe & ((1 << node.len) - 1)) {
+            for slot in bits(maybe & u32::from(node.live)) {
                 hit[slot] = node.hit_packet::<N, NAN_FREE>(slot, p, t_max, &mut enter) & mask;
             }
             let order = node.order[p.octant];
