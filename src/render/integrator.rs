@@ -275,8 +275,8 @@ impl Integrator<'_> {
     }
 
     /// Whether a moving shape may block the light at distance `dist` along `l` from `hit` (on
-    /// moving entry `from`, if any), at `time`: then the shadow ray is traced in full (as also when the moving shapes are too
-    /// many to ask one by one).
+    /// moving entry `from`, if any), at `time`: then the shadow ray is traced in full, as also
+    /// when the moving shapes are too many to ask one by one.
     fn moving_blocks(
         &self,
         hit: &SurfaceHit,

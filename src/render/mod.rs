@@ -456,9 +456,8 @@ fn render_adaptive(
     // every depth it skipped more but cost the held-out room 0.035).
     let known_clear = |x: usize, y: usize| -> u32 {
         let mut seen = 0;
-        for ny in y.saturating_sub(1)..(y + 2).min(h) {
-            let row = ny * w;
-            for nc in &not_clear[row + x.saturating_sub(1)..row + (x + 2).min(w)] {
+        for near in around(x, y, (w, h)) {
+            for nc in &not_clear[near] {
                 seen |= nc;
             }
         }
@@ -472,15 +471,14 @@ fn render_adaptive(
         if !known_of_still {
             return None;
         }
-        let mut near = (f32::INFINITY, f32::NEG_INFINITY);
-        for ny in y.saturating_sub(1)..(y + 2).min(h) {
-            let row = ny * w;
-            for s in &sweeps[row + x.saturating_sub(1)..row + (x + 2).min(w)] {
+        let mut range = (f32::INFINITY, f32::NEG_INFINITY);
+        for near in around(x, y, (w, h)) {
+            for s in &sweeps[near] {
                 // NaN (no depth kept) leaves the range as it is.
-                near = (near.0.min(s.depth), near.1.max(s.depth));
+                range = (range.0.min(s.depth), range.1.max(s.depth));
             }
         }
-        Some(near)
+        Some(range)
     };
     // The largest tone-mapped difference (8-bit levels) between the centre of (x, y) and the
     // centres around it, or None if the pixel is flat and keeps its centre sample.
@@ -492,9 +490,7 @@ fn render_adaptive(
         // In a moving frame, a pixel next to one whose centre ray met something moving is not
         // flat, and the image must be flat along the streak the camera's motion draws.
         let mut moving = false;
-        for ny in y.saturating_sub(1)..(y + 2).min(h) {
-            let row = ny * w;
-            let near = row + x.saturating_sub(1)..row + (x + 2).min(w);
+        for near in around(x, y, (w, h)) {
             for (t, (_, p)) in tones[near.clone()].iter().zip(&base[near.clone()]) {
                 other_surface |= *p != prim;
                 contrast = contrast.max((*t - tone).abs().max_element());
@@ -611,6 +607,17 @@ fn render_adaptive(
     (pixels, counts)
 }
 
+/// The 3×3 neighbourhood of pixel (x, y) in a `w`×`h` image, clipped to it: per row, the
+/// range of its pixels' indices (row-major).
+fn around(
+    x: usize,
+    y: usize,
+    (w, h): (usize, usize),
+) -> impl Iterator<Item = std::ops::Range<usize>> {
+    (y.saturating_sub(1)..(y + 2).min(h))
+        .map(move |ny| ny * w + x.saturating_sub(1)..ny * w + (x + 2).min(w))
+}
+
 /// Sets what a pixel's samples know of the lights (`TraceState::known_clear`).
 type Know<'a> = dyn Fn(usize, usize, &mut TraceState) + Sync + 'a;
 /// Sample `i` of a pixel's own pattern: its radiance.
@@ -653,8 +660,7 @@ fn recheck_motion(
                 };
                 let tone = tones[y * w + x];
                 let mut differs = 0.0f32;
-                for ny in y.saturating_sub(1)..(y + 2).min(h) {
-                    let near = ny * w + x.saturating_sub(1)..ny * w + (x + 2).min(w);
+                for near in around(x, y, (w, h)) {
                     for t in &tones[near] {
                         differs = differs.max((*t - tone).abs().max_element());
                     }

@@ -20,8 +20,8 @@ pub const MIN_SAMPLES: u32 = 4;
 /// 1/n of the exposure, so n samples all miss only what covers the pixel for less than about
 /// 1/n of it: at 4, a moving shadow's blurred end went unseen often enough to leave the
 /// blurred frames of animations/blur.ron at 0.92–0.98 levels RMS from the mean of 16
-/// instants; at 8, 0.54–0.59 (BENCHMARKS.md §14.2). What 8 still miss, pass 3 of
-/// `render_adaptive` looks for in the neighbours.
+/// instants; at 8, 0.54–0.59; at 8 with pass 3 of `render_adaptive` (which looks in the
+/// neighbours for what 8 still miss), 0.41–0.48 (BENCHMARKS.md §14.2).
 pub const MOTION_MIN_SAMPLES: u32 = 8;
 
 /// Largest contrast (8-bit levels) between a pixel's centre sample and its 8 neighbours'

@@ -684,7 +684,8 @@ mod tests {
             prop_assert!(moving.met_by(k, &ray), "entry {k} hit at step {step}, not met");
             // And a shadow ray at that instant asks it (its bounds in that part hold it).
             let at = ray.at_time(u as f32);
-            prop_assert_eq!(moving.blocks(&at, f32::INFINITY, None), Some(true), "entry {} at step {}", k, step);
+            let blocks = moving.blocks(&at, f32::INFINITY, None);
+            prop_assert_eq!(blocks, Some(true), "entry {} at step {}", k, step);
         }
     }
 
