@@ -45,6 +45,11 @@ impl CameraRays {
         })
     }
 
+    /// Where the rays start.
+    pub fn eye(&self) -> Vec3A {
+        self.eye
+    }
+
     /// The image position (pixels from the top-left corner) at which `p` is seen, if it lies
     /// in front of the eye: the inverse of [`CameraRays::ray`].
     pub fn project(&self, p: Vec3A) -> Option<(f32, f32)> {

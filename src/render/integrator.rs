@@ -1,6 +1,7 @@
 //! Whitted-style shading: the local Phong model of docs/shading.md §2 with hard shadows, mirror
 //! reflection and Fresnel refraction.
 
+use super::camera::CameraRays;
 use super::compile::{RenderScene, ShadeMaterial, Shadow};
 use super::primitive::SurfaceHit;
 use super::RayCounts;
@@ -41,12 +42,42 @@ pub struct TraceState {
     pub known_clear: u32,
     /// In a frame with motion, `known_clear` speaks for the shapes that hold still only: a
     /// sample still asks the moving shapes at its own instant. And it holds for camera hits
-    /// between these distances only (those of the first pass's hits around the pixel): a
-    /// hit nearer or farther than all of them, on a shape that has moved there, may see the
-    /// lights past shapes theirs did not.
-    pub known_clear_near: Option<(f32, f32)>,
+    /// near the first pass's hits around the pixel only (`KnownNear`).
+    pub known_clear_near: Option<KnownNear>,
     /// The moving entry the latest camera ray hit, whose shadow rays leave it.
     lit_from: Option<u32>,
+}
+
+/// Where a camera hit of a frame with motion must lie for the lights the first pass's
+/// centres around its pixel saw fully to count as visible from it: a hit nearer or farther
+/// than all of theirs, on a shape that has moved there or seen past an edge the moving
+/// camera uncovers, may see the lights past shapes theirs did not; and under a moving camera
+/// a sample's hit may lie pixels away from those centres, across a shadow's edge.
+#[derive(Clone, Debug)]
+pub struct KnownNear {
+    /// The least and greatest distance from the first pass's eye (the camera at the middle
+    /// of the exposure) of the centres' hits.
+    pub depth: (f32, f32),
+    /// Under a moving camera: that eye's view, and the window of image positions (left, top,
+    /// right, bottom) spanned by the centres, in which the hit must be seen from it.
+    pub seen_from: Option<(CameraRays, [f32; 4])>,
+}
+
+impl KnownNear {
+    /// Whether `point`, a camera ray's hit `t` along it, lies among the centres' hits.
+    #[inline]
+    fn holds(&self, point: Vec3A, t: f32) -> bool {
+        let (lo, hi) = self.depth;
+        let Some((view, [left, top, right, bottom])) = &self.seen_from else {
+            return t >= lo && t <= hi;
+        };
+        let dist = view.eye().distance(point);
+        dist >= lo
+            && dist <= hi
+            && view
+                .project(point)
+                .is_some_and(|(x, y)| x >= *left && x <= *right && y >= *top && y <= *bottom)
+    }
 }
 
 impl Default for TraceState {
@@ -143,8 +174,8 @@ impl Integrator<'_> {
         // Shading normal faces the incoming ray; the geometric one decides inside/outside.
         let n = if entering { hit.normal } else { -hit.normal };
         let (rho, alpha) = (mat.reflectivity, mat.opacity);
-        let near = |(lo, hi): (f32, f32)| hit.t >= lo && hit.t <= hi;
-        let known_clear = if depth == 0 && st.known_clear_near.is_none_or(near) {
+        let near = |k: &KnownNear| k.holds(hit.point, hit.t);
+        let known_clear = if depth == 0 && st.known_clear_near.as_ref().is_none_or(near) {
             if st.known_clear_near.is_some() {
                 st.lit_from = scene.moving_entry(prim);
             }

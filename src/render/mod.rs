@@ -14,7 +14,7 @@ use crate::scene::{Camera, RenderJob, Scene};
 use camera::{sample_offsets, CameraError, CameraRays};
 use compile::RenderScene;
 use glam::{DVec3, Vec3, Vec3A};
-use integrator::{Integrator, TraceState, NO_HIT};
+use integrator::{Integrator, KnownNear, TraceState, NO_HIT};
 use motion::Shutter;
 use rayon::prelude::*;
 use sampling::PixelPattern;
@@ -398,14 +398,14 @@ fn render_adaptive(
             .enumerate()
             .map(|(y, ((row, sweep_row), not_clear_row))| {
                 let mut st = TraceState::default();
-                // The refined samples hit near the centres only while the camera holds still,
-                // and a light a centre's shadow rays saw fully stays so only while it holds
-                // still. Then, where the moving shapes are few enough to ask at each sample's
+                // A light a centre's shadow rays saw fully stays so only while it holds still.
+                // Then, where the moving shapes are few enough to ask at each sample's
                 // instant, what they saw is kept as news of the shapes that hold still, with
-                // how far the centre's hit is (see `known_clear_near`); otherwise only for
-                // centres none of whose rays may meet anything moving.
-                let shadows_hold = !s.camera_moves() && !s.lights_move();
+                // how far the centre's hit is (see `known_clear_near`); otherwise, only while
+                // the camera holds still too (so that the refined samples hit near the
+                // centres), for centres none of whose rays may meet anything moving.
                 let of_still = integrator.scene.answers_moving_blocks();
+                let shadows_hold = !s.lights_move() && (of_still || !s.camera_moves());
                 let pixels = row.iter_mut().zip(sweep_row).zip(not_clear_row);
                 for (x, ((px, sw), nc)) in pixels.enumerate() {
                     let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
@@ -446,8 +446,9 @@ fn render_adaptive(
     let tones: Vec<Vec3A> = base.par_iter().map(|(c, _)| sampling::tone3(*c)).collect();
     let tones = &tones;
     let not_clear = &not_clear;
-    let known_of_still = shutter.is_some_and(|s| !s.camera_moves() && !s.lights_move())
-        && integrator.scene.answers_moving_blocks();
+    let known_of_still =
+        shutter.is_some_and(|s| !s.lights_move()) && integrator.scene.answers_moving_blocks();
+    let view_moves = shutter.is_some_and(|s| s.camera_moves());
     // The lights that every shadow ray of the centres around (x, y) saw fully: a refined
     // pixel's samples take them as visible, without shadow rays, where their camera rays
     // hit. A shadow edge inside the pixel that none of the nine centres' trees met is lost,
@@ -464,21 +465,28 @@ fn render_adaptive(
         !seen
     };
     // In a frame with motion whose centres kept their shadow rays' findings for the shapes
-    // that hold still: the range of distances of the hits of the centres around (x, y). A
-    // sample that hits nearer or farther than every one of them may see the lights past other
-    // shapes, so it takes none as known (`TraceState::known_clear_near`).
-    let known_clear_near = |x: usize, y: usize| -> Option<(f32, f32)> {
+    // that hold still: the range of distances of the hits of the centres around (x, y), and
+    // under a moving camera the span of those centres in the image. A sample whose hit lies
+    // outside them may see the lights past other shapes, so it takes none as known
+    // (`KnownNear`).
+    let known_clear_near = |x: usize, y: usize| -> Option<KnownNear> {
         if !known_of_still {
             return None;
         }
-        let mut range = (f32::INFINITY, f32::NEG_INFINITY);
+        let mut depth = (f32::INFINITY, f32::NEG_INFINITY);
         for near in around(x, y, (w, h)) {
             for s in &sweeps[near] {
                 // NaN (no depth kept) leaves the range as it is.
-                range = (range.0.min(s.depth), range.1.max(s.depth));
+                depth = (depth.0.min(s.depth), depth.1.max(s.depth));
             }
         }
-        Some(range)
+        let seen_from = view_moves.then(|| {
+            let first = |c: usize| c.saturating_sub(1) as f32 + 0.5;
+            let last = |c: usize, n: usize| (c + 1).min(n - 1) as f32 + 0.5;
+            let span = [first(x), first(y), last(x, w), last(y, h)];
+            (camera.clone(), span)
+        });
+        Some(KnownNear { depth, seen_from })
     };
     // The largest tone-mapped difference (8-bit levels) between the centre of (x, y) and the
     // centres around it, or None if the pixel is flat and keeps its centre sample.
