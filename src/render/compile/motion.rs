@@ -139,9 +139,9 @@ pub struct Moving {
     placed: Vec<OnceLock<Option<Primitive>>>,
     /// Where [`Moving::blocks`] answers: per part of the exposure, the world box of each
     /// entry's pose there (its bounds over the exposure where it has none), in groups of
-    /// four (`min`, `max`; NaN past the last entry), for [`BoxRay::slabs4`].
-    part_min: Vec<Vec4>,
-    part_max: Vec<Vec4>,
+    /// four (`[min, max]`; NaN past the last entry), for [`BoxRay::slabs4`]: part `i`'s
+    /// groups are cells `i·groups` to `(i+1)·groups − 1`.
+    part_boxes: Vec<[[Vec4; LANES]; 2]>,
 }
 
 /// The instant camera samples at `time` are taken at: the middle of its part of the
@@ -173,8 +173,7 @@ impl Moving {
             bounds: Vec::new(),
             poses: Vec::new(),
             convex: Vec::new(),
-            part_min: Vec::new(),
-            part_max: Vec::new(),
+            part_boxes: Vec::new(),
             lights: scene.lights.iter().map(|l| l.position).collect(),
             placed: Vec::new(),
         })
@@ -187,19 +186,24 @@ impl Moving {
             self.placed = (0..cells).map(|_| OnceLock::new()).collect();
         }
         if self.answers_blocks() {
-            let lanes = self.entries.len().next_multiple_of(LANES);
+            let groups = self.entries.len().div_ceil(LANES);
             let unused = Vec4::splat(f32::NAN);
-            (self.part_min, self.part_max) = (0..POSE_PARTS)
-                .flat_map(|part| (0..lanes).map(move |k| (part, k)))
-                .map(|(part, k)| match self.poses.get(k * POSE_PARTS + part) {
-                    _ if k >= self.entries.len() => (unused, unused),
-                    Some(Some(pose)) => (pose.world.min.extend(0.0), pose.world.max.extend(0.0)),
-                    _ => (
-                        self.bounds[k].min.extend(0.0),
-                        self.bounds[k].max.extend(0.0),
-                    ),
+            let world = |part: usize, k: usize| match self.poses.get(k * POSE_PARTS + part) {
+                _ if k >= self.entries.len() => (unused, unused),
+                Some(Some(pose)) => (pose.world.min.extend(0.0), pose.world.max.extend(0.0)),
+                _ => (
+                    self.bounds[k].min.extend(0.0),
+                    self.bounds[k].max.extend(0.0),
+                ),
+            };
+            self.part_boxes = (0..POSE_PARTS)
+                .flat_map(|part| (0..groups).map(move |g| (part, g)))
+                .map(|(part, g)| {
+                    let lanes: [(Vec4, Vec4); LANES] =
+                        std::array::from_fn(|lane| world(part, g * LANES + lane));
+                    [lanes.map(|(min, _)| min), lanes.map(|(_, max)| max)]
                 })
-                .unzip();
+                .collect();
         }
     }
 
@@ -284,12 +288,12 @@ impl Moving {
         let part = ((ray.time * POSE_PARTS as f32) as usize).min(POSE_PARTS - 1);
         let boxes = BoxRay::new(ray);
         let n = self.entries.len();
-        let first = part * n.next_multiple_of(LANES);
-        for group in (0..n).step_by(LANES) {
-            let at = first + group;
-            let four = |v: &[Vec4]| [v[at], v[at + 1], v[at + 2], v[at + 3]];
+        let groups = n.div_ceil(LANES);
+        let cells = self.part_boxes.get(part * groups..(part + 1) * groups)?;
+        for (g, [min, max]) in cells.iter().enumerate() {
+            let group = g * LANES;
             let live = (1u32 << (n - group).min(LANES)) - 1;
-            let slabs = boxes.slabs4(four(&self.part_min), four(&self.part_max));
+            let slabs = boxes.slabs4(*min, *max);
             let mut near = slabs.overlaps(t_max) & live;
             while near != 0 {
                 let k = group + near.trailing_zeros() as usize;
@@ -490,7 +494,7 @@ impl Moving {
             + self.poses.capacity() * std::mem::size_of::<Option<Pose>>()
             + self.lights.capacity() * 24
             + self.placed.capacity() * std::mem::size_of::<OnceLock<Option<Primitive>>>()
-            + (self.part_min.capacity() + self.part_max.capacity()) * std::mem::size_of::<Vec4>()
+            + self.part_boxes.capacity() * std::mem::size_of::<[[Vec4; LANES]; 2]>()
     }
 }
 
