@@ -50,6 +50,30 @@ impl CameraRays {
         self.eye
     }
 
+    /// World units per pixel at the depth of `p`: a move of the eye by δ across the view
+    /// shifts `p`'s image by δ over this (negative: `p` is behind the eye).
+    pub fn world_per_pixel(&self, p: Vec3A) -> f32 {
+        (p - self.eye).dot(self.forward) / self.forward.length_squared()
+    }
+
+    /// How much a move of the eye along the view shifts an image point at most, against the
+    /// same move across it, for points within `margin` pixels beyond the image's edges.
+    pub fn reach(&self, margin: f32) -> f32 {
+        1.0 + (self.half_w.hypot(self.half_h) + margin) / self.forward.length()
+    }
+
+    /// Whether `other` looks the same way through the same image plane (its eye aside).
+    pub fn same_view(&self, other: &CameraRays) -> bool {
+        (self.forward, self.right, self.up, self.half_w, self.half_h)
+            == (
+                other.forward,
+                other.right,
+                other.up,
+                other.half_w,
+                other.half_h,
+            )
+    }
+
     /// The image position (pixels from the top-left corner) at which `p` is seen, if it lies
     /// in front of the eye: the inverse of [`CameraRays::ray`].
     pub fn project(&self, p: Vec3A) -> Option<(f32, f32)> {

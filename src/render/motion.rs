@@ -37,6 +37,11 @@ pub struct Shutter {
     height: u32,
     /// The camera at instants spread over the exposure, when it moves.
     sweep: Vec<CameraRays>,
+    /// When the camera slides without turning, with every eye of `sweep` on the way between
+    /// the first and the last: how far (world units) one strays from that segment at most,
+    /// times the view's `reach`. Then a point's image moves along a straight line (a line
+    /// seen in perspective), whatever the speed, up to that stray over the point's depth.
+    slide_stray: Option<f32>,
     /// The camera at each instant camera samples are rounded to, when it moves (`None` where
     /// it is degenerate then): placed once per frame, not once per sample.
     at_step: Vec<Option<CameraRays>>,
@@ -54,6 +59,7 @@ impl Shutter {
             width,
             height,
             sweep: Vec::new(),
+            slide_stray: None,
             at_step: Vec::new(),
             pixel_angle: (2.0 * (camera.fov_x_deg.to_radians() / 2.0).tan() / width.max(1) as f64)
                 as f32,
@@ -69,6 +75,7 @@ impl Shutter {
                 .into_iter()
                 .filter_map(|u| shutter.camera_at(u as f32))
                 .collect();
+            shutter.slide_stray = slide_stray(&shutter.sweep);
             shutter.at_step = (0..MOTION_TIME_STEPS)
                 .map(|i| shutter.camera_at((i as f32 + 0.5) / MOTION_TIME_STEPS as f32))
                 .collect();
@@ -136,7 +143,15 @@ impl Shutter {
         {
             return None;
         }
-        // The instants between lie on the halves, within a pixel.
+        // The instants between lie on the halves, within a pixel: surely so on a slide, where
+        // they are off the line through the ends by at most the stray over the depth.
+        let near = first.world_per_pixel(p).min(last.world_per_pixel(p));
+        if self
+            .slide_stray
+            .is_some_and(|stray| near > 0.0 && stray <= SLIDE_SLACK * near)
+        {
+            return Some(ends);
+        }
         let n = self.sweep.len();
         for (i, c) in self.sweep.iter().enumerate() {
             let (dx, dy) = end(c)?;
@@ -227,6 +242,31 @@ impl Shutter {
     }
 }
 
+/// Pixels the image of a point may stray from its streak's line for a slide to skip checking
+/// the instants between its ends, far below the pixel those checks allow.
+const SLIDE_SLACK: f32 = 1.0 / 64.0;
+
+/// `Shutter::slide_stray` of a camera seen at the instants `sweep`.
+fn slide_stray(sweep: &[CameraRays]) -> Option<f32> {
+    let (first, last) = (sweep.first()?, sweep.last()?);
+    let way = last.eye() - first.eye();
+    let mut stray = 0.0f32;
+    for c in sweep {
+        if !c.same_view(first) {
+            return None;
+        }
+        let off = c.eye() - first.eye();
+        let along = if way == Vec3A::ZERO {
+            0.0
+        } else {
+            (off.dot(way) / way.length_squared()).clamp(0.0, 1.0)
+        };
+        stray = stray.max(off.distance(way * along));
+    }
+    let stray = stray * first.reach(MAX_FLAT_SWEEP);
+    stray.is_finite().then_some(stray)
+}
+
 /// `v.floor()` as an integer, without the library call `f32::floor` makes on CPUs the build
 /// does not assume to round in hardware (the streak walk takes several per pixel).
 #[inline]
@@ -256,6 +296,46 @@ mod tests {
         ] {
             assert_eq!(floor(v), v.floor() as i64, "{v}");
         }
+    }
+
+    fn view(eye: [f64; 3], dir: [f64; 3]) -> CameraRays {
+        let cam = Camera {
+            name: "eye".into(),
+            fov_x_deg: 50.0,
+            eye: eye.into(),
+            dir: dir.into(),
+            up: [0.0, 1.0, 0.0].into(),
+        };
+        CameraRays::new(&cam, 64, 36).expect("a camera")
+    }
+
+    #[test]
+    fn only_a_camera_sliding_one_way_without_turning_is_a_slide() {
+        let ahead = [0.0, 0.0, -1.0];
+        // Eased along a line: uneven steps, one way.
+        let eased: Vec<_> = [0.0, 0.05, 0.3, 0.7, 0.95, 1.0]
+            .iter()
+            .map(|u| view([2.0 * u, 0.5 * u, -3.0 * u], ahead))
+            .collect();
+        let stray = slide_stray(&eased).expect("a slide");
+        assert!(stray < 1e-5, "{stray}");
+        // Off the line by 0.1 at one instant (across it: (3, 0, 2) is square to the way):
+        // that far, times the view's reach.
+        let across = 0.1 / 13f64.sqrt();
+        let mut bent = eased.clone();
+        bent[2] = view([0.6 + 3.0 * across, 0.15, -0.9 + 2.0 * across], ahead);
+        let stray = slide_stray(&bent).expect("no turn");
+        let reach = eased[0].reach(MAX_FLAT_SWEEP);
+        assert!((stray - 0.1 * reach).abs() < 1e-4 * reach, "{stray}");
+        // Past the last eye and back: the way beyond counts as stray.
+        let mut back = eased.clone();
+        back[4] = view([2.4, 0.6, -3.6], ahead);
+        let stray = slide_stray(&back).expect("no turn");
+        assert!(stray > 0.1 * reach, "{stray}");
+        // Turning a little: not a slide.
+        let mut turned = eased;
+        turned[3] = view([1.4, 0.35, -2.1], [0.01, 0.0, -1.0]);
+        assert_eq!(slide_stray(&turned), None);
     }
 
     #[test]
