@@ -230,7 +230,25 @@ impl Bvh {
         &self,
         p: &Packet<N>,
         t_max: &mut [f32; N],
-        leaf: impl FnMut(usize, &[u32], f32) -> f32,
+        mut leaf: impl FnMut(usize, &[u32], f32) -> f32,
+    ) {
+        self.closest_leaf_visits_packet(p, t_max, |rays, prims, t_max| {
+            for r in bits(rays) {
+                t_max[r] = leaf(r, prims, t_max[r]);
+            }
+        });
+    }
+
+    /// [`Bvh::closest_leaves_packet`] a leaf visit at a time: `leaf(rays, prims, t_max)`
+    /// tests the leaf for each ray whose bit is set in `rays`, lowest first, updating its
+    /// `t_max` (what is shared between them, such as the leaf's primitives in lanes, is then
+    /// prepared once).
+    #[inline]
+    pub fn closest_leaf_visits_packet<const N: usize>(
+        &self,
+        p: &Packet<N>,
+        t_max: &mut [f32; N],
+        leaf: impl FnMut(u32, &[u32], &mut [f32; N]),
     ) {
         if p.nan_free {
             self.closest_packet_impl::<N, true>(p, t_max, leaf);
@@ -244,7 +262,7 @@ impl Bvh {
         &self,
         p: &Packet<N>,
         t_max: &mut [f32; N],
-        mut leaf: impl FnMut(usize, &[u32], f32) -> f32,
+        mut leaf: impl FnMut(u32, &[u32], &mut [f32; N]),
     ) {
         if self.nodes.is_empty() {
             return;
@@ -255,10 +273,7 @@ impl Bvh {
         let (mut reference, mut mask) = (0, Packet::<N>::all());
         loop {
             if reference & LEAF != 0 {
-                let prims = self.leaf(reference);
-                for r in bits(mask) {
-                    t_max[r] = leaf(r, prims, t_max[r]);
-                }
+                leaf(mask, self.leaf(reference), t_max);
             } else {
                 let node = &self.nodes[reference as usize];
                 let mut hit = [0u32; WIDTH];
