@@ -391,7 +391,7 @@ impl RenderScene {
 
     /// The four packed spheres from primitive `i` on.
     #[inline(always)]
-    fn four_spheres(&self, i: usize) -> [Vec4; LANES] {
+    pub(super) fn four_spheres(&self, i: usize) -> [Vec4; LANES] {
         four(&self.spheres, i)
     }
 
@@ -554,22 +554,42 @@ impl RenderScene {
         let end = first + leaf.len();
         let limit = t_max.next_up();
         for start in (first..end).step_by(LANES) {
-            let live = (end - start).min(LANES);
-            let (mask, t) = lanes.hit4(self.four_spheres(start), limit);
-            let mut mask = mask & ((1 << live) - 1);
-            while mask != 0 {
-                let k = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                let i = start + k;
-                if Best::loses_to(best, t_max, t[k], self.key[i]) {
-                    t_max = t[k];
-                    *best = Some(Best {
-                        id: i as u32,
-                        t: t_max,
-                        key: self.key[i],
-                        hit: None,
-                    });
-                }
+            let spheres = SphereRay::lanes(self.four_spheres(start));
+            t_max = self.closest_in_spheres(lanes, &spheres, start, end, limit, t_max, best);
+        }
+        t_max
+    }
+
+    /// One group of `closest_in_sphere_leaf`: the packed spheres from `start` on (those
+    /// before `end`), in lanes, tested up to `limit` (the leaf's first `t_max`, moved up
+    /// one ulp); returns the new `t_max`.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn closest_in_spheres(
+        &self,
+        lanes: &SphereRay,
+        spheres: &[Vec4; LANES],
+        start: usize,
+        end: usize,
+        limit: f32,
+        mut t_max: f32,
+        best: &mut Option<Best>,
+    ) -> f32 {
+        let live = (end - start).min(LANES);
+        let (mask, t) = lanes.hit_lanes(spheres, limit);
+        let mut mask = mask & ((1 << live) - 1);
+        while mask != 0 {
+            let k = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let i = start + k;
+            if Best::loses_to(best, t_max, t[k], self.key[i]) {
+                t_max = t[k];
+                *best = Some(Best {
+                    id: i as u32,
+                    t: t_max,
+                    key: self.key[i],
+                    hit: None,
+                });
             }
         }
         t_max

@@ -9,8 +9,10 @@ use super::integrator::{Integrator, TraceState, NO_HIT};
 use glam::{Vec3, Vec3A};
 
 /// A packet of the uniform path: `BLOCK_W × BLOCK_H` pixels, one sample position each.
+/// 4×4 walks the tree once for twice the rays of 4×2 at little more cost per node (grid10k
+/// 1280×720: 3.3 % fewer instructions; 8×2 and 8×4 saved less, and 8×4 cost random100k 2 %).
 const BLOCK_W: u32 = 4;
-const BLOCK_H: u32 = 2;
+const BLOCK_H: u32 = 4;
 const BLOCK: usize = (BLOCK_W * BLOCK_H) as usize;
 /// A packet of adaptive sampling's first pass (one row at a time): this many pixels of a row.
 const ROW_RUN: usize = 8;

@@ -94,19 +94,44 @@ impl SphereRay {
     /// NaN is never hit.
     #[inline(always)]
     pub fn hit4(&self, spheres: [Vec4; 4], t_max: f32) -> (u32, Vec4) {
+        self.hit_lanes(&SphereRay::lanes(spheres), t_max)
+    }
+
+    /// Four packed spheres as lanes: centres' `x`, `y`, `z`, then radii (what
+    /// [`SphereRay::hit_lanes`] takes; rays of a packet share them).
+    #[inline(always)]
+    pub fn lanes(spheres: [Vec4; 4]) -> [Vec4; 4] {
         let m = Mat4::from_cols(spheres[0], spheres[1], spheres[2], spheres[3]).transpose();
-        let (r, [dx, dy, dz]) = (m.w_axis, self.dir);
-        let fx = self.origin[0] - m.x_axis;
-        let fy = self.origin[1] - m.y_axis;
-        let fz = self.origin[2] - m.z_axis;
+        [m.x_axis, m.y_axis, m.z_axis, m.w_axis]
+    }
+
+    /// [`SphereRay::hit4`] of spheres already in lanes ([`SphereRay::lanes`]).
+    #[inline(always)]
+    pub fn hit_lanes(&self, spheres: &[Vec4; 4], t_max: f32) -> (u32, Vec4) {
+        let (r, [dx, dy, dz]) = (spheres[3], self.dir);
+        let fx = self.origin[0] - spheres[0];
+        let fy = self.origin[1] - spheres[1];
+        let fz = self.origin[2] - spheres[2];
         // Vec3A's dot product adds (x + y) + z.
         let beta = fx * dx + fy * dy + fz * dz;
+        let r2 = r * r;
+        let c = (fx * fx + fy * fy + fz * fz) - r2;
+        // A lane with `beta > 0` (or NaN) has `q < 0` (or NaN), so `x = q / a` is not above
+        // 0, and with `c > 0` (or NaN: then `t` falls to `x`) neither is `t`: a miss, the
+        // origin outside and the sphere behind it. When every lane is one (a shadow ray
+        // leaving its own sphere, mostly), the rest is skipped; `t` matters only where hit.
+        let may_hit = beta.cmple(Vec4::ZERO) | c.cmple(Vec4::ZERO);
+        if may_hit.bitmask() == 0 {
+            return (0, Vec4::ZERO);
+        }
         let k = beta / self.a;
         let (px, py, pz) = (fx - dx * k, fy - dy * k, fz - dz * k);
-        let r2 = r * r;
         let disc = self.a * (r2 - (px * px + py * py + pz * pz));
-        let c = (fx * fx + fy * fy + fz * fz) - r2;
-        // A negative discriminant gives NaN here, and NaN fails every comparison below.
+        // A negative discriminant gives NaN here, and NaN fails every comparison below: a
+        // miss in every lane where it is negative (or NaN) needs nothing more.
+        if (disc.cmpge(Vec4::ZERO) & may_hit).bitmask() == 0 {
+            return (0, Vec4::ZERO);
+        }
         let q = -(beta + disc.map(f32::sqrt).copysign(beta));
         let x = q / self.a;
         let y = c / q;

@@ -13,7 +13,7 @@
 use super::{Bvh, Node, LEAF, STACK_SIZE, WIDTH};
 use crate::math::{Ray, SLAB_WIDEN};
 use arrayvec::ArrayVec;
-use glam::Vec4;
+use glam::{Mat4, Vec4};
 
 /// Rays tested at once against one box.
 const LANES: usize = 4;
@@ -51,29 +51,76 @@ impl<const N: usize> Packet<N> {
 
     /// `None` when the rays' directions do not share an octant: children would then be
     /// visited in different orders, and the single-ray walk is the one to take.
+    ///
+    /// Built four rays at a time, transposed into lanes (`1/d` is `Vec3A::recip`'s division
+    /// lane by lane, so the same floats): gathering them ray by ray and axis by axis cost
+    /// about 90 instructions per camera ray.
     pub fn new(rays: &[Ray; N]) -> Option<Packet<N>> {
-        let octant = super::octant(&rays[0]);
-        if rays.iter().any(|r| super::octant(r) != octant) {
+        let mut origin = [[0.0f32; N]; 3];
+        let mut inv_dir = [[0.0f32; N]; 3];
+        // Per axis, the rays whose direction is negative there; per ray, NaN-free.
+        let mut negative = [0u32; 3];
+        let mut nan_free = true;
+        // The rays whose origin is, bit for bit, the first ray's (finite origins assumed:
+        // only asked when all are NaN-free).
+        let mut same = 0u32;
+        let o0 = rays[0].origin;
+        let o0_lanes = crate::math::splat3(o0);
+        let o0_sign = [o0.x, o0.y, o0.z].map(|c| if c.is_sign_negative() { 0xF } else { 0 });
+        for g in 0..Self::GROUPS {
+            let four = &rays[g * LANES..g * LANES + LANES];
+            let o = Mat4::from_cols(
+                four[0].origin.extend(0.0),
+                four[1].origin.extend(0.0),
+                four[2].origin.extend(0.0),
+                four[3].origin.extend(0.0),
+            )
+            .transpose();
+            let d = Mat4::from_cols(
+                four[0].dir.extend(0.0),
+                four[1].dir.extend(0.0),
+                four[2].dir.extend(0.0),
+                four[3].dir.extend(0.0),
+            )
+            .transpose();
+            let (o, d) = (
+                [o.x_axis, o.y_axis, o.z_axis],
+                [d.x_axis, d.y_axis, d.z_axis],
+            );
+            let mut same_here = 0xF;
+            for axis in 0..3 {
+                let inv = Vec4::ONE / d[axis];
+                negative[axis] |= d[axis].cmplt(Vec4::ZERO).bitmask() << (g * LANES);
+                let ok = o[axis].is_finite_mask() & inv.is_finite_mask() & inv.cmpne(Vec4::ZERO);
+                nan_free &= ok.all();
+                same_here &= o[axis].cmpeq(o0_lanes[axis]).bitmask()
+                    & !(o[axis].is_negative_bitmask() ^ o0_sign[axis]);
+                o[axis].write_to_slice(&mut origin[axis][g * LANES..g * LANES + LANES]);
+                inv.write_to_slice(&mut inv_dir[axis][g * LANES..g * LANES + LANES]);
+            }
+            same |= same_here << (g * LANES);
+        }
+        let all = Self::all();
+        if negative.iter().any(|&m| m != 0 && m != all) {
             return None;
         }
-        let inv = rays.map(|r| r.dir.recip());
-        let nan_free = rays.iter().all(super::RayLanes::nan_free);
-        let origin = rays[0].origin;
-        let same =
-            |r: &Ray| r.origin.to_array().map(f32::to_bits) == origin.to_array().map(f32::to_bits);
-        let bounds = (nan_free && rays.iter().all(same)).then(|| {
-            let lo = inv.iter().fold(inv[0], |a, &b| a.min(b));
-            let hi = inv.iter().fold(inv[0], |a, &b| a.max(b));
+        let octant = (0..3).fold(0, |o, a| o | ((negative[a] & 1) as usize) << a);
+        // Finite and non-zero (NaN-free rays), the `1/d` have one least and one greatest
+        // value whatever the order they are compared in.
+        let bounds = (nan_free && same == all).then(|| {
+            let lanes = |a: usize, f: fn(Vec4, Vec4) -> Vec4| {
+                (1..Self::GROUPS).fold(group(&inv_dir[a], 0), |m, g| f(m, group(&inv_dir[a], g)))
+            };
             Bounds {
-                origin: crate::math::splat3(origin),
-                inv_lo: crate::math::splat3(lo),
-                inv_hi: crate::math::splat3(hi),
+                origin: o0_lanes,
+                inv_lo: [0, 1, 2].map(|a| Vec4::splat(lanes(a, Vec4::min).min_element())),
+                inv_hi: [0, 1, 2].map(|a| Vec4::splat(lanes(a, Vec4::max).max_element())),
             }
         });
         Some(Packet {
             bounds,
-            origin: [0, 1, 2].map(|a| std::array::from_fn(|r| rays[r].origin[a])),
-            inv_dir: [0, 1, 2].map(|a| std::array::from_fn(|r| inv[r][a])),
+            origin,
+            inv_dir,
             octant,
             nan_free,
         })
@@ -183,7 +230,25 @@ impl Bvh {
         &self,
         p: &Packet<N>,
         t_max: &mut [f32; N],
-        leaf: impl FnMut(usize, &[u32], f32) -> f32,
+        mut leaf: impl FnMut(usize, &[u32], f32) -> f32,
+    ) {
+        self.closest_leaf_visits_packet(p, t_max, |rays, prims, t_max| {
+            for r in bits(rays) {
+                t_max[r] = leaf(r, prims, t_max[r]);
+            }
+        });
+    }
+
+    /// [`Bvh::closest_leaves_packet`] a leaf visit at a time: `leaf(rays, prims, t_max)`
+    /// tests the leaf for each ray whose bit is set in `rays`, lowest first, updating its
+    /// `t_max` (what is shared between them, such as the leaf's primitives in lanes, is then
+    /// prepared once).
+    #[inline]
+    pub fn closest_leaf_visits_packet<const N: usize>(
+        &self,
+        p: &Packet<N>,
+        t_max: &mut [f32; N],
+        leaf: impl FnMut(u32, &[u32], &mut [f32; N]),
     ) {
         if p.nan_free {
             self.closest_packet_impl::<N, true>(p, t_max, leaf);
@@ -197,7 +262,7 @@ impl Bvh {
         &self,
         p: &Packet<N>,
         t_max: &mut [f32; N],
-        mut leaf: impl FnMut(usize, &[u32], f32) -> f32,
+        mut leaf: impl FnMut(u32, &[u32], &mut [f32; N]),
     ) {
         if self.nodes.is_empty() {
             return;
@@ -208,10 +273,7 @@ impl Bvh {
         let (mut reference, mut mask) = (0, Packet::<N>::all());
         loop {
             if reference & LEAF != 0 {
-                let prims = self.leaf(reference);
-                for r in bits(mask) {
-                    t_max[r] = leaf(r, prims, t_max[r]);
-                }
+                leaf(mask, self.leaf(reference), t_max);
             } else {
                 let node = &self.nodes[reference as usize];
                 let mut hit = [0u32; WIDTH];
