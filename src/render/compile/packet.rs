@@ -8,6 +8,7 @@ use crate::accel::Packet;
 use crate::math::Ray;
 use crate::render::primitive::Primitive;
 use crate::shape::{BoxRay, SphereRay};
+use glam::Vec4;
 
 /// Wide nodes below which a scene's camera rays go one by one: with a hierarchy of a few
 /// nodes (a room of ten shapes) the walk costs little, and gathering a packet's answers cost
@@ -94,5 +95,42 @@ impl RenderScene {
                 )
             });
         std::array::from_fn(|r| self.surface_of(&rays[r], best[r]?, won[r].as_ref()))
+    }
+}
+
+impl RenderScene {
+    /// One group of `closest_in_sphere_leaf`: the packed spheres from `start` on (those
+    /// before `end`), in lanes, tested up to `limit` (the leaf's first `t_max`, moved up
+    /// one ulp); returns the new `t_max`.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn closest_in_spheres(
+        &self,
+        lanes: &SphereRay,
+        spheres: &[Vec4; LANES],
+        start: usize,
+        end: usize,
+        limit: f32,
+        mut t_max: f32,
+        best: &mut Option<Best>,
+    ) -> f32 {
+        let live = (end - start).min(LANES);
+        let (mask, t) = lanes.hit_lanes(spheres, limit);
+        let mut mask = mask & ((1 << live) - 1);
+        while mask != 0 {
+            let k = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let i = start + k;
+            if Best::loses_to(best, t_max, t[k], self.key[i]) {
+                t_max = t[k];
+                *best = Some(Best {
+                    id: i as u32,
+                    t: t_max,
+                    key: self.key[i],
+                    hit: None,
+                });
+            }
+        }
+        t_max
     }
 }
