@@ -312,7 +312,7 @@ fn turning_scene() -> String {
 /// facing the eye, or 0 where the line to the light passes within R of the ball's centre
 /// (the ball lies between the two).
 fn dome_light(d: [f64; 3]) -> f64 {
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let dot = dot3;
     let p = d.map(|c| c * DOME);
     let to_light = [LIGHT[0] - p[0], LIGHT[1] - p[1], LIGHT[2] - p[2]];
     let l = to_light.map(|c| c / dot(to_light, to_light).sqrt());
@@ -338,45 +338,59 @@ fn dome_light(d: [f64; 3]) -> f64 {
 fn a_turning_camera_blurs_a_still_shadow_along_its_path() {
     let job = job(&turning_scene());
     let out = render_job(&job, &RenderSettings::default(), &|_| {}).expect("renders");
+    // The view direction `d` of the camera at the middle of the exposure, turned about y
+    // (right-handed) by where the turn is at `u`.
+    let light = |d: [f64; 3], u: f64| {
+        let (sin, cos) = (TURN * (1.0 - 2.0 * u)).to_radians().sin_cos();
+        dome_light([cos * d[0] + sin * d[2], d[1], -sin * d[0] + cos * d[2]])
+    };
+    let want = exposure_means(light);
+    let dark = exposure_means(|d, u| (light(d, u) == 0.0) as u8 as f64);
+    let partly = dark.iter().filter(|&&f| f > 0.1 && f < 0.9).count();
+    // The blur widens the shadow (about 13 pixels) by 2·TURN degrees, about 11 pixels.
+    assert!(partly > 12 * H as usize, "{partly} pixels partly in shadow");
+    let worst = worst_against(&out.image.pixels, &want);
+    assert!(worst.0 < 0.06, "largest difference {worst:?}");
+}
+
+/// Per pixel (row-major), the mean of `value(d, u)` over the pixel (16×16 positions) and the
+/// exposure (32 instants `u`, the middles of its equal parts), `d` the unit direction from the
+/// eye through the position as the camera has it at the middle of the exposure.
+fn exposure_means(value: impl Fn([f64; 3], f64) -> f64) -> Vec<f64> {
     let dist = (W as f64 / 2.0) / (FOV.to_radians() / 2.0).tan();
     let (n, instants) = (16, 32);
-    let mut worst = (0.0f64, 0, 0);
-    let mut partly = 0;
+    let mut means = Vec::with_capacity((W * H) as usize);
     for y in 0..H {
         for x in 0..W {
-            let (mut want, mut dark) = (0.0, 0);
-            for k in 0..instants {
-                let angle = (TURN * (1.0 - 2.0 * (k as f64 + 0.5) / instants as f64)).to_radians();
-                let (sin, cos) = angle.sin_cos();
-                for j in 0..n {
-                    for i in 0..n {
-                        let px = x as f64 + (i as f64 + 0.5) / n as f64;
-                        let py = y as f64 + (j as f64 + 0.5) / n as f64;
-                        let v = [px - W as f64 / 2.0, H as f64 / 2.0 - py, -dist];
-                        // Turned about y, right-handed.
-                        let v = [cos * v[0] + sin * v[2], v[1], -sin * v[0] + cos * v[2]];
-                        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                        let lit = dome_light(v.map(|c| c / len));
-                        want += lit;
-                        dark += (lit == 0.0) as u32;
+            let mut sum = 0.0;
+            for j in 0..n {
+                for i in 0..n {
+                    let px = x as f64 + (i as f64 + 0.5) / n as f64;
+                    let py = y as f64 + (j as f64 + 0.5) / n as f64;
+                    let v = [px - W as f64 / 2.0, H as f64 / 2.0 - py, -dist];
+                    let d = v.map(|c| c / dot3(v, v).sqrt());
+                    for k in 0..instants {
+                        sum += value(d, (k as f64 + 0.5) / instants as f64);
                     }
                 }
             }
-            let all = (n * n * instants) as f64;
-            want /= all;
-            let dark = dark as f64 / all;
-            if dark > 0.1 && dark < 0.9 {
-                partly += 1;
-            }
-            let got = out.image.pixels[(y * W + x) as usize].x as f64;
-            if (got - want).abs() > worst.0 {
-                worst = ((got - want).abs(), x, y);
-            }
+            means.push(sum / (n * n * instants) as f64);
         }
     }
-    // The blur widens the shadow (about 13 pixels) by 2·TURN degrees, about 11 pixels.
-    assert!(partly > 12 * H as usize, "{partly} pixels partly in shadow");
-    assert!(worst.0 < 0.06, "largest difference {worst:?}");
+    means
+}
+
+/// The largest difference of a rendered image's red channel from `want` (row-major), and
+/// where.
+fn worst_against(pixels: &[glam::Vec3], want: &[f64]) -> (f64, u32, u32) {
+    let mut worst = (0.0f64, 0, 0);
+    for (i, (got, want)) in pixels.iter().zip(want).enumerate() {
+        let off = (got.x as f64 - want).abs();
+        if off > worst.0 {
+            worst = (off, i as u32 % W, i as u32 / W);
+        }
+    }
+    worst
 }
 
 /// A still ball between the light and the sliding ball's path: its shadow falls on the
@@ -463,31 +477,7 @@ fn crossing_light(d: [f64; 3], u: f64) -> f64 {
 fn a_moving_shape_is_shadowed_where_the_wall_behind_it_is_not() {
     let job = job(&crossing_scene());
     let out = render_job(&job, &RenderSettings::default(), &|_| {}).expect("renders");
-    let dist = (W as f64 / 2.0) / (FOV.to_radians() / 2.0).tan();
-    let (n, instants) = (16, 32);
-    let mut worst = (0.0f64, 0, 0);
-    for y in 0..H {
-        for x in 0..W {
-            let mut want = 0.0;
-            for k in 0..instants {
-                let u = (k as f64 + 0.5) / instants as f64;
-                for j in 0..n {
-                    for i in 0..n {
-                        let px = x as f64 + (i as f64 + 0.5) / n as f64;
-                        let py = y as f64 + (j as f64 + 0.5) / n as f64;
-                        let v = [px - W as f64 / 2.0, H as f64 / 2.0 - py, -dist];
-                        let len = dot3(v, v).sqrt();
-                        want += crossing_light(v.map(|c| c / len), u);
-                    }
-                }
-            }
-            want /= (n * n * instants) as f64;
-            let got = out.image.pixels[(y * W + x) as usize].x as f64;
-            if (got - want).abs() > worst.0 {
-                worst = ((got - want).abs(), x, y);
-            }
-        }
-    }
+    let worst = worst_against(&out.image.pixels, &exposure_means(crossing_light));
     // Default settings leave up to about 0.055 on the ball's blurred edges (at most 32
     // samples for a pixel the ball covers part of the time).
     assert!(worst.0 < 0.09, "largest difference {worst:?}");
