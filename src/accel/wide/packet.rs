@@ -69,24 +69,7 @@ impl<const N: usize> Packet<N> {
         let o0_sign = [o0.x, o0.y, o0.z].map(|c| if c.is_sign_negative() { 0xF } else { 0 });
         for g in 0..Self::GROUPS {
             let four = &rays[g * LANES..g * LANES + LANES];
-            let o = Mat4::from_cols(
-                four[0].origin.extend(0.0),
-                four[1].origin.extend(0.0),
-                four[2].origin.extend(0.0),
-                four[3].origin.extend(0.0),
-            )
-            .transpose();
-            let d = Mat4::from_cols(
-                four[0].dir.extend(0.0),
-                four[1].dir.extend(0.0),
-                four[2].dir.extend(0.0),
-                four[3].dir.extend(0.0),
-            )
-            .transpose();
-            let (o, d) = (
-                [o.x_axis, o.y_axis, o.z_axis],
-                [d.x_axis, d.y_axis, d.z_axis],
-            );
+            let (o, d) = (lanes3(four, |r| r.origin), lanes3(four, |r| r.dir));
             let mut same_here = 0xF;
             for axis in 0..3 {
                 let inv = Vec4::ONE / d[axis];
@@ -130,6 +113,19 @@ impl<const N: usize> Packet<N> {
     fn all() -> u32 {
         u32::MAX >> (32 - N)
     }
+}
+
+/// A vector of each of four rays (`of`), transposed: per axis, the four rays' components.
+#[inline(always)]
+fn lanes3(four: &[Ray], of: impl Fn(&Ray) -> glam::Vec3A) -> [Vec4; 3] {
+    let m = Mat4::from_cols(
+        of(&four[0]).extend(0.0),
+        of(&four[1]).extend(0.0),
+        of(&four[2]).extend(0.0),
+        of(&four[3]).extend(0.0),
+    )
+    .transpose();
+    [m.x_axis, m.y_axis, m.z_axis]
 }
 
 #[inline(always)]
