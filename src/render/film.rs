@@ -32,10 +32,12 @@ fn round_level(v: f32) -> u8 {
 
 /// 8-bit RGB, row-major from the top row.
 pub fn to_rgb8(img: &HdrImage) -> Vec<u8> {
-    img.pixels
-        .iter()
-        .flat_map(|p| [tone_map_u8(p.x), tone_map_u8(p.y), tone_map_u8(p.z)])
-        .collect()
+    // Filled in place: collected from a flat map, each byte took a capacity check and a push.
+    let mut rgb = vec![0u8; img.pixels.len() * 3];
+    for (p, out) in img.pixels.iter().zip(rgb.chunks_exact_mut(3)) {
+        out.copy_from_slice(&[tone_map_u8(p.x), tone_map_u8(p.y), tone_map_u8(p.z)]);
+    }
+    rgb
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
