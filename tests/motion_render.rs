@@ -191,18 +191,35 @@ const BALL_SLIDE: f64 = 2.0;
 /// A white diffuse wall (radiance N·L, nothing else), the ball out of view above it.
 fn shadow_scene() -> String {
     let [bx, by, bz] = BALL;
-    let [lx, ly, lz] = LIGHT;
     let half = BALL_SLIDE / 2.0;
+    lit_scene(
+        &format!(
+            "define shape plane wall 0 0 {WALL_Z} 0 0 1 wallm\n\
+             define shape sphere ball {bx} {by} {bz} {R} wallm\n"
+        ),
+        &ball_slide(half),
+        "shadow.ppm",
+    )
+}
+
+/// `motion` lines sliding `ball` along x from −`half` to `half` over the exposure.
+fn ball_slide(half: f64) -> String {
+    format!("motion ball 0 translate -{half} 0 0\nmotion ball 0.5\nmotion ball 1 translate {half} 0 0\n")
+}
+
+/// A scene of white diffuse shapes (`shapes`, of material `wallm`: radiance N·L) lit by
+/// `LIGHT` alone on black, seen by the camera `eye` with `motion` lines, rendered to `image`.
+fn lit_scene(shapes: &str, motion: &str, image: &str) -> String {
+    let [lx, ly, lz] = LIGHT;
     format!(
         "define material wallm 0 0 0 1 1 1 0 0 0 1\n\
-         define shape plane wall 0 0 {WALL_Z} 0 0 1 wallm\n\
-         define shape sphere ball {bx} {by} {bz} {R} wallm\n\
+         {shapes}\
          define light key {lx} {ly} {lz} 1 1 1 1\n\
          ambient 0 0 0\n\
          background 0 0 0\n\
          define camera eye {FOV}\n\
-         motion ball 0 translate -{half} 0 0\nmotion ball 0.5\nmotion ball 1 translate {half} 0 0\n\
-         render eye shadow.ppm {W} {H}\n"
+         {motion}\
+         render eye {image} {W} {H}\n"
     )
 }
 
@@ -294,36 +311,22 @@ const TURN: f64 = 5.0;
 /// turns about y. The ball's shadow falls round (0, 0, −DOME), in the middle of the view.
 fn turning_scene() -> String {
     let [bx, by, bz] = BALL;
-    let [lx, ly, lz] = LIGHT;
-    format!(
-        "define material wallm 0 0 0 1 1 1 0 0 0 1\n\
-         define shape sphere dome 0 0 0 {DOME} wallm\n\
-         define shape sphere ball {bx} {by} {bz} {R} wallm\n\
-         define light key {lx} {ly} {lz} 1 1 1 1\n\
-         ambient 0 0 0\n\
-         background 0 0 0\n\
-         define camera eye {FOV}\n\
-         motion eye 0 rotate {TURN} 0 1 0\nmotion eye 0.5\nmotion eye 1 rotate -{TURN} 0 1 0\n\
-         render eye turn.ppm {W} {H}\n"
+    lit_scene(
+        &format!(
+            "define shape sphere dome 0 0 0 {DOME} wallm\n\
+             define shape sphere ball {bx} {by} {bz} {R} wallm\n"
+        ),
+        &format!(
+            "motion eye 0 rotate {TURN} 0 1 0\nmotion eye 0.5\nmotion eye 1 rotate -{TURN} 0 1 0\n"
+        ),
+        "turn.ppm",
     )
 }
 
-/// The dome's light at the point seen along unit direction `d` from the eye: N·L with N
-/// facing the eye, or 0 where the line to the light passes within R of the ball's centre
-/// (the ball lies between the two).
+/// The dome's light at the point seen along unit direction `d` from the eye (the normal
+/// facing the eye), past the still ball.
 fn dome_light(d: [f64; 3]) -> f64 {
-    let dot = dot3;
-    let p = d.map(|c| c * DOME);
-    let to_light = [LIGHT[0] - p[0], LIGHT[1] - p[1], LIGHT[2] - p[2]];
-    let l = to_light.map(|c| c / dot(to_light, to_light).sqrt());
-    let c = [BALL[0] - p[0], BALL[1] - p[1], BALL[2] - p[2]];
-    let cl = dot(c, l);
-    let n_dot_l = -dot(d, l);
-    if n_dot_l <= 0.0 || dot(c, c) - cl * cl < R * R {
-        0.0
-    } else {
-        n_dot_l
-    }
+    diffuse_light(d.map(|c| c * DOME), d.map(|c| -c), &[(BALL, R)])
 }
 
 /// Under a camera that moves, a refined sample's hit lies pixels away from the first pass's
@@ -404,20 +407,16 @@ const CROSSING_Z: f64 = -6.0;
 /// A white diffuse ball sliding across the view (x from −SLIDE/2 to SLIDE/2) before the
 /// wall, lit past the still ball `OCCLUDER` out of view above.
 fn crossing_scene() -> String {
-    let [lx, ly, lz] = LIGHT;
     let [ox, oy, oz] = OCCLUDER;
     let half = SLIDE / 2.0;
-    format!(
-        "define material wallm 0 0 0 1 1 1 0 0 0 1\n\
-         define shape plane wall 0 0 {WALL_Z} 0 0 1 wallm\n\
-         define shape sphere ball 0 0 {CROSSING_Z} {R} wallm\n\
-         define shape sphere occluder {ox} {oy} {oz} {OCCLUDER_R} wallm\n\
-         define light key {lx} {ly} {lz} 1 1 1 1\n\
-         ambient 0 0 0\n\
-         background 0 0 0\n\
-         define camera eye {FOV}\n\
-         motion ball 0 translate -{half} 0 0\nmotion ball 0.5\nmotion ball 1 translate {half} 0 0\n\
-         render eye crossing.ppm {W} {H}\n"
+    lit_scene(
+        &format!(
+            "define shape plane wall 0 0 {WALL_Z} 0 0 1 wallm\n\
+             define shape sphere ball 0 0 {CROSSING_Z} {R} wallm\n\
+             define shape sphere occluder {ox} {oy} {oz} {OCCLUDER_R} wallm\n"
+        ),
+        &ball_slide(half),
+        "crossing.ppm",
     )
 }
 
@@ -453,13 +452,19 @@ fn crossing_light(d: [f64; 3], u: f64) -> f64 {
         }
         None => (d.map(|c| c * WALL_Z / d[2]), [0.0, 0.0, 1.0]),
     };
+    diffuse_light(p, n, &[(ball, R), (OCCLUDER, OCCLUDER_R)])
+}
+
+/// What `LIGHT` gives a white diffuse point `p` of unit normal `n`: N·L, or 0 where it faces
+/// away or one of the spheres `blockers` (centre, radius) lies on the way to the light.
+fn diffuse_light(p: [f64; 3], n: [f64; 3], blockers: &[([f64; 3], f64)]) -> f64 {
     let to_light = sub3(LIGHT, p);
     let dist = dot3(to_light, to_light).sqrt();
     let l = to_light.map(|c| c / dist);
     let n_dot_l = dot3(n, l);
-    let hidden = [(ball, R), (OCCLUDER, OCCLUDER_R)]
-        .into_iter()
-        .any(|(c, r)| sphere_entry(p, l, c, r, 1e-9).is_some_and(|t| t < dist));
+    let hidden = blockers
+        .iter()
+        .any(|&(c, r)| sphere_entry(p, l, c, r, 1e-9).is_some_and(|t| t < dist));
     if n_dot_l <= 0.0 || hidden {
         0.0
     } else {
