@@ -300,13 +300,17 @@ impl Bvh {
                 if mask != 0 {
                     let enter = enter.to_array();
                     let order = node.order[octant];
-                    // Farthest pushed first, so the nearest is visited next.
-                    for k in (0..node.len).rev() {
+                    let (nearest, k) = nearest_met(order, mask);
+                    // The others pushed farthest first; the nearest visited next, without a
+                    // trip through the stack.
+                    for k in (k..node.len).rev() {
                         let slot = usize::from((order >> (2 * k)) & 3);
                         if mask & (1 << slot) != 0 {
                             stack.push((node.child[slot], enter[slot]));
                         }
                     }
+                    reference = node.child[nearest];
+                    continue;
                 }
             }
             loop {
@@ -378,17 +382,26 @@ impl Bvh {
             if mask == 0 {
                 continue;
             }
+            if !NEAR_FIRST {
+                // Pushed from the last slot down, so that they come off left to right.
+                for slot in (0..usize::from(node.len)).rev() {
+                    if mask & (1 << slot) != 0 {
+                        stack.push(node.child[slot]);
+                    }
+                }
+                continue;
+            }
+            // The others pushed farthest first; the nearest visited next, without a trip
+            // through the stack.
             let order = node.order[octant];
-            for k in (0..node.len).rev() {
-                let slot = if NEAR_FIRST {
-                    usize::from((order >> (2 * k)) & 3)
-                } else {
-                    usize::from(k)
-                };
+            let (nearest, k) = nearest_met(order, mask);
+            for k in (k..node.len).rev() {
+                let slot = usize::from((order >> (2 * k)) & 3);
                 if mask & (1 << slot) != 0 {
                     stack.push(node.child[slot]);
                 }
             }
+            next = Some(node.child[nearest]);
         }
         false
     }
@@ -396,6 +409,20 @@ impl Bvh {
     /// Bytes held by the hierarchy.
     pub fn memory_bytes(&self) -> usize {
         self.nodes.capacity() * std::mem::size_of::<Node>() + self.prims.capacity() * 4
+    }
+}
+
+/// The first slot of a node's visit `order` (for the ray's octant) whose bit is set in
+/// `mask` (not empty), and the position in `order` after it.
+#[inline(always)]
+fn nearest_met(order: u8, mask: u32) -> (usize, u8) {
+    let mut k = 0;
+    loop {
+        let slot = usize::from((order >> (2 * k)) & 3);
+        k += 1;
+        if mask & (1 << slot) != 0 {
+            return (slot, k);
+        }
     }
 }
 
