@@ -20,6 +20,40 @@ pub const NO_HIT: u32 = u32::MAX;
 
 /// Lights whose last blocker a [`TraceState`] remembers (the others go without).
 const CACHED_LIGHTS: usize = 8;
+/// Shadow rays towards a light found clear in a row after which its last blocker is no
+/// longer tried first (see [`LastShadows`]).
+const CLEAR_RUN_SKIP: u8 = 8;
+
+/// What a worker's latest shadow rays towards one light found: the opaque primitive that
+/// last blocked one, tried first by the next (neighbouring points mostly lie in the same
+/// shadow), and how many in a row have since found the light clear. Out of shadow, trying
+/// a blocker that blocks nothing is a wasted test per ray; but where shadowed and lit points
+/// alternate (a packet of camera rays crossing gaps between spheres), the blocker of two
+/// rays ago is often the next one's too. So it is tried until a few clear rays in a row.
+#[derive(Clone, Copy, Debug)]
+struct LastShadows {
+    blocker: u32,
+    clear_run: u8,
+}
+
+impl LastShadows {
+    const NONE: LastShadows = LastShadows {
+        blocker: NO_HIT,
+        clear_run: 0,
+    };
+
+    /// The primitive to try first, if any.
+    fn guess(&self) -> Option<u32> {
+        (self.blocker != NO_HIT && self.clear_run < CLEAR_RUN_SKIP).then_some(self.blocker)
+    }
+
+    fn blocked_by(&mut self, prim: u32) {
+        *self = LastShadows {
+            blocker: prim,
+            clear_run: 0,
+        };
+    }
+}
 
 /// What one worker keeps between the rays it traces: its ray counts, and per light the
 /// opaque primitive that last blocked a shadow ray (see [`Integrator::visibility`]). The
@@ -28,7 +62,7 @@ const CACHED_LIGHTS: usize = 8;
 #[derive(Clone, Debug)]
 pub struct TraceState {
     pub counts: RayCounts,
-    blockers: [u32; CACHED_LIGHTS],
+    shadows: [LastShadows; CACHED_LIGHTS],
     /// A light's term whose share of the pixel, lit, is below this is added as lit without
     /// its shadow ray: 0 (every shadow ray traced) except for adaptive sampling's refining
     /// samples ([`TraceState::refining`]).
@@ -84,7 +118,7 @@ impl Default for TraceState {
     fn default() -> Self {
         TraceState {
             counts: RayCounts::default(),
-            blockers: [NO_HIT; CACHED_LIGHTS],
+            shadows: [LastShadows::NONE; CACHED_LIGHTS],
             shadow_cut: 0.0,
             not_clear: 0,
             known_clear: 0,
@@ -293,7 +327,7 @@ impl Integrator<'_> {
                 continue;
             }
             st.counts.shadow += 1;
-            let vis = self.visibility(hit, l, dist, time, st.blockers.get_mut(k));
+            let vis = self.visibility(hit, l, dist, time, st.shadows.get_mut(k));
             if vis < 1.0 {
                 st.not_clear |= 1 << k.min(31);
             }
@@ -336,14 +370,14 @@ impl Integrator<'_> {
         l: Vec3A,
         dist: f32,
         time: f32,
-        mut blocker: Option<&mut u32>,
+        mut last: Option<&mut LastShadows>,
     ) -> f32 {
         let scene = self.scene;
         let ray = hit.spawn_ray(l).at_time(time);
         let light = hit.point + l * dist;
         let remaining = (light - ray.origin).dot(l);
-        if let Some(&mut b) = blocker.as_deref_mut() {
-            if b != NO_HIT && scene.hit(b, &ray, remaining).is_some() {
+        if let Some(b) = last.as_deref().and_then(LastShadows::guess) {
+            if scene.hit(b, &ray, remaining).is_some() {
                 return 0.0;
             }
         }
@@ -351,10 +385,15 @@ impl Integrator<'_> {
         // (packed primitives four at a time) says so, looking past glass for an opaque
         // blocker, which means no light whatever else the ray crosses.
         match scene.shadow(&ray, remaining) {
-            Shadow::Clear => return 1.0,
+            Shadow::Clear => {
+                if let Some(last) = last {
+                    last.clear_run = last.clear_run.saturating_add(1);
+                }
+                return 1.0;
+            }
             Shadow::Blocked(first) => {
-                if let Some(b) = blocker {
-                    *b = first;
+                if let Some(last) = last {
+                    last.blocked_by(first);
                 }
                 return 0.0;
             }
@@ -372,8 +411,8 @@ impl Integrator<'_> {
             let opacity = scene.materials[scene.material_of(i) as usize].opacity;
             if opacity >= 1.0 {
                 let hit = scene.hit(i, &ray, remaining).is_some();
-                if let Some(b) = blocker.as_deref_mut().filter(|_| hit) {
-                    *b = i;
+                if let Some(last) = last.as_deref_mut().filter(|_| hit) {
+                    last.blocked_by(i);
                 }
                 return hit;
             }
