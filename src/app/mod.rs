@@ -36,7 +36,7 @@ pub enum Command {
 }
 
 /// Runs `command` on a rayon pool of `threads` workers (default: one per core), the one pool
-/// of the process: tiles of a frame and frames of a directory share it.
+/// of the process: the rows of a frame and the frames of a directory share it.
 pub fn run(command: Command, threads: Option<u32>) -> ExitCode {
     // Deep mirror recursion (up to limits::MAX_DEPTH) runs on these threads.
     let mut builder = rayon::ThreadPoolBuilder::new().stack_size(limits::RENDER_STACK_BYTES);

@@ -1,4 +1,4 @@
-//! `anim render FILE|DIR ...`: scene files rendered one by one (tiles in parallel), frame
+//! `anim render FILE|DIR ...`: scene files rendered one by one (rows in parallel), frame
 //! directories rendered frames in parallel; warnings, errors and a summary on stderr.
 
 use super::progress::{plural, FrameLog, LazyBar};

@@ -1,5 +1,5 @@
 //! `anim render DIR`: every `.sdf` file of a directory rendered as an animation frame —
-//! frames in parallel (and tiles within frames), unchanged frames skipped (see [`super::cache`]),
+//! frames in parallel (and rows within frames), unchanged frames skipped (see [`super::cache`]),
 //! one shard of the frames when asked, and a summary at the end.
 
 use super::cache::{

@@ -1,4 +1,4 @@
-//! Rendering: compile a scene description, trace it on rayon tiles, tone-map, write the image.
+//! Rendering: compile a scene description, trace its rows in parallel (rayon), tone-map, write the image.
 
 pub mod camera;
 pub mod compile;
@@ -19,10 +19,6 @@ use motion::Shutter;
 use rayon::prelude::*;
 use sampling::PixelPattern;
 use std::path::PathBuf;
-
-/// Tile edge in pixels: small enough to balance two to many cores, big enough that the
-/// per-tile overhead (one allocation, one progress update) vanishes.
-const TILE: u32 = 32;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -182,11 +178,12 @@ fn camera_relative(job: &RenderJob) -> Option<(Scene, Camera)> {
     Some((scene, camera))
 }
 
-/// Renders one job to an HDR image. `on_tile(pixels)` is called as tiles finish.
+/// Renders one job to an HDR image. `on_pixels(n)` is called as each band of `n` pixels
+/// finishes.
 pub fn render_job(
     job: &RenderJob,
     settings: &RenderSettings,
-    on_tile: &(dyn Fn(u64) + Sync),
+    on_pixels: &(dyn Fn(u64) + Sync),
 ) -> Result<Rendered, CameraError> {
     let (width, height, _) = settings.resolve(job);
     let rebased = camera_relative(job);
@@ -206,7 +203,7 @@ pub fn render_job(
     };
     let (pixels, counts) = match settings.sampling(job) {
         Sampling::Uniform(spp) => {
-            render_uniform(&camera, shutter, &integrator, width, height, spp, on_tile)
+            render_uniform(&camera, shutter, &integrator, width, height, spp, on_pixels)
         }
         Sampling::Adaptive { error, max_spp } => render_adaptive(
             &camera,
@@ -215,7 +212,7 @@ pub fn render_job(
             (width, height),
             error,
             max_spp,
-            on_tile,
+            on_pixels,
         ),
     };
     Ok(Rendered {
@@ -239,33 +236,25 @@ fn render_uniform(
     width: u32,
     height: u32,
     spp: u32,
-    on_tile: &(dyn Fn(u64) + Sync),
+    on_pixels: &(dyn Fn(u64) + Sync),
 ) -> (Vec<Vec3>, RayCounts) {
     let offsets = sample_offsets(spp);
     let inv_spp = 1.0 / offsets.len() as f32;
-    let tiles_x = width.div_ceil(TILE);
-    let tiles: Vec<(u32, u32)> = (0..height.div_ceil(TILE))
-        .flat_map(|ty| (0..tiles_x).map(move |tx| (tx * TILE, ty * TILE)))
-        .collect();
-    // Each pixel depends only on its own position, so the result is the same for any
-    // thread count or tile order.
-    let rendered: Vec<(Vec<Vec3>, RayCounts)> = tiles
-        .par_iter()
-        .map(|&(x0, y0)| {
-            let (x1, y1) = ((x0 + TILE).min(width), (y0 + TILE).min(height));
+    let mut pixels = vec![Vec3::ZERO; (width * height) as usize];
+    // Bands of whole rows, written where they lie in the image: each pixel depends only on
+    // its own position, so the result is the same for any thread count or band order.
+    let rows = packet::BLOCK_H;
+    let counts = pixels
+        .par_chunks_mut((width * rows).max(1) as usize)
+        .enumerate()
+        .map(|(i, band)| {
+            let y0 = i as u32 * rows;
             let mut st = TraceState::default();
-            let tile = (x0, x1, y0, y1);
-            let packed = shutter
-                .is_none()
-                .then(|| packet::render_tile(camera, integrator, tile, &offsets, &mut st))
-                .flatten();
-            if let Some(out) = packed {
-                on_tile(out.len() as u64);
-                return (out, st.counts);
-            }
-            let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-            for y in y0..y1 {
-                for x in x0..x1 {
+            let packed = shutter.is_none()
+                && packet::render_band(camera, integrator, (y0, width), band, &offsets, &mut st);
+            if !packed {
+                for (k, out) in band.iter_mut().enumerate() {
+                    let (x, y) = (k as u32 % width, y0 + k as u32 / width);
                     let mut sum = Vec3A::ZERO;
                     for (i, &(dx, dy)) in offsets.iter().enumerate() {
                         let (px, py) = (x as f32 + dx, y as f32 + dy);
@@ -279,24 +268,14 @@ fn render_uniform(
                         };
                         sum += integrator.trace(&ray, 0, 1.0, &mut st);
                     }
-                    st.counts.primary += offsets.len() as u64;
-                    out.push(Vec3::from(sum * inv_spp));
+                    *out = Vec3::from(sum * inv_spp);
                 }
+                st.counts.primary += (band.len() * offsets.len()) as u64;
             }
-            on_tile(out.len() as u64);
-            (out, st.counts)
+            on_pixels(band.len() as u64);
+            st.counts
         })
-        .collect();
-    let mut pixels = vec![Vec3::ZERO; (width * height) as usize];
-    let mut counts = RayCounts::default();
-    for (&(x0, y0), (tile, c)) in tiles.iter().zip(rendered) {
-        counts += c;
-        let w = (x0 + TILE).min(width) - x0;
-        for (row, chunk) in tile.chunks(w as usize).enumerate() {
-            let start = ((y0 + row as u32) * width + x0) as usize;
-            pixels[start..start + chunk.len()].copy_from_slice(chunk);
-        }
-    }
+        .reduce(RayCounts::default, add_counts);
     (pixels, counts)
 }
 
@@ -362,7 +341,7 @@ fn render_adaptive(
     (width, height): (u32, u32),
     error: f32,
     max_spp: u32,
-    on_tile: &(dyn Fn(u64) + Sync),
+    on_pixels: &(dyn Fn(u64) + Sync),
 ) -> (Vec<Vec3>, RayCounts) {
     let (w, h) = (width as usize, height as usize);
     let mut base = vec![(Vec3A::ZERO, NO_HIT); w * h];
@@ -591,7 +570,7 @@ fn render_adaptive(
                 *out = Vec3::from(m.mean());
                 taken_row[x] = m.n.min(u8::MAX as u32) as u8;
             }
-            on_tile(row.len() as u64);
+            on_pixels(row.len() as u64);
             st.counts
         })
         .reduce(RayCounts::default, add_counts);

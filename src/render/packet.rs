@@ -9,10 +9,11 @@ use super::integrator::{Integrator, TraceState, NO_HIT};
 use glam::{Vec3, Vec3A};
 
 /// A packet of the uniform path: `BLOCK_W × BLOCK_H` pixels, one sample position each.
+/// The uniform path hands out work a row of packets at a time (`BLOCK_H` rows).
 /// 4×4 walks the tree once for twice the rays of 4×2 at little more cost per node (grid10k
 /// 1280×720: 3.3 % fewer instructions; 8×2 and 8×4 saved less, and 8×4 cost random100k 2 %).
 const BLOCK_W: u32 = 4;
-const BLOCK_H: u32 = 4;
+pub const BLOCK_H: u32 = 4;
 const BLOCK: usize = (BLOCK_W * BLOCK_H) as usize;
 /// A packet of adaptive sampling's first pass (one row at a time): this many pixels of a row.
 const ROW_RUN: usize = 8;
@@ -46,53 +47,59 @@ fn trace_primaries<const N: usize>(
     out
 }
 
-/// The pixels of the tile `x0..x1 × y0..y1` (row by row) for uniform sampling at `offsets`,
-/// or `None` when packets do not apply (the caller then traces ray by ray). Counts the
-/// camera rays in `st`.
-pub fn render_tile(
+/// Uniform sampling at `offsets` of the rows `y0..` of the image that `band` holds (whole
+/// rows of `width` pixels), written into it; false (and nothing traced) when packets do not
+/// apply, for the caller to trace ray by ray. Counts the camera rays in `st`.
+pub fn render_band(
     camera: &CameraRays,
     integrator: &Integrator,
-    (x0, x1, y0, y1): (u32, u32, u32, u32),
+    (y0, width): (u32, u32),
+    band: &mut [Vec3],
     offsets: &[(f32, f32)],
     st: &mut TraceState,
-) -> Option<Vec<Vec3>> {
+) -> bool {
     if !packets_apply(integrator) {
-        return None;
+        return false;
     }
-    let w = (x1 - x0) as usize;
-    let mut sums = vec![Vec3A::ZERO; w * (y1 - y0) as usize];
+    let y1 = y0 + (band.len() / width.max(1) as usize) as u32;
+    let inv_spp = 1.0 / offsets.len() as f32;
+    let index = |(x, y): (u32, u32)| (y - y0) as usize * width as usize + x as usize;
     for by in (y0..y1).step_by(BLOCK_H as usize) {
-        for bx in (x0..x1).step_by(BLOCK_W as usize) {
+        for bx in (0..width).step_by(BLOCK_W as usize) {
             let at = |k: usize| (bx + k as u32 % BLOCK_W, by + k as u32 / BLOCK_W);
-            let index = |(x, y): (u32, u32)| (y - y0) as usize * w + (x - x0) as usize;
-            if bx + BLOCK_W > x1 || by + BLOCK_H > y1 {
-                // A partial block at the tile's edge: ray by ray.
+            if bx + BLOCK_W > width || by + BLOCK_H > y1 {
+                // A partial block at the image's edge: ray by ray.
                 for y in by..(by + BLOCK_H).min(y1) {
-                    for x in bx..(bx + BLOCK_W).min(x1) {
+                    for x in bx..(bx + BLOCK_W).min(width) {
+                        let mut sum = Vec3A::ZERO;
                         for &(dx, dy) in offsets {
                             let ray = camera.ray(x as f32 + dx, y as f32 + dy);
-                            sums[index((x, y))] += integrator.trace(&ray, 0, 1.0, st);
+                            sum += integrator.trace(&ray, 0, 1.0, st);
                         }
+                        band[index((x, y))] = Vec3::from(sum * inv_spp);
                     }
                 }
                 continue;
             }
             // Each pixel adds its samples in the order of `offsets`, as the single-ray loop.
+            let mut sums = [Vec3A::ZERO; BLOCK];
             for &(dx, dy) in offsets {
                 let rays: [_; BLOCK] = std::array::from_fn(|k| {
                     let (x, y) = at(k);
                     camera.ray(x as f32 + dx, y as f32 + dy)
                 });
                 let traced = trace_primaries(integrator, &rays, st, &mut [0; BLOCK]);
-                for (k, (c, _)) in traced.iter().enumerate() {
-                    sums[index(at(k))] += *c;
+                for (sum, (c, _)) in sums.iter_mut().zip(&traced) {
+                    *sum += *c;
                 }
+            }
+            for (k, sum) in sums.iter().enumerate() {
+                band[index(at(k))] = Vec3::from(*sum * inv_spp);
             }
         }
     }
-    st.counts.primary += (sums.len() * offsets.len()) as u64;
-    let inv_spp = 1.0 / offsets.len() as f32;
-    Some(sums.into_iter().map(|s| Vec3::from(s * inv_spp)).collect())
+    st.counts.primary += (band.len() * offsets.len()) as u64;
+    true
 }
 
 /// Adaptive sampling's first pass over row `y`: one ray through every pixel centre, its
