@@ -362,10 +362,10 @@ impl Integrator<'_> {
     /// either way: the first opaque blocker ends the query, and crossings of transparent
     /// objects multiply in whatever order the hierarchy offers them.
     ///
-    /// `blocker` is this light's entry of the worker's [`TraceState`]: the opaque primitive
-    /// that last blocked a shadow ray towards it. Neighbouring points mostly lie in the same
-    /// shadow, so that one is tried first; an opaque hit means no light whatever else the ray
-    /// crosses, so the answer is the same as without the cache.
+    /// `last` is this light's entry of the worker's [`TraceState`] ([`LastShadows`]): the
+    /// opaque primitive that last blocked a shadow ray towards it is tried first while it is
+    /// likely to block again; an opaque hit means no light whatever else the ray crosses, so
+    /// the answer is the same as without the cache.
     fn visibility(
         &self,
         hit: &SurfaceHit,

@@ -1,4 +1,5 @@
-//! Rendering: compile a scene description, trace its rows in parallel (rayon), tone-map, write the image.
+//! Rendering: compile a scene description, trace its rows in parallel (rayon), tone-map,
+//! write the image.
 
 pub mod camera;
 pub mod compile;
@@ -239,7 +240,6 @@ fn render_uniform(
     on_pixels: &(dyn Fn(u64) + Sync),
 ) -> (Vec<Vec3>, RayCounts) {
     let offsets = sample_offsets(spp);
-    let inv_spp = 1.0 / offsets.len() as f32;
     let mut pixels = vec![Vec3::ZERO; (width * height) as usize];
     // Bands of whole rows, written where they lie in the image: each pixel depends only on
     // its own position, so the result is the same for any thread count or band order.
@@ -255,20 +255,7 @@ fn render_uniform(
             if !packed {
                 for (k, out) in band.iter_mut().enumerate() {
                     let (x, y) = (k as u32 % width, y0 + k as u32 / width);
-                    let mut sum = Vec3A::ZERO;
-                    for (i, &(dx, dy)) in offsets.iter().enumerate() {
-                        let (px, py) = (x as f32 + dx, y as f32 + dy);
-                        let ray = match shutter {
-                            None => camera.ray(px, py),
-                            Some(s) => {
-                                let n = offsets.len() as u32;
-                                let time = sampling::uniform_time(x, y, i as u32, n);
-                                s.ray(camera, px, py, time)
-                            }
-                        };
-                        sum += integrator.trace(&ray, 0, 1.0, &mut st);
-                    }
-                    *out = Vec3::from(sum * inv_spp);
+                    *out = uniform_pixel(camera, shutter, integrator, (x, y), &offsets, &mut st);
                 }
                 st.counts.primary += (band.len() * offsets.len()) as u64;
             }
@@ -277,6 +264,32 @@ fn render_uniform(
         })
         .reduce(RayCounts::default, add_counts);
     (pixels, counts)
+}
+
+/// Pixel (`x`, `y`) of uniform sampling ray by ray: the mean of its samples at `offsets`
+/// (in a frame with motion, at the instants `sampling::uniform_time` gives them), added in
+/// that order, as the camera packets add theirs. Does not count the camera rays.
+pub(super) fn uniform_pixel(
+    camera: &CameraRays,
+    shutter: Option<&Shutter>,
+    integrator: &Integrator,
+    (x, y): (u32, u32),
+    offsets: &[(f32, f32)],
+    st: &mut TraceState,
+) -> Vec3 {
+    let mut sum = Vec3A::ZERO;
+    for (i, &(dx, dy)) in offsets.iter().enumerate() {
+        let (px, py) = (x as f32 + dx, y as f32 + dy);
+        let ray = match shutter {
+            None => camera.ray(px, py),
+            Some(s) => {
+                let n = offsets.len() as u32;
+                s.ray(camera, px, py, sampling::uniform_time(x, y, i as u32, n))
+            }
+        };
+        sum += integrator.trace(&ray, 0, 1.0, st);
+    }
+    Vec3::from(sum * (1.0 / offsets.len() as f32))
 }
 
 /// How a pixel's centre ray saw the motion of a frame (adaptive sampling's first pass).

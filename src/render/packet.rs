@@ -71,12 +71,8 @@ pub fn render_band(
                 // A partial block at the image's edge: ray by ray.
                 for y in by..(by + BLOCK_H).min(y1) {
                     for x in bx..(bx + BLOCK_W).min(width) {
-                        let mut sum = Vec3A::ZERO;
-                        for &(dx, dy) in offsets {
-                            let ray = camera.ray(x as f32 + dx, y as f32 + dy);
-                            sum += integrator.trace(&ray, 0, 1.0, st);
-                        }
-                        band[index((x, y))] = Vec3::from(sum * inv_spp);
+                        band[index((x, y))] =
+                            super::uniform_pixel(camera, None, integrator, (x, y), offsets, st);
                     }
                 }
                 continue;
