@@ -6,7 +6,7 @@
 
 use anim::accel::{Bvh, Packet};
 use anim::math::{Ray, Transform};
-use anim::render::compile::RenderScene;
+use anim::render::compile::{RenderScene, Shadow};
 use anim::render::primitive::Primitive;
 use anim::scene::{Instance, Material, Scene};
 use anim::shape::Geometry;
@@ -535,4 +535,87 @@ fn instanced_render_scene_equals_flattened_and_brute_force() {
         assert!(hits > 1500, "seed {seed}: {hits} hits");
         assert!(ties > 20, "seed {seed}: {ties} ties");
     }
+}
+
+/// Shadow rays in scenes of few shapes, where each light keeps direction cells around itself
+/// (a light buffer) and a shadow ray tests only what its cell lists: blocked exactly when
+/// brute force finds a hit before the light. Origins are lifted off at random by up to 10⁻³
+/// (as `SurfaceHit::spawn_ray` moves them), and lights sit among the shapes, inside the
+/// rooms, and far off. Rays aimed elsewhere must be answered too (the cells then answer
+/// nothing, and the whole scene is tested).
+#[test]
+fn shadow_rays_through_light_cells_meet_what_brute_force_meets() {
+    let mut rng = Rng(0x9E3779B97F4A7C15);
+    let mut blocked = 0;
+    let mut clear = 0;
+    let scenes = [
+        mixed_instances(&mut rng, 6),
+        mixed_instances(&mut rng, 13),
+        world_boxes(&mut rng, 5),
+        world_boxes(&mut rng, 10),
+    ];
+    for (instances, transforms) in scenes {
+        let prims: Vec<Primitive> = instances
+            .iter()
+            .map(|i| Primitive::new(&i.geometry, &transforms[i.transform as usize], 0).unwrap())
+            .collect();
+        let lights: Vec<DVec3> = (0..4)
+            .map(|k| match k {
+                0 => DVec3::new(200.0, 300.0, -150.0),
+                _ => rng.vec(60.0) - DVec3::splat(5.0),
+            })
+            .collect();
+        let scene = Scene {
+            materials: vec![Material::phong("m", Vec3::ONE, Vec3::ONE, Vec3::ONE, 1.0)],
+            instances: instances
+                .into_iter()
+                .map(|mut i| {
+                    i.material = 0;
+                    i
+                })
+                .collect::<Vec<_>>()
+                .into(),
+            transforms,
+            lights: lights
+                .iter()
+                .map(|&position| anim::scene::Light {
+                    name: "l".into(),
+                    position,
+                    intensity: Vec3::ONE,
+                })
+                .collect(),
+            ..Scene::default()
+        };
+        let (render, dropped) = RenderScene::compile(&scene);
+        assert!(dropped.is_empty());
+        for (k, light) in lights.iter().enumerate() {
+            let light = Vec3A::from(light.as_vec3());
+            for i in 0..3000 {
+                let (ray, t_limit) = if i % 5 == 4 {
+                    (random_ray(&mut rng, i), t_limit_of(i))
+                } else {
+                    let from = Vec3A::from((rng.vec(80.0) - DVec3::splat(15.0)).as_vec3());
+                    let dir = (light - from).normalize();
+                    let lift = Vec3A::from((rng.vec(2e-3) - DVec3::splat(1e-3)).as_vec3());
+                    let origin = from + lift * (i % 3) as f32;
+                    (Ray::new(origin, dir), (light - origin).dot(dir))
+                };
+                let brute = brute_closest(&prims, &ray, t_limit).is_some();
+                let found = render.shadow(&ray, t_limit, k);
+                match found {
+                    Shadow::Clear => clear += 1,
+                    Shadow::Blocked(id) => {
+                        assert!(render.hit(id, &ray, t_limit).is_some(), "ray {i}");
+                        blocked += 1;
+                    }
+                    other => panic!("opaque shapes only, yet {other:?}"),
+                }
+                assert_eq!(found != Shadow::Clear, brute, "light {k}, ray {i}: {ray:?}");
+            }
+        }
+    }
+    assert!(
+        blocked > 5000 && clear > 5000,
+        "{blocked} blocked, {clear} clear"
+    );
 }

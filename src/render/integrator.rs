@@ -329,7 +329,7 @@ impl Integrator<'_> {
                 continue;
             }
             st.counts.shadow += 1;
-            let vis = self.visibility(hit, l, dist, time, st.shadows.get_mut(k));
+            let vis = self.visibility(hit, k, l, dist, time, st.shadows.get_mut(k));
             if vis < 1.0 {
                 st.not_clear |= 1 << k.min(31);
             }
@@ -369,6 +369,7 @@ impl Integrator<'_> {
     fn visibility(
         &self,
         hit: &SurfaceHit,
+        light_index: usize,
         l: Vec3A,
         dist: f32,
         time: f32,
@@ -386,7 +387,7 @@ impl Integrator<'_> {
         // Most shadow rays meet nothing at all, or one glass object: the any-hit query
         // (packed primitives four at a time) says so, looking past glass for an opaque
         // blocker, which means no light whatever else the ray crosses.
-        match scene.shadow(&ray, remaining) {
+        match scene.shadow(&ray, remaining, light_index) {
             Shadow::Clear => {
                 if let Some(last) = last {
                     last.clear_run = last.clear_run.saturating_add(1);
