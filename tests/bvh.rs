@@ -7,7 +7,7 @@
 use anim::accel::{Bvh, Packet};
 use anim::math::{Ray, Transform};
 use anim::render::compile::{RenderScene, Shadow};
-use anim::render::primitive::Primitive;
+use anim::render::primitive::{Primitive, SurfaceHit};
 use anim::scene::{Instance, Material, Scene};
 use anim::shape::Geometry;
 use glam::{DVec3, Vec3, Vec3A};
@@ -539,15 +539,16 @@ fn instanced_render_scene_equals_flattened_and_brute_force() {
 
 /// Shadow rays in scenes of few shapes, where each light keeps direction cells around itself
 /// (a light buffer) and a shadow ray tests only what its cell lists: blocked exactly when
-/// brute force finds a hit before the light. Origins are lifted off at random by up to 10⁻³
+/// brute force finds a hit before the light. Camera rays likewise, from the eye's cells. Origins are lifted off at random by up to 10⁻³
 /// (as `SurfaceHit::spawn_ray` moves them), and lights sit among the shapes, inside the
 /// rooms, and far off. Rays aimed elsewhere must be answered too (the cells then answer
 /// nothing, and the whole scene is tested).
 #[test]
-fn shadow_rays_through_light_cells_meet_what_brute_force_meets() {
+fn rays_through_direction_cells_meet_what_brute_force_meets() {
     let mut rng = Rng(0x9E3779B97F4A7C15);
     let mut blocked = 0;
     let mut clear = 0;
+    let mut seen_hits = 0;
     let scenes = [
         mixed_instances(&mut rng, 6),
         mixed_instances(&mut rng, 13),
@@ -586,8 +587,34 @@ fn shadow_rays_through_light_cells_meet_what_brute_force_meets() {
                 .collect(),
             ..Scene::default()
         };
-        let (render, dropped) = RenderScene::compile(&scene);
+        let (mut render, dropped) = RenderScene::compile(&scene);
         assert!(dropped.is_empty());
+        // Camera rays from an eye with cells around it (and rays from elsewhere): the same
+        // hit as `closest` and brute force find, to the bit.
+        let eye = rng.vec(60.0) - DVec3::splat(5.0);
+        let eye = Vec3A::from(eye.as_vec3());
+        render.watch_from(eye);
+        for i in 0..3000 {
+            let ray = if i % 5 == 4 {
+                random_ray(&mut rng, i)
+            } else {
+                let towards = Vec3A::from((rng.vec(2.0) - DVec3::ONE).as_vec3());
+                Ray::new(eye, towards.normalize())
+            };
+            let seen = render.closest_seen(&ray);
+            let found = render.closest(&ray, f32::INFINITY);
+            let brute = brute_closest(&prims, &ray, f32::INFINITY);
+            assert_eq!(
+                seen.map(|(_, h)| h.t.to_bits()),
+                brute.map(|(_, t)| t.to_bits()),
+                "camera ray {i}: {ray:?}"
+            );
+            let bits = |h: Option<(u32, SurfaceHit)>| {
+                h.map(|(id, h)| (id, h.point.to_array(), h.normal.to_array()))
+            };
+            assert_eq!(bits(seen), bits(found), "camera ray {i}");
+            seen_hits += seen.is_some() as usize;
+        }
         for (k, light) in lights.iter().enumerate() {
             let light = Vec3A::from(light.as_vec3());
             for i in 0..3000 {
@@ -618,4 +645,5 @@ fn shadow_rays_through_light_cells_meet_what_brute_force_meets() {
         blocked > 5000 && clear > 5000,
         "{blocked} blocked, {clear} clear"
     );
+    assert!(seen_hits > 2000, "{seen_hits} camera rays hit");
 }

@@ -44,8 +44,12 @@ pub struct DirectionCells {
     cells: Box<[u32]>,
     /// The cells' lists, each padded with the caller's `pad` to a multiple of `GROUP`.
     lists: Box<[u32]>,
-    /// No primitive outside those listed in every cell comes closer to the centre than this.
-    clear: f32,
+    /// No primitive outside those listed in every cell comes closer to the centre than
+    /// `clear` (in `new`); a line passing the centre within `ANGLE·clear` is answered by cell:
+    /// that distance squared.
+    pass2: f32,
+    /// `clear/2`.
+    half_clear: f32,
 }
 
 impl DirectionCells {
@@ -115,7 +119,8 @@ impl DirectionCells {
             centre,
             cells,
             lists: lists.into_boxed_slice(),
-            clear,
+            pass2: (ANGLE * clear) * (ANGLE * clear),
+            half_clear: 0.5 * clear,
         }
     }
 
@@ -134,15 +139,15 @@ impl DirectionCells {
     pub fn candidates(&self, origin: Vec3A, dir: Vec3A, t_max: f32) -> Option<&[u32]> {
         let to_centre = self.centre - origin;
         let len2 = dir.length_squared();
-        let reach = ANGLE * self.clear;
         // |w × d|² = h²·|d|², without the cancellation of |w|² − (w·d)²/|d|².
         let off2 = to_centre.cross(dir).length_squared();
-        if off2.is_nan() || off2 > reach * reach * len2 {
+        if off2.is_nan() || off2 > self.pass2 * len2 {
             return None;
         }
-        let foot = to_centre.dot(dir) / len2;
-        let half = 0.5 * self.clear / len2.sqrt();
-        let cell = match (foot > half, t_max - foot > half) {
+        // In units of |d|²: the foot of the perpendicular, and `clear/2` along the line.
+        let foot = to_centre.dot(dir);
+        let half = self.half_clear * len2.sqrt();
+        let cell = match (foot > half, t_max * len2 - foot > half) {
             (true, false) => self.cell(-dir)?,
             (false, true) => self.cell(dir)?,
             // Only the primitives every cell lists can be met (a cell's own come after them
@@ -151,7 +156,7 @@ impl DirectionCells {
             (true, true) => return None,
         };
         let (at, len) = ((cell >> 4) as usize, (cell & 0xF) as usize);
-        Some(&self.lists[at..at + len])
+        self.lists.get(at..at + len)
     }
 
     /// The entry of the cell direction `d` falls in, or `None` if it lists nothing, or `d` is
@@ -159,21 +164,22 @@ impl DirectionCells {
     #[inline]
     fn cell(&self, d: Vec3A) -> Option<u32> {
         let a = d.abs();
-        let axis = if a.x >= a.y && a.x >= a.z {
-            0
+        // The major axis, and the components along the face's `u` and `v` (`axes`).
+        let (major, u, v, face) = if a.x >= a.y && a.x >= a.z {
+            (d.x, d.y, d.z, 0)
         } else if a.y >= a.z {
-            1
+            (d.y, d.z, d.x, 2)
         } else {
-            2
+            (d.z, d.x, d.y, 4)
         };
-        let (_, u_axis, v_axis) = axes(axis);
-        if a[axis] == 0.0 || !a.is_finite() {
+        if major == 0.0 || !a.is_finite() {
             return None;
         }
-        let face = 2 * axis + (d[axis] < 0.0) as usize;
-        let inv = 1.0 / a[axis];
-        let index = |c: f32| (((c * inv + 1.0) * (0.5 * SIDE as f32)) as usize).min(SIDE - 1);
-        let cell = self.cells[(face * SIDE + index(d[v_axis])) * SIDE + index(d[u_axis])];
+        let face = face + (major < 0.0) as usize;
+        let scale = (0.5 * SIDE as f32) / major.abs();
+        // |u|, |v| ≤ |major|: the index is in 0..=SIDE (SIDE only for the face's far edge).
+        let index = |c: f32| ((c * scale + 0.5 * SIDE as f32) as i32).min(SIDE as i32 - 1) as usize;
+        let cell = self.cells[(face * SIDE + index(v)) * SIDE + index(u)];
         (cell != TOO_MANY).then_some(cell)
     }
 
@@ -294,7 +300,7 @@ mod tests {
             prop_assume!(along.length() > 1e-3);
             let side = off.0.cross(along);
             prop_assume!(side.length() > 1e-6);
-            let pass = if cells.clear.is_finite() { ANGLE * cells.clear } else { 1.0 };
+            let pass = if cells.pass2.is_finite() { cells.pass2.sqrt() } else { 1.0 };
             let from = centre + along * beyond + side * (off.1 * pass / side.length());
             let dir = (centre - from).normalize();
             let t_max = (centre - from).dot(dir);

@@ -12,6 +12,7 @@ use crate::math::{Aabb, Ray};
 use crate::scene::{Material, Scene};
 use crate::shape::{BoxRay, Shape, ShapeHit, Sphere, SphereRay};
 pub use any_hit::Shadow;
+use any_hit::{fours, gather};
 use glam::{Vec3A, Vec4};
 use instance::{Best, Instances};
 use motion::Moving;
@@ -112,9 +113,11 @@ pub struct RenderScene {
     /// What moves during the exposure, if anything does.
     moving: Option<Box<Moving>>,
     bvh: Bvh,
-    /// Per light, in a scene of few primitives that hold still (`lights_take_cells`): which
-    /// of them a shadow ray towards the light may meet, by direction. Empty otherwise.
+    /// Per light, in a scene of few primitives that hold still (`takes_cells`): which of
+    /// them a shadow ray towards the light may meet, by direction. Empty otherwise.
     light_cells: Vec<DirectionCells>,
+    /// The same around the camera's eye (`watch_from`), for camera rays.
+    eye_cells: Option<DirectionCells>,
     /// The first primitive without finite bounds (planes); these are tested on every ray.
     unbounded: u32,
     /// Whether every primitive is a packed sphere: leaves are then tested without looking
@@ -281,30 +284,9 @@ impl RenderScene {
             })
             .fold(0.0f32, f32::max);
         let max_radiance = max_local.max(background.max_element());
-        let light_cells = if lights_take_cells(first_unbounded, moving.is_some()) {
-            let bounds: Vec<Aabb> = (0..first_unbounded as usize)
-                .map(|i| match all_spheres {
-                    true => {
-                        let s = spheres[i];
-                        let r = Vec3A::splat(s.w);
-                        Aabb::new(Vec3A::from(s.truncate()) - r, Vec3A::from(s.truncate()) + r)
-                    }
-                    false => Aabb::new(
-                        bounds_min[i].truncate().into(),
-                        bounds_max[i].truncate().into(),
-                    ),
-                })
-                .collect();
-            lights
-                .iter()
-                // Past the last primitive, every packed array holds NaN: never hit.
-                .map(|l| DirectionCells::new(l.position, &bounds, material.len() as u32))
-                .collect()
-        } else {
-            Vec::new()
-        };
-        let scene = RenderScene {
-            light_cells,
+        let mut scene = RenderScene {
+            light_cells: Vec::new(),
+            eye_cells: None,
             all_spheres,
             material,
             kind,
@@ -324,7 +306,41 @@ impl RenderScene {
             any_transparent,
             max_radiance,
         };
+        scene.light_cells = scene
+            .lights
+            .iter()
+            .filter_map(|l| scene.cells_around(l.position))
+            .collect();
         (scene, dropped)
+    }
+
+    /// Where camera rays start: their candidates are then looked up by direction
+    /// (`closest_seen`) in a scene that takes cells (`takes_cells`).
+    pub fn watch_from(&mut self, eye: Vec3A) {
+        self.eye_cells = self.cells_around(eye);
+    }
+
+    /// Cells around `centre` listing the bounded primitives, if the scene takes them.
+    fn cells_around(&self, centre: Vec3A) -> Option<DirectionCells> {
+        if !takes_cells(self.unbounded, self.moving.is_some()) {
+            return None;
+        }
+        let bounds: Vec<Aabb> = (0..self.unbounded as usize)
+            .map(|i| {
+                if self.all_spheres {
+                    let s = self.spheres[i];
+                    let (c, r) = (Vec3A::from(s.truncate()), Vec3A::splat(s.w));
+                    Aabb::new(c - r, c + r)
+                } else {
+                    Aabb::new(
+                        self.bounds_min[i].truncate().into(),
+                        self.bounds_max[i].truncate().into(),
+                    )
+                }
+            })
+            .collect();
+        // Past the last primitive, every packed array holds NaN: never hit.
+        Some(DirectionCells::new(centre, &bounds, self.len() as u32))
     }
 
     /// Number of primitives.
@@ -489,6 +505,46 @@ impl RenderScene {
         self.surface_of(ray, best?, won.as_ref())
     }
 
+    /// `closest` of a camera ray, from the eye `watch_from` named (or, if it starts
+    /// elsewhere, as `closest` finds it), with no limit.
+    #[inline]
+    pub fn closest_seen(&self, ray: &Ray) -> Option<(u32, SurfaceHit)> {
+        let listed = self
+            .eye_cells
+            .as_ref()
+            .and_then(|cells| cells.candidates(ray.origin, ray.dir, f32::INFINITY));
+        match listed {
+            Some(listed) => self.closest_listed(ray, listed),
+            None => self.closest(ray, f32::INFINITY),
+        }
+    }
+
+    /// `closest` (without limit) among the bounded primitives of `listed` alone
+    /// (`DirectionCells::candidates`, padded to a multiple of four): the others are known to
+    /// lie off the ray, and which of those listed wins is judged as `closest` judges it, by
+    /// distance and number. Not inlined, as `RenderScene::any_listed`.
+    #[inline(never)]
+    fn closest_listed(&self, ray: &Ray, listed: &[u32]) -> Option<(u32, SurfaceHit)> {
+        let mut won = None;
+        let (mut best, mut t_max) = self.closest_unbounded_into(ray, f32::INFINITY, &mut won);
+        let lanes = SphereRay::new(ray);
+        let limit = t_max.next_up();
+        let boxes = (!self.all_spheres).then(|| BoxRay::new(ray));
+        for ids in fours(listed) {
+            let id = |k: usize| ids[k];
+            let Some(boxes) = &boxes else {
+                let spheres = SphereRay::lanes(gather(&self.spheres, ids));
+                t_max = self.closest_in_spheres(&lanes, &spheres, id, 0xF, limit, t_max, &mut best);
+                continue;
+            };
+            let (min, max) = (gather(&self.bounds_min, ids), gather(&self.bounds_max, ids));
+            let c = self.classify_lanes(boxes, min, max, 0xF, limit);
+            let group = (id, c, || gather(&self.spheres, ids));
+            t_max = self.closest_in_four(&lanes, ray, group, limit, t_max, &mut best, &mut won);
+        }
+        self.surface_of(ray, best?, won.as_ref())
+    }
+
     /// All bounded primitives as one leaf, when there are so few that testing them all, four
     /// at a time, costs less than walking the hierarchy to them; `None` otherwise (or when
     /// there are none). In a closed room every ray's box overlaps most of the few leaves
@@ -580,14 +636,14 @@ impl RenderScene {
         let limit = t_max.next_up();
         for start in (first..end).step_by(LANES) {
             let spheres = SphereRay::lanes(self.four_spheres(start));
-            t_max = self.closest_in_spheres(lanes, &spheres, start, end, limit, t_max, best);
+            let live = (1 << (end - start).min(LANES)) - 1;
+            t_max =
+                self.closest_in_spheres(lanes, &spheres, |k| start + k, live, limit, t_max, best);
         }
         t_max
     }
 
-    /// Tests one leaf's primitives (see `closest`); returns the new `t_max`. Of each four,
-    /// only those hit (spheres, boxes) or whose bounds the ray meets (other kinds) are looked
-    /// at, in lane order, which is the order the leaf lists them in.
+    /// Tests one leaf's primitives (see `closest`); returns the new `t_max`.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn closest_in_leaf(
@@ -605,60 +661,87 @@ impl RenderScene {
         // A hit as close as the kept one is found too, to be judged by its number.
         let limit = t_max.next_up();
         for start in (first..end).step_by(LANES) {
-            let c = self.classify(boxes, start, end, limit);
-            let (sphere_hit, sphere_t) = if c.spheres != 0 {
-                lanes.hit4(self.four_spheres(start), limit)
-            } else {
-                (0, Vec4::ZERO)
-            };
-            let mut todo = (sphere_hit & c.spheres) | c.boxes_hit | c.others_near;
-            while todo != 0 {
-                let k = todo.trailing_zeros() as usize;
-                todo &= todo - 1;
-                let i = start + k;
-                let (t, hit) = if c.others_near & (1 << k) != 0 {
-                    let kind = self.kind[i];
-                    if is_moving(kind) {
-                        let h = self
-                            .moving_with(kind, ray, |p| p.hit(ray, t_max.next_up()))
-                            .flatten();
-                        if let Some(h) = h.filter(|h| Best::loses_to(best, t_max, h.t, self.key[i]))
-                        {
-                            t_max = h.t;
-                            *best = Some(Best {
-                                id: i as u32,
-                                t: t_max,
-                                key: self.key[i],
-                                hit: Some(h),
-                            });
-                            *won = self.moving_with(kind, ray, Primitive::clone);
-                        }
-                        continue;
+            let (min, max) = (four(&self.bounds_min, start), four(&self.bounds_max, start));
+            let live = (1 << (end - start).min(LANES)) - 1;
+            let c = self.classify_lanes(boxes, min, max, live, limit);
+            let four_spheres = || self.four_spheres(start);
+            let group = (|k| start + k, c, four_spheres);
+            t_max = self.closest_in_four(lanes, ray, group, limit, t_max, best, won);
+        }
+        t_max
+    }
+
+    /// One group of four primitives of `closest_in_leaf` (or of a cell's list): `id` of each
+    /// lane, their slab tests `c` (`classify_lanes`), and their packed spheres, loaded only if
+    /// some lane is a sphere. Only those hit (spheres, boxes) or whose bounds the ray meets
+    /// (other kinds) are looked at, in lane order. Returns the new `t_max`.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn closest_in_four(
+        &self,
+        lanes: &SphereRay,
+        ray: &Ray,
+        (id, c, four_spheres): (
+            impl Fn(usize) -> usize,
+            Lanes,
+            impl FnOnce() -> [Vec4; LANES],
+        ),
+        limit: f32,
+        mut t_max: f32,
+        best: &mut Option<Best>,
+        won: &mut Option<Primitive>,
+    ) -> f32 {
+        let (sphere_hit, sphere_t) = if c.spheres != 0 {
+            lanes.hit4(four_spheres(), limit)
+        } else {
+            (0, Vec4::ZERO)
+        };
+        let mut todo = (sphere_hit & c.spheres) | c.boxes_hit | c.others_near;
+        while todo != 0 {
+            let k = todo.trailing_zeros() as usize;
+            todo &= todo - 1;
+            let i = id(k);
+            let (t, hit) = if c.others_near & (1 << k) != 0 {
+                let kind = self.kind[i];
+                if is_moving(kind) {
+                    let h = self
+                        .moving_with(kind, ray, |p| p.hit(ray, t_max.next_up()))
+                        .flatten();
+                    if let Some(h) = h.filter(|h| Best::loses_to(best, t_max, h.t, self.key[i])) {
+                        t_max = h.t;
+                        *best = Some(Best {
+                            id: i as u32,
+                            t: t_max,
+                            key: self.key[i],
+                            hit: Some(h),
+                        });
+                        *won = self.moving_with(kind, ray, Primitive::clone);
                     }
-                    if is_use(kind) {
-                        if let Some(inst) = &self.instances {
-                            inst.closest(kind & !USE, ray, &mut t_max, best, won);
-                        }
-                        continue;
-                    }
-                    match self.objects[kind as usize].hit(ray, t_max.next_up()) {
-                        Some(h) => (h.t, Some(h)),
-                        None => continue,
-                    }
-                } else if c.spheres & (1 << k) != 0 {
-                    (sphere_t[k], None)
-                } else {
-                    (c.box_t[k], None)
-                };
-                if Best::loses_to(best, t_max, t, self.key[i]) {
-                    t_max = t;
-                    *best = Some(Best {
-                        id: i as u32,
-                        t,
-                        key: self.key[i],
-                        hit,
-                    });
+                    continue;
                 }
+                if is_use(kind) {
+                    if let Some(inst) = &self.instances {
+                        inst.closest(kind & !USE, ray, &mut t_max, best, won);
+                    }
+                    continue;
+                }
+                match self.objects[kind as usize].hit(ray, t_max.next_up()) {
+                    Some(h) => (h.t, Some(h)),
+                    None => continue,
+                }
+            } else if c.spheres & (1 << k) != 0 {
+                (sphere_t[k], None)
+            } else {
+                (c.box_t[k], None)
+            };
+            if Best::loses_to(best, t_max, t, self.key[i]) {
+                t_max = t;
+                *best = Some(Best {
+                    id: i as u32,
+                    t,
+                    key: self.key[i],
+                    hit,
+                });
             }
         }
         t_max
@@ -733,12 +816,12 @@ fn is_flat(bounded: u32, moving: bool) -> bool {
     bounded > 0 && bounded as usize <= FLAT_MAX && !moving
 }
 
-/// Whether shadow rays in a scene of `bounded` primitives with finite bounds look up their
-/// candidates in `DirectionCells` around each light: in a flat scene (`is_flat`: the cells
-/// follow no moving shape or light) of more than one test of four. One test of four is all a
-/// list could save there; in the hierarchy of a larger scene, a light's cells list too many
-/// primitives to beat its walk (the showcase's 57: 4 % more instructions).
-fn lights_take_cells(bounded: u32, moving: bool) -> bool {
+/// Whether a scene of `bounded` primitives with finite bounds keeps `DirectionCells` around
+/// each light and the eye, for the candidates of shadow and camera rays: in a flat scene
+/// (`is_flat`: the cells follow no moving shape or light) of more than one test of four. One
+/// test of four is all a list could save there; in the hierarchy of a larger scene, a light's
+/// cells list too many primitives to beat its walk (the showcase's 57: 4 % more instructions).
+fn takes_cells(bounded: u32, moving: bool) -> bool {
     is_flat(bounded, moving) && bounded as usize > LANES
 }
 

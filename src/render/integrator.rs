@@ -177,6 +177,14 @@ impl Integrator<'_> {
         }
     }
 
+    /// `trace` of a camera ray (its closest hit found from the eye: `closest_seen`).
+    pub fn trace_camera(&self, ray: &Ray, st: &mut TraceState) -> Vec3A {
+        match self.scene.closest_seen(ray) {
+            Some((prim, hit)) => self.shade(ray, prim, &hit, 0, 1.0, st),
+            None => self.scene.background,
+        }
+    }
+
     /// Radiance along a camera ray and the primitive it hit ([`NO_HIT`] for the background),
     /// which adaptive sampling compares between neighbouring pixels. The uniform path keeps
     /// calling [`Integrator::trace`].
@@ -187,7 +195,7 @@ impl Integrator<'_> {
 
     /// `trace_primary`, and how far along the ray the surface is (`None`: the background).
     pub fn trace_primary_hit(&self, ray: &Ray, st: &mut TraceState) -> (Vec3A, u32, Option<f32>) {
-        match self.scene.closest(ray, f32::INFINITY) {
+        match self.scene.closest_seen(ray) {
             Some((prim, hit)) => (self.shade(ray, prim, &hit, 0, 1.0, st), prim, Some(hit.t)),
             None => (self.scene.background, NO_HIT, None),
         }

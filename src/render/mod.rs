@@ -197,7 +197,8 @@ pub fn render_job(
         .map(|m| Shutter::new(m, camera, width, height));
     let shutter = shutter.as_ref();
     let camera = CameraRays::new(camera, width, height)?;
-    let (scene, dropped) = RenderScene::compile(scene);
+    let (mut scene, dropped) = RenderScene::compile(scene);
+    scene.watch_from(camera.eye());
     let integrator = Integrator {
         scene: &scene,
         max_depth: settings.max_depth,
@@ -287,7 +288,7 @@ pub(super) fn uniform_pixel(
                 s.ray(camera, px, py, sampling::uniform_time(x, y, i as u32, n))
             }
         };
-        sum += integrator.trace(&ray, 0, 1.0, st);
+        sum += integrator.trace_camera(&ray, st);
     }
     Vec3::from(sum * (1.0 / offsets.len() as f32))
 }
@@ -543,7 +544,7 @@ fn render_adaptive(
             None => camera.ray(px, py),
             Some(s) => s.ray(camera, px, py, pattern.time(i)),
         };
-        integrator.trace(&ray, 0, 1.0, st)
+        integrator.trace_camera(&ray, st)
     };
     // What a pixel's samples know of the lights before they trace (`TraceState`).
     let know = |x: usize, y: usize, st: &mut TraceState| {

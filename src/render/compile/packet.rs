@@ -65,8 +65,8 @@ impl RenderScene {
                         t_max[r] = self.closest_in_spheres(
                             &lanes[r],
                             &spheres,
-                            first,
-                            end,
+                            |k| first + k,
+                            (1 << (end - first).min(LANES)) - 1,
                             t.next_up(),
                             t,
                             &mut best[r],
@@ -99,28 +99,27 @@ impl RenderScene {
 }
 
 impl RenderScene {
-    /// One group of `closest_in_sphere_leaf`: the packed spheres from `start` on (those
-    /// before `end`), in lanes, tested up to `limit` (the leaf's first `t_max`, moved up
-    /// one ulp); returns the new `t_max`.
+    /// One group of `closest_in_sphere_leaf` (or of a cell's list): four packed spheres in
+    /// lanes, primitive `id(k)` in lane `k`, of which the lanes `live` count, tested up to
+    /// `limit` (the leaf's first `t_max`, moved up one ulp); returns the new `t_max`.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub(super) fn closest_in_spheres(
         &self,
         lanes: &SphereRay,
         spheres: &[Vec4; LANES],
-        start: usize,
-        end: usize,
+        id: impl Fn(usize) -> usize,
+        live: u32,
         limit: f32,
         mut t_max: f32,
         best: &mut Option<Best>,
     ) -> f32 {
-        let live = (end - start).min(LANES);
         let (mask, t) = lanes.hit_lanes(spheres, limit);
-        let mut mask = mask & ((1 << live) - 1);
+        let mut mask = mask & live;
         while mask != 0 {
             let k = mask.trailing_zeros() as usize;
             mask &= mask - 1;
-            let i = start + k;
+            let i = id(k);
             if Best::loses_to(best, t_max, t[k], self.key[i]) {
                 t_max = t[k];
                 *best = Some(Best {
