@@ -48,8 +48,8 @@ pub struct DirectionCells {
     /// `clear` (in `new`); a line passing the centre within `ANGLE·clear` is answered by cell:
     /// that distance squared.
     pass2: f32,
-    /// `clear/2`.
-    half_clear: f32,
+    /// `(clear/2)²`.
+    half_clear2: f32,
 }
 
 impl DirectionCells {
@@ -120,7 +120,7 @@ impl DirectionCells {
             cells,
             lists: lists.into_boxed_slice(),
             pass2: (ANGLE * clear) * (ANGLE * clear),
-            half_clear: 0.5 * clear,
+            half_clear2: (0.5 * clear) * (0.5 * clear),
         }
     }
 
@@ -144,10 +144,13 @@ impl DirectionCells {
         if off2.is_nan() || off2 > self.pass2 * len2 {
             return None;
         }
-        // In units of |d|²: the foot of the perpendicular, and `clear/2` along the line.
+        // In units of |d|²: the foot of the perpendicular, and how far the segment reaches
+        // past it; each compared with `clear/2` along the line (squared, without a root).
         let foot = to_centre.dot(dir);
-        let half = self.half_clear * len2.sqrt();
-        let cell = match (foot > half, t_max * len2 - foot > half) {
+        let past = t_max * len2 - foot;
+        let half2 = self.half_clear2 * len2;
+        let beyond_half = |x: f32| x > 0.0 && x * x > half2;
+        let cell = match (beyond_half(foot), beyond_half(past)) {
             (true, false) => self.cell(-dir)?,
             (false, true) => self.cell(dir)?,
             // Only the primitives every cell lists can be met (a cell's own come after them
