@@ -786,7 +786,8 @@ impl RenderScene {
         }
     }
 
-    /// Bytes the scene's geometry holds (primitives and hierarchy, not materials or lights).
+    /// Bytes the scene's geometry holds (primitives, hierarchy and direction cells, not
+    /// materials or lights).
     pub fn geometry_bytes(&self) -> usize {
         self.material.capacity() * 4
             + self.kind.capacity() * 4
@@ -800,6 +801,12 @@ impl RenderScene {
                 .as_ref()
                 .map_or(0, |inst| inst.memory_bytes())
             + self.moving.as_ref().map_or(0, |m| m.memory_bytes())
+            + self
+                .light_cells
+                .iter()
+                .chain(&self.eye_cells)
+                .map(DirectionCells::memory_bytes)
+                .sum::<usize>()
     }
 
     /// Top-level uses of prototypes (each stands for all the shapes of its composite).
