@@ -74,7 +74,20 @@ impl DirectionCells {
                 clear = clear.min(d);
             }
         }
-        let mut seen: Vec<Vec<u32>> = vec![near.clone(); 6 * SIDE * SIDE];
+        // Per cell, what it sees so far (up to one past `LIST_MAX`, which marks it as seeing
+        // too much): in place, without a list per cell to allocate.
+        let mut seen = vec![[0u32; LIST_MAX + 1]; 6 * SIDE * SIDE];
+        let mut count = vec![0u8; seen.len()];
+        let mut see = |cell: usize, i: u32| {
+            let n = count[cell] as usize;
+            if n <= LIST_MAX {
+                seen[cell][n] = i;
+                count[cell] += 1;
+            }
+        };
+        for &i in &near {
+            (0..6 * SIDE * SIDE).for_each(|cell| see(cell, i));
+        }
         for (i, b) in bounds.iter().enumerate() {
             if near.contains(&(i as u32)) {
                 continue;
@@ -96,24 +109,24 @@ impl DirectionCells {
                 };
                 for v in vs.clone() {
                     for u in us.clone() {
-                        let list = &mut seen[(face * SIDE + v) * SIDE + u];
-                        if list.len() <= LIST_MAX {
-                            list.push(i as u32);
-                        }
+                        see((face * SIDE + v) * SIDE + u, i as u32);
                     }
                 }
             }
         }
         let mut lists = Vec::new();
         let cells = seen
-            .into_iter()
-            .map(|mut list| {
-                if list.len() > LIST_MAX {
+            .iter()
+            .zip(&count)
+            .map(|(seen, &n)| {
+                let n = n as usize;
+                if n > LIST_MAX {
                     return TOO_MANY;
                 }
-                list.resize(list.len().div_ceil(GROUP) * GROUP, pad);
-                let at = (lists.len() as u32) << 4 | list.len() as u32;
-                lists.extend(list);
+                let padded = n.div_ceil(GROUP) * GROUP;
+                let at = (lists.len() as u32) << 4 | padded as u32;
+                lists.extend_from_slice(&seen[..n]);
+                lists.resize(lists.len() + padded - n, pad);
                 at
             })
             .collect();
