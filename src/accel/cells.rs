@@ -31,7 +31,7 @@ const ANGLE: f32 = MARGIN / 6.0;
 const NEAR_SHARE: f32 = 1e-3;
 /// Most primitives a cell lists (two tests of four); a cell that sees more leaves its rays to
 /// the hierarchy.
-pub const LIST_MAX: usize = 8;
+const LIST_MAX: usize = 8;
 /// Lists are padded to a multiple of this many entries, so that they are tested four at once.
 const GROUP: usize = 4;
 /// `DirectionCells::cells` entry of a cell that lists nothing (it sees too much).
@@ -202,7 +202,8 @@ impl DirectionCells {
     }
 
     /// Share of the cells that list their primitives (the rest leave rays to the hierarchy).
-    pub fn listed_share(&self) -> f32 {
+    #[cfg(test)]
+    fn listed_share(&self) -> f32 {
         self.cells.iter().filter(|&&c| c != TOO_MANY).count() as f32 / self.cells.len() as f32
     }
 

@@ -661,9 +661,7 @@ impl RenderScene {
         // A hit as close as the kept one is found too, to be judged by its number.
         let limit = t_max.next_up();
         for start in (first..end).step_by(LANES) {
-            let (min, max) = (four(&self.bounds_min, start), four(&self.bounds_max, start));
-            let live = (1 << (end - start).min(LANES)) - 1;
-            let c = self.classify_lanes(boxes, min, max, live, limit);
+            let c = self.classify(boxes, start, end, limit);
             let four_spheres = || self.four_spheres(start);
             let group = (|k| start + k, c, four_spheres);
             t_max = self.closest_in_four(lanes, ray, group, limit, t_max, best, won);

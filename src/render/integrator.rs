@@ -177,14 +177,6 @@ impl Integrator<'_> {
         }
     }
 
-    /// `trace` of a camera ray (its closest hit found from the eye: `closest_seen`).
-    pub fn trace_camera(&self, ray: &Ray, st: &mut TraceState) -> Vec3A {
-        match self.scene.closest_seen(ray) {
-            Some((prim, hit)) => self.shade(ray, prim, &hit, 0, 1.0, st),
-            None => self.scene.background,
-        }
-    }
-
     /// Radiance along a camera ray and the primitive it hit ([`NO_HIT`] for the background),
     /// which adaptive sampling compares between neighbouring pixels. The uniform path keeps
     /// calling [`Integrator::trace`].

@@ -288,7 +288,7 @@ pub(super) fn uniform_pixel(
                 s.ray(camera, px, py, sampling::uniform_time(x, y, i as u32, n))
             }
         };
-        sum += integrator.trace_camera(&ray, st);
+        sum += integrator.trace_primary(&ray, st).0;
     }
     Vec3::from(sum * (1.0 / offsets.len() as f32))
 }
@@ -544,7 +544,7 @@ fn render_adaptive(
             None => camera.ray(px, py),
             Some(s) => s.ray(camera, px, py, pattern.time(i)),
         };
-        integrator.trace_camera(&ray, st)
+        integrator.trace_primary(&ray, st).0
     };
     // What a pixel's samples know of the lights before they trace (`TraceState`).
     let know = |x: usize, y: usize, st: &mut TraceState| {

@@ -1,7 +1,7 @@
 //! Any-hit queries of the render scene: whether and what a ray meets before a distance, in
 //! whatever order is cheapest, for shadow rays (`RenderScene::shadow`) and occlusion.
 
-use super::{is_moving, is_use, RenderScene, LANES, USE};
+use super::{is_moving, is_use, Lanes, RenderScene, LANES, USE};
 use crate::math::Ray;
 use crate::shape::{BoxRay, SphereRay};
 use glam::Vec4;
@@ -71,31 +71,19 @@ impl RenderScene {
         let lanes = SphereRay::new(ray);
         let boxes = (!self.all_spheres).then(|| BoxRay::new(ray));
         for ids in fours(listed) {
+            let id = |k: usize| ids[k];
             let Some(boxes) = &boxes else {
                 let mask = lanes.hit4(gather(&self.spheres, ids), t_max).0;
-                if offer_ids(ids, mask, &mut stop) {
+                if offer(id, mask, &mut stop) {
                     return;
                 }
                 continue;
             };
             let (min, max) = (gather(&self.bounds_min, ids), gather(&self.bounds_max, ids));
             let c = self.classify_lanes(boxes, min, max, 0xF, t_max);
-            if offer_ids(ids, c.boxes_hit, &mut stop) {
+            let group = (id, c, || gather(&self.spheres, ids));
+            if self.any_in_four(ray, &lanes, t_max, group, &mut stop) {
                 return;
-            }
-            if c.spheres != 0 {
-                let mask = lanes.hit4(gather(&self.spheres, ids), t_max).0 & c.spheres;
-                if offer_ids(ids, mask, &mut stop) {
-                    return;
-                }
-            }
-            let mut near = c.others_near;
-            while near != 0 {
-                let k = near.trailing_zeros() as usize;
-                near &= near - 1;
-                if self.other_hit(ids[k], ray, t_max).is_some_and(&mut stop) {
-                    return;
-                }
             }
         }
     }
@@ -118,7 +106,7 @@ impl RenderScene {
                 (first..end).step_by(LANES).any(|start| {
                     let live = (end - start).min(LANES);
                     let mask = lanes.hit4(self.four_spheres(start), t_max).0 & ((1 << live) - 1);
-                    offer(start, mask, &mut stop)
+                    offer(|k| start + k, mask, &mut stop)
                 })
             };
             match flat {
@@ -129,33 +117,51 @@ impl RenderScene {
         }
         let boxes = BoxRay::new(ray);
         let leaf = |leaf: &[u32]| {
-            let first = leaf[0] as usize;
-            for start in (first..first + leaf.len()).step_by(LANES) {
-                let c = self.classify(&boxes, start, first + leaf.len(), t_max);
-                if offer(start, c.boxes_hit, &mut stop) {
-                    return true;
-                }
-                if c.spheres != 0 {
-                    let mask = lanes.hit4(self.four_spheres(start), t_max).0 & c.spheres;
-                    if offer(start, mask, &mut stop) {
-                        return true;
-                    }
-                }
-                let mut near = c.others_near;
-                while near != 0 {
-                    let k = near.trailing_zeros() as usize;
-                    near &= near - 1;
-                    if self.other_hit(start + k, ray, t_max).is_some_and(&mut stop) {
-                        return true;
-                    }
-                }
-            }
-            false
+            let (first, end) = (leaf[0] as usize, leaf[0] as usize + leaf.len());
+            (first..end).step_by(LANES).any(|start| {
+                let c = self.classify(&boxes, start, end, t_max);
+                let group = (|k| start + k, c, || self.four_spheres(start));
+                self.any_in_four(ray, &lanes, t_max, group, &mut stop)
+            })
         };
         match flat {
             Some(all) => _ = { leaf }(all),
             None => _ = self.bvh.any_leaves(ray, t_max, leaf),
         }
+    }
+
+    /// One group of four primitives of `any_hit` (or of a cell's list): `id` of each lane,
+    /// their slab tests `c` (`classify_lanes`), and their packed spheres, loaded only if some
+    /// lane is a sphere. Offers those hit to `stop`: boxes, then spheres, then the other
+    /// kinds whose bounds the ray meets; true when `stop` did.
+    #[inline(always)]
+    fn any_in_four(
+        &self,
+        ray: &Ray,
+        lanes: &SphereRay,
+        t_max: f32,
+        (id, c, four_spheres): (
+            impl Fn(usize) -> usize,
+            Lanes,
+            impl FnOnce() -> [Vec4; LANES],
+        ),
+        stop: &mut impl FnMut(u32) -> bool,
+    ) -> bool {
+        if offer(&id, c.boxes_hit, stop) {
+            return true;
+        }
+        if c.spheres != 0 && offer(&id, lanes.hit4(four_spheres(), t_max).0 & c.spheres, stop) {
+            return true;
+        }
+        let mut near = c.others_near;
+        while near != 0 {
+            let k = near.trailing_zeros() as usize;
+            near &= near - 1;
+            if self.other_hit(id(k), ray, t_max).is_some_and(&mut *stop) {
+                return true;
+            }
+        }
+        false
     }
 
     /// Primitive `i`, of a kind whose bounds do not give its hit, as `any_hit` offers it if
@@ -205,28 +211,14 @@ pub enum Shadow {
     Walk,
 }
 
-/// Offers the lanes set in `mask` of the four primitives from `start` on to `stop`, in
-/// lane order, until it returns true (then true).
+/// Offers the lanes set in `mask` of four primitives (`id` of each lane) to `stop`, in lane
+/// order, until it returns true (then true).
 #[inline(always)]
-fn offer(start: usize, mut mask: u32, stop: &mut impl FnMut(u32) -> bool) -> bool {
+fn offer(id: impl Fn(usize) -> usize, mut mask: u32, stop: &mut impl FnMut(u32) -> bool) -> bool {
     while mask != 0 {
         let k = mask.trailing_zeros() as usize;
         mask &= mask - 1;
-        if stop((start + k) as u32) {
-            return true;
-        }
-    }
-    false
-}
-
-/// Offers the lanes set in `mask` of the four primitives `ids` to `stop`, in lane order,
-/// until it returns true (then true).
-#[inline(always)]
-fn offer_ids(ids: [usize; LANES], mut mask: u32, stop: &mut impl FnMut(u32) -> bool) -> bool {
-    while mask != 0 {
-        let k = mask.trailing_zeros() as usize;
-        mask &= mask - 1;
-        if stop(ids[k] as u32) {
+        if stop(id(k) as u32) {
             return true;
         }
     }
