@@ -556,37 +556,13 @@ fn rays_through_direction_cells_meet_what_brute_force_meets() {
         world_boxes(&mut rng, 10),
     ];
     for (instances, transforms) in scenes {
-        let prims: Vec<Primitive> = instances
-            .iter()
-            .map(|i| Primitive::new(&i.geometry, &transforms[i.transform as usize], 0).unwrap())
-            .collect();
         let lights: Vec<DVec3> = (0..4)
             .map(|k| match k {
                 0 => DVec3::new(200.0, 300.0, -150.0),
                 _ => rng.vec(60.0) - DVec3::splat(5.0),
             })
             .collect();
-        let scene = Scene {
-            materials: vec![Material::phong("m", Vec3::ONE, Vec3::ONE, Vec3::ONE, 1.0)],
-            instances: instances
-                .into_iter()
-                .map(|mut i| {
-                    i.material = 0;
-                    i
-                })
-                .collect::<Vec<_>>()
-                .into(),
-            transforms,
-            lights: lights
-                .iter()
-                .map(|&position| anim::scene::Light {
-                    name: "l".into(),
-                    position,
-                    intensity: Vec3::ONE,
-                })
-                .collect(),
-            ..Scene::default()
-        };
+        let (scene, prims) = lit_scene(instances, transforms, &lights);
         let (mut render, dropped) = RenderScene::compile(&scene);
         assert!(dropped.is_empty());
         // Camera rays from an eye with cells around it (and rays from elsewhere): the same
@@ -601,19 +577,7 @@ fn rays_through_direction_cells_meet_what_brute_force_meets() {
                 let towards = Vec3A::from((rng.vec(2.0) - DVec3::ONE).as_vec3());
                 Ray::new(eye, towards.normalize())
             };
-            let seen = render.closest_seen(&ray);
-            let found = render.closest(&ray, f32::INFINITY);
-            let brute = brute_closest(&prims, &ray, f32::INFINITY);
-            assert_eq!(
-                seen.map(|(_, h)| h.t.to_bits()),
-                brute.map(|(_, t)| t.to_bits()),
-                "camera ray {i}: {ray:?}"
-            );
-            let bits = |h: Option<(u32, SurfaceHit)>| {
-                h.map(|(id, h)| (id, h.point.to_array(), h.normal.to_array()))
-            };
-            assert_eq!(bits(seen), bits(found), "camera ray {i}");
-            seen_hits += seen.is_some() as usize;
+            seen_hits += check_seen(&render, &prims, &ray, i) as usize;
         }
         for (k, light) in lights.iter().enumerate() {
             let light = Vec3A::from(light.as_vec3());
@@ -621,23 +585,12 @@ fn rays_through_direction_cells_meet_what_brute_force_meets() {
                 let (ray, t_limit) = if i % 5 == 4 {
                     (random_ray(&mut rng, i), t_limit_of(i))
                 } else {
-                    let from = Vec3A::from((rng.vec(80.0) - DVec3::splat(15.0)).as_vec3());
-                    let dir = (light - from).normalize();
-                    let lift = Vec3A::from((rng.vec(2e-3) - DVec3::splat(1e-3)).as_vec3());
-                    let origin = from + lift * (i % 3) as f32;
-                    (Ray::new(origin, dir), (light - origin).dot(dir))
+                    shadow_ray(&mut rng, light, i)
                 };
-                let brute = brute_closest(&prims, &ray, t_limit).is_some();
-                let found = render.shadow(&ray, t_limit, k);
-                match found {
-                    Shadow::Clear => clear += 1,
-                    Shadow::Blocked(id) => {
-                        assert!(render.hit(id, &ray, t_limit).is_some(), "ray {i}");
-                        blocked += 1;
-                    }
-                    other => panic!("opaque shapes only, yet {other:?}"),
+                match check_shadow(&render, &prims, &ray, t_limit, k) {
+                    true => blocked += 1,
+                    false => clear += 1,
                 }
-                assert_eq!(found != Shadow::Clear, brute, "light {k}, ray {i}: {ray:?}");
             }
         }
     }
@@ -646,4 +599,154 @@ fn rays_through_direction_cells_meet_what_brute_force_meets() {
         "{blocked} blocked, {clear} clear"
     );
     assert!(seen_hits > 2000, "{seen_hits} camera rays hit");
+}
+
+/// The scene of `instances` (one material) lit by point lights at `lights`, and its shapes as
+/// primitives for brute force.
+fn lit_scene(
+    instances: Vec<Instance>,
+    transforms: Vec<Transform>,
+    lights: &[DVec3],
+) -> (Scene, Vec<Primitive>) {
+    let prims = instances
+        .iter()
+        .map(|i| Primitive::new(&i.geometry, &transforms[i.transform as usize], 0).unwrap())
+        .collect();
+    let scene = Scene {
+        materials: vec![Material::phong("m", Vec3::ONE, Vec3::ONE, Vec3::ONE, 1.0)],
+        instances: instances
+            .into_iter()
+            .map(|mut i| {
+                i.material = 0;
+                i
+            })
+            .collect::<Vec<_>>()
+            .into(),
+        transforms,
+        lights: lights
+            .iter()
+            .map(|&position| anim::scene::Light {
+                name: "l".into(),
+                position,
+                intensity: Vec3::ONE,
+            })
+            .collect(),
+        ..Scene::default()
+    };
+    (scene, prims)
+}
+
+/// `closest_seen` of a camera ray against `closest` (to the bit) and brute force (the
+/// distance); whether it hit.
+fn check_seen(render: &RenderScene, prims: &[Primitive], ray: &Ray, i: usize) -> bool {
+    let seen = render.closest_seen(ray);
+    let found = render.closest(ray, f32::INFINITY);
+    let brute = brute_closest(prims, ray, f32::INFINITY);
+    assert_eq!(
+        seen.map(|(_, h)| h.t.to_bits()),
+        brute.map(|(_, t)| t.to_bits()),
+        "camera ray {i}: {ray:?}"
+    );
+    let bits = |h: Option<(u32, SurfaceHit)>| {
+        h.map(|(id, h)| (id, h.point.to_array(), h.normal.to_array()))
+    };
+    assert_eq!(bits(seen), bits(found), "camera ray {i}");
+    seen.is_some()
+}
+
+/// A ray from a random point of the scenes' region towards `light`, its start lifted off at
+/// random by up to 10⁻³ (as `SurfaceHit::spawn_ray` moves it) for two rays in three, and its
+/// length to the light.
+fn shadow_ray(rng: &mut Rng, light: Vec3A, i: usize) -> (Ray, f32) {
+    let from = Vec3A::from((rng.vec(80.0) - DVec3::splat(15.0)).as_vec3());
+    let dir = (light - from).normalize();
+    let lift = Vec3A::from((rng.vec(2e-3) - DVec3::splat(1e-3)).as_vec3());
+    let origin = from + lift * (i % 3) as f32;
+    (Ray::new(origin, dir), (light - origin).dot(dir))
+}
+
+/// `shadow` of a ray towards light `k` against brute force (opaque shapes only); whether it
+/// is blocked.
+fn check_shadow(
+    render: &RenderScene,
+    prims: &[Primitive],
+    ray: &Ray,
+    t_limit: f32,
+    k: usize,
+) -> bool {
+    let brute = brute_closest(prims, ray, t_limit).is_some();
+    let found = render.shadow(ray, t_limit, k);
+    match found {
+        Shadow::Clear => {}
+        Shadow::Blocked(id) => assert!(render.hit(id, ray, t_limit).is_some(), "{ray:?}"),
+        other => panic!("opaque shapes only, yet {other:?}"),
+    }
+    assert_eq!(found != Shadow::Clear, brute, "light {k}: {ray:?}");
+    brute
+}
+
+/// Image tiles (`RenderScene::watch_image`): in scenes larger than a flat one (mixed kinds
+/// with a plane, world boxes with rooms around the eye, world spheres alone), camera rays
+/// through random points of the image (and a few beyond its edges, or from elsewhere) get
+/// `closest`'s hit to the bit, and brute force's distance; shadow rays towards lights far
+/// off, among the shapes and inside the rooms, lifted off their start as `spawn_ray` does,
+/// are blocked exactly when brute force finds a hit before the light.
+#[test]
+fn rays_through_image_tiles_meet_what_brute_force_meets() {
+    use anim::render::camera::CameraRays;
+    use anim::scene::Camera;
+    let mut rng = Rng(0xD1B54A32D192ED03);
+    let (mut blocked, mut clear, mut seen_hits) = (0, 0, 0);
+    let (mixed, mixed_transforms) = mixed_instances(&mut rng, 60);
+    let spheres = instances_only(mixed.clone(), &mixed_transforms, true);
+    let scenes = [
+        (mixed, mixed_transforms.clone()),
+        world_boxes(&mut rng, 40),
+        (spheres, mixed_transforms),
+    ];
+    for (instances, transforms) in scenes {
+        let lights: Vec<DVec3> = (0..4)
+            .map(|k| match k {
+                0 => DVec3::new(200.0, 300.0, -150.0),
+                1 => DVec3::new(-90.0, 20.0, 25.0),
+                _ => rng.vec(60.0) - DVec3::splat(5.0),
+            })
+            .collect();
+        let (scene, prims) = lit_scene(instances, transforms, &lights);
+        let (mut render, dropped) = RenderScene::compile(&scene);
+        assert!(dropped.is_empty());
+        let mut camera = Camera::default_with_fov("c", 40.0 + 60.0 * rng.next());
+        camera.eye = DVec3::new(25.0, 25.0, 110.0) + rng.vec(10.0);
+        camera.dir = DVec3::splat(25.0) - camera.eye + rng.vec(20.0);
+        let (width, height) = (96, 54);
+        let rays = CameraRays::new(&camera, width, height).unwrap();
+        render.watch_image(rays.view(), (width, height), u64::MAX);
+        for i in 0..4000 {
+            let (x, y) = (
+                rng.next() as f32 * 100.0 - 2.0,
+                rng.next() as f32 * 58.0 - 2.0,
+            );
+            let ray = if i % 9 == 8 {
+                random_ray(&mut rng, i)
+            } else {
+                rays.ray(x, y)
+            };
+            seen_hits += check_seen(&render, &prims, &ray, i) as usize;
+        }
+        for (k, light) in lights.iter().enumerate() {
+            let light = Vec3A::from(light.as_vec3());
+            for i in 0..4000 {
+                let (ray, t_limit) = shadow_ray(&mut rng, light, i);
+                match check_shadow(&render, &prims, &ray, t_limit, k) {
+                    true => blocked += 1,
+                    false => clear += 1,
+                }
+            }
+        }
+    }
+    assert!(
+        blocked > 5000 && clear > 5000,
+        "{blocked} blocked, {clear} clear"
+    );
+    assert!(seen_hits > 3000, "{seen_hits} camera rays hit");
 }

@@ -272,23 +272,9 @@ mod tests {
         list.is_none_or(|l| l.contains(&(i as u32)))
     }
 
-    /// Whether the segment meets the box (closed), by clipping its parameter range.
+    /// Whether the segment meets the box (closed).
     fn meets(b: &Aabb, origin: Vec3A, dir: Vec3A, t_max: f32) -> bool {
-        let (mut t0, mut t1) = (0.0f64, t_max as f64);
-        for k in 0..3 {
-            let (o, d) = (origin[k] as f64, dir[k] as f64);
-            let (lo, hi) = (b.min[k] as f64, b.max[k] as f64);
-            if d == 0.0 {
-                if o < lo || o > hi {
-                    return false;
-                }
-                continue;
-            }
-            let (a, c) = ((lo - o) / d, (hi - o) / d);
-            t0 = t0.max(a.min(c));
-            t1 = t1.min(a.max(c));
-        }
-        t0 <= t1
+        super::super::segment_entry(b, origin, dir, t_max as f64).is_some()
     }
 
     proptest! {

@@ -1,19 +1,15 @@
 //! Primary rays: pinhole camera with a horizontal field of view, rays through sub-pixel
 //! positions, row 0 at the top of the image.
 
+use crate::accel::ImageView;
 use crate::math::Ray;
 use crate::scene::Camera;
 use glam::{DVec3, Vec3A};
 
 #[derive(Clone, Debug)]
 pub struct CameraRays {
-    eye: Vec3A,
-    /// Unit view direction times the image-plane distance `(w/2)/tan(fov/2)`, in pixels.
-    forward: Vec3A,
-    right: Vec3A,
-    up: Vec3A,
-    half_w: f32,
-    half_h: f32,
+    /// Its image-plane distance is `(w/2)/tan(fov/2)` pixels.
+    view: ImageView,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -36,63 +32,61 @@ impl CameraRays {
         let dist = (width as f64 / 2.0) / (cam.fov_x_deg.to_radians() / 2.0).tan();
         let v = |x: DVec3| Vec3A::from(x.as_vec3());
         Ok(CameraRays {
-            eye: v(cam.eye),
-            forward: v(d * dist),
-            right: v(r),
-            up: v(u),
-            half_w: width as f32 / 2.0,
-            half_h: height as f32 / 2.0,
+            view: ImageView {
+                eye: v(cam.eye),
+                forward: v(d * dist),
+                right: v(r),
+                up: v(u),
+                half_w: width as f32 / 2.0,
+                half_h: height as f32 / 2.0,
+            },
         })
     }
 
     /// Where the rays start.
     pub fn eye(&self) -> Vec3A {
-        self.eye
+        self.view.eye
+    }
+
+    /// The image the rays pass through.
+    pub fn view(&self) -> ImageView {
+        self.view
     }
 
     /// World units per pixel at the depth of `p`: a move of the eye by δ across the view
     /// shifts `p`'s image by δ over this (negative: `p` is behind the eye).
     pub fn world_per_pixel(&self, p: Vec3A) -> f32 {
-        (p - self.eye).dot(self.forward) / self.forward.length_squared()
+        let v = &self.view;
+        (p - v.eye).dot(v.forward) / v.forward.length_squared()
     }
 
     /// How much a move of the eye along the view shifts an image point at most, against the
     /// same move across it, for points within `margin` pixels beyond the image's edges.
     pub fn reach(&self, margin: f32) -> f32 {
-        1.0 + (self.half_w.hypot(self.half_h) + margin) / self.forward.length()
+        let v = &self.view;
+        1.0 + (v.half_w.hypot(v.half_h) + margin) / v.forward.length()
     }
 
     /// Whether `other` looks the same way through the same image plane (its eye aside).
     pub fn same_view(&self, other: &CameraRays) -> bool {
-        (self.forward, self.right, self.up, self.half_w, self.half_h)
-            == (
-                other.forward,
-                other.right,
-                other.up,
-                other.half_w,
-                other.half_h,
-            )
+        ImageView {
+            eye: other.view.eye,
+            ..self.view
+        } == other.view
     }
 
     /// The image position (pixels from the top-left corner) at which `p` is seen, if it lies
     /// in front of the eye: the inverse of [`CameraRays::ray`].
     pub fn project(&self, p: Vec3A) -> Option<(f32, f32)> {
-        let d = p - self.eye;
-        let s = d.dot(self.forward) / self.forward.length_squared();
-        if s.is_nan() || s <= 0.0 {
-            return None;
-        }
-        Some((
-            self.half_w + d.dot(self.right) / s,
-            self.half_h - d.dot(self.up) / s,
-        ))
+        self.view.pixel_of(p - self.view.eye)
     }
 
     /// Ray through image position (`x`, `y`) in pixels from the top-left corner.
     #[inline]
     pub fn ray(&self, x: f32, y: f32) -> Ray {
-        let dir = self.forward + self.right * (x - self.half_w) + self.up * (self.half_h - y);
-        Ray::new(self.eye, dir.normalize())
+        let v = &self.view;
+        let dir = v.forward + v.right * (x - v.half_w) + v.up * (v.half_h - y);
+        Ray::new(v.eye, dir.normalize())
     }
 }
 

@@ -5,14 +5,14 @@ mod any_hit;
 mod instance;
 pub mod motion;
 mod packet;
+mod seen;
 
 use super::primitive::{Primitive, SurfaceHit};
-use crate::accel::{Bvh, DirectionCells};
-use crate::math::{Aabb, Ray};
+use crate::accel::{Bvh, DirectionCells, ImageTiles};
+use crate::math::Ray;
 use crate::scene::{Material, Scene};
 use crate::shape::{BoxRay, Shape, ShapeHit, Sphere, SphereRay};
 pub use any_hit::Shadow;
-use any_hit::{fours, gather};
 use glam::{Vec3A, Vec4};
 use instance::{Best, Instances};
 use motion::Moving;
@@ -116,8 +116,15 @@ pub struct RenderScene {
     /// Per light, in a scene of few primitives that hold still (`takes_cells`): which of
     /// them a shadow ray towards the light may meet, by direction. Empty otherwise.
     light_cells: Vec<DirectionCells>,
+    /// Per light, in a larger scene that holds still: which primitives a shadow ray towards
+    /// the light may meet, by where the light sees its start (`ImageTiles::around`). Empty
+    /// otherwise; `None` for a light no image around it serves.
+    light_tiles: Vec<Option<ImageTiles>>,
     /// The same around the camera's eye (`watch_from`), for camera rays.
     eye_cells: Option<DirectionCells>,
+    /// In a larger scene that holds still, which primitives each part of the camera's image
+    /// may show (`watch_image`), for camera rays.
+    eye_tiles: Option<ImageTiles>,
     /// The first primitive without finite bounds (planes); these are tested on every ray.
     unbounded: u32,
     /// Whether every primitive is a packed sphere: leaves are then tested without looking
@@ -286,7 +293,9 @@ impl RenderScene {
         let max_radiance = max_local.max(background.max_element());
         let mut scene = RenderScene {
             light_cells: Vec::new(),
+            light_tiles: Vec::new(),
             eye_cells: None,
+            eye_tiles: None,
             all_spheres,
             material,
             kind,
@@ -312,35 +321,6 @@ impl RenderScene {
             .filter_map(|l| scene.cells_around(l.position))
             .collect();
         (scene, dropped)
-    }
-
-    /// Where camera rays start: their candidates are then looked up by direction
-    /// (`closest_seen`) in a scene that takes cells (`takes_cells`).
-    pub fn watch_from(&mut self, eye: Vec3A) {
-        self.eye_cells = self.cells_around(eye);
-    }
-
-    /// Cells around `centre` listing the bounded primitives, if the scene takes them.
-    fn cells_around(&self, centre: Vec3A) -> Option<DirectionCells> {
-        if !takes_cells(self.unbounded, self.moving.is_some()) {
-            return None;
-        }
-        let bounds: Vec<Aabb> = (0..self.unbounded as usize)
-            .map(|i| {
-                if self.all_spheres {
-                    let s = self.spheres[i];
-                    let (c, r) = (Vec3A::from(s.truncate()), Vec3A::splat(s.w));
-                    Aabb::new(c - r, c + r)
-                } else {
-                    Aabb::new(
-                        self.bounds_min[i].truncate().into(),
-                        self.bounds_max[i].truncate().into(),
-                    )
-                }
-            })
-            .collect();
-        // Past the last primitive, every packed array holds NaN: never hit.
-        Some(DirectionCells::new(centre, &bounds, self.len() as u32))
     }
 
     /// Number of primitives.
@@ -501,46 +481,6 @@ impl RenderScene {
                 Some(all) => _ = leaf(all, t_best),
                 None => _ = self.bvh.closest_leaves(ray, t_best, leaf),
             }
-        }
-        self.surface_of(ray, best?, won.as_ref())
-    }
-
-    /// `closest` of a camera ray, from the eye `watch_from` named (or, if it starts
-    /// elsewhere, as `closest` finds it), with no limit.
-    #[inline]
-    pub fn closest_seen(&self, ray: &Ray) -> Option<(u32, SurfaceHit)> {
-        let listed = self
-            .eye_cells
-            .as_ref()
-            .and_then(|cells| cells.candidates(ray.origin, ray.dir, f32::INFINITY));
-        match listed {
-            Some(listed) => self.closest_listed(ray, listed),
-            None => self.closest(ray, f32::INFINITY),
-        }
-    }
-
-    /// `closest` (without limit) among the bounded primitives of `listed` alone
-    /// (`DirectionCells::candidates`, padded to a multiple of four): the others are known to
-    /// lie off the ray, and which of those listed wins is judged as `closest` judges it, by
-    /// distance and number. Not inlined, as `RenderScene::any_listed`.
-    #[inline(never)]
-    fn closest_listed(&self, ray: &Ray, listed: &[u32]) -> Option<(u32, SurfaceHit)> {
-        let mut won = None;
-        let (mut best, mut t_max) = self.closest_unbounded_into(ray, f32::INFINITY, &mut won);
-        let lanes = SphereRay::new(ray);
-        let limit = t_max.next_up();
-        let boxes = (!self.all_spheres).then(|| BoxRay::new(ray));
-        for ids in fours(listed) {
-            let id = |k: usize| ids[k];
-            let Some(boxes) = &boxes else {
-                let spheres = SphereRay::lanes(gather(&self.spheres, ids));
-                t_max = self.closest_in_spheres(&lanes, &spheres, id, 0xF, limit, t_max, &mut best);
-                continue;
-            };
-            let (min, max) = (gather(&self.bounds_min, ids), gather(&self.bounds_max, ids));
-            let c = self.classify_lanes(boxes, min, max, 0xF, limit);
-            let group = (id, c, || gather(&self.spheres, ids));
-            t_max = self.closest_in_four(&lanes, ray, group, limit, t_max, &mut best, &mut won);
         }
         self.surface_of(ray, best?, won.as_ref())
     }
@@ -804,6 +744,13 @@ impl RenderScene {
                 .iter()
                 .chain(&self.eye_cells)
                 .map(DirectionCells::memory_bytes)
+                .sum::<usize>()
+            + self
+                .light_tiles
+                .iter()
+                .chain([&self.eye_tiles])
+                .flatten()
+                .map(ImageTiles::memory_bytes)
                 .sum::<usize>()
     }
 

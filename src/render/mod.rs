@@ -104,6 +104,14 @@ pub enum Sampling {
 }
 
 impl Sampling {
+    /// The fewest samples any pixel takes.
+    pub fn least_spp(&self) -> u32 {
+        match *self {
+            Sampling::Uniform(n) => n,
+            Sampling::Adaptive { .. } => 1,
+        }
+    }
+
     /// The most samples any pixel may take.
     pub fn max_spp(&self) -> u32 {
         match *self {
@@ -199,11 +207,16 @@ pub fn render_job(
     let camera = CameraRays::new(camera, width, height)?;
     let (mut scene, dropped) = RenderScene::compile(scene);
     scene.watch_from(camera.eye());
+    let sampling = settings.sampling(job);
+    if shutter.is_none() {
+        let camera_rays = u64::from(width) * u64::from(height) * u64::from(sampling.least_spp());
+        scene.watch_image(camera.view(), (width, height), camera_rays);
+    }
     let integrator = Integrator {
         scene: &scene,
         max_depth: settings.max_depth,
     };
-    let (pixels, counts) = match settings.sampling(job) {
+    let (pixels, counts) = match sampling {
         Sampling::Uniform(spp) => {
             render_uniform(&camera, shutter, &integrator, width, height, spp, on_pixels)
         }

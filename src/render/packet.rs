@@ -35,7 +35,7 @@ fn trace_primaries<const N: usize>(
     st: &mut TraceState,
     not_clear: &mut [u32; N],
 ) -> [(Vec3A, u32); N] {
-    let hits = integrator.scene.closest_packet(rays, f32::INFINITY);
+    let hits = integrator.scene.closest_seen_packet(rays);
     let mut out = [(integrator.scene.background, NO_HIT); N];
     for (r, hit) in hits.iter().enumerate() {
         st.not_clear = 0;

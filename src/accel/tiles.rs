@@ -1,0 +1,517 @@
+//! Image tiles: which primitives a ray from (or to) a point may meet, looked up by where it
+//! crosses an image seen from that point. For the camera this is the vista buffer of classic
+//! ray tracers: every primitive's bounds are projected onto the image once, each tile of
+//! `TILE`×`TILE` pixels lists the primitives whose footprints cover it, nearest first, and a
+//! camera ray tests its tile's list only until the next entry lies farther than its closest
+//! hit so far, walking no hierarchy. Around a light, an image that takes in the whole scene
+//! does the same for shadow rays (`ImageTiles::around`): a segment ending at the light is seen
+//! from it as one point, and only the entries nearer to the light than the segment's far end
+//! can lie on it.
+
+use crate::math::Aabb;
+use glam::Vec3A;
+
+/// Pixels per side of a tile: the blocks camera rays are traced in.
+const TILE: usize = 4;
+/// Widening of every footprint, in pixels. Round-off in projecting a box's corners and in
+/// placing a ray on the image is thousandths of a pixel (single precision, offsets of
+/// thousands of pixels), and a hit test that counts a grazing ray as a hit is off by less.
+const MARGIN: f32 = 1.0;
+/// Share taken off a box's distance from the eye to bound the distance of any hit in it from
+/// below: the box holds its primitive, and a computed hit's distance is off by far less.
+const NEAR_SLACK: f32 = 1e-3;
+/// Most primitives reaching the plane through the eye (whose footprints are unbounded, so
+/// that every tile lists them); with more, tiles are not kept and camera rays walk the
+/// hierarchy.
+const AROUND_MAX: usize = 16;
+/// Most entries the tiles hold: this many per primitive, and as many again per tile; with
+/// more, tiles are not kept (a scene seen from inside a dense cloud).
+const ENTRIES_PER_PRIMITIVE: usize = 8;
+const ENTRIES_PER_TILE: usize = 16;
+/// Lists are padded to a multiple of this many entries, so that they are tested four at once.
+const GROUP: usize = 4;
+/// Tiles of an image around a light, per primitive: footprints of a tile or two leave most
+/// tiles a few entries.
+const TILES_PER_PRIMITIVE: usize = 2;
+/// Most pixels along a side of an image around a light (1 MiB of tile starts).
+const AROUND_SIDE_MAX: usize = 2048;
+/// Widest half-angle an image around a light may take in (its tangent): wider, the pixels at
+/// its edges stretch, and a scene that wraps round the light is left to the hierarchy.
+const AROUND_TAN_MAX: f32 = 2.0;
+
+/// A pinhole camera's image: where a point in front of the eye is seen, in pixels from the
+/// image's top-left corner.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImageView {
+    pub eye: Vec3A,
+    /// Unit view direction times the image-plane distance, in pixels.
+    pub forward: Vec3A,
+    /// Unit vectors along the image's rows (rightwards) and columns (upwards).
+    pub right: Vec3A,
+    pub up: Vec3A,
+    pub half_w: f32,
+    pub half_h: f32,
+}
+
+impl ImageView {
+    /// Where the ray from the eye along `d` (of any length) crosses the image plane, if it
+    /// runs forwards: the image position of every point `eye + s·d`, `s > 0`.
+    #[inline]
+    pub fn pixel_of(&self, d: Vec3A) -> Option<(f32, f32)> {
+        let s = self.depth(d);
+        if s.is_nan() || s <= 0.0 {
+            return None;
+        }
+        Some((
+            self.half_w + d.dot(self.right) / s,
+            self.half_h - d.dot(self.up) / s,
+        ))
+    }
+
+    /// Depth of the point `eye + d` in image-plane distances (positive in front of the eye).
+    #[inline]
+    fn depth(&self, d: Vec3A) -> f32 {
+        d.dot(self.forward) / self.forward.length_squared()
+    }
+
+    /// A square image `side` pixels wide, from `eye` towards the centre of `bounds`, that takes
+    /// in all of it; `None` if no image narrower than `AROUND_TAN_MAX` does.
+    fn around(eye: Vec3A, bounds: &Aabb, side: usize) -> Option<ImageView> {
+        let ahead = (bounds.centroid() - eye).try_normalize()?;
+        let right = ahead.any_orthonormal_vector();
+        let up = right.cross(ahead);
+        let mut widest = 0.0f32;
+        for k in 0..8 {
+            let d = corner(bounds, k) - eye;
+            let s = d.dot(ahead);
+            let off = d.dot(right).abs().max(d.dot(up).abs());
+            // Also rejects a box whose corners are not numbers.
+            if !(s > 0.0 && off <= AROUND_TAN_MAX * s) {
+                return None;
+            }
+            widest = widest.max(off / s);
+        }
+        let half = side as f32 / 2.0;
+        Some(ImageView {
+            eye,
+            forward: ahead * (half / widest.max(1e-3)),
+            right,
+            up,
+            half_w: half,
+            half_h: half,
+        })
+    }
+}
+
+/// A view's image-plane coordinates of points, in one product per axis (for the eight
+/// corners of a box at a time).
+struct Projector {
+    eye: Vec3A,
+    /// Per world axis, what a unit step along it adds to a point's offset along the image's
+    /// rows, its offset along its columns (upwards), and its depth (as `ImageView::depth`).
+    steps: [Vec3A; 3],
+}
+
+impl Projector {
+    fn new(view: &ImageView) -> Projector {
+        let depth = view.forward / view.forward.length_squared();
+        let step = |a: usize| Vec3A::new(view.right[a], view.up[a], depth[a]);
+        Projector {
+            eye: view.eye,
+            steps: [step(0), step(1), step(2)],
+        }
+    }
+
+    /// Each corner of `b` (numbered as `corner`) as its offsets along the image's rows and
+    /// columns times its depth, and its depth: `x/z` and `y/z` place it on the image.
+    fn corners(&self, b: &Aabb) -> [Vec3A; 8] {
+        let d = b.min - self.eye;
+        let e = b.max - b.min;
+        let [sx, sy, sz] = self.steps;
+        let base = sx * d.x + sy * d.y + sz * d.z;
+        let (ex, ey, ez) = (sx * e.x, sy * e.y, sz * e.z);
+        std::array::from_fn(|k| {
+            let pick = |axis: usize, step: Vec3A| {
+                if k >> axis & 1 == 0 {
+                    Vec3A::ZERO
+                } else {
+                    step
+                }
+            };
+            base + pick(0, ex) + pick(1, ey) + pick(2, ez)
+        })
+    }
+}
+
+/// Corner `k` of `b`: bit `a` of `k` picks the high end along axis `a`.
+#[inline]
+fn corner(b: &Aabb, k: usize) -> Vec3A {
+    let pick = |axis: usize| {
+        if k >> axis & 1 == 0 {
+            b.min[axis]
+        } else {
+            b.max[axis]
+        }
+    };
+    Vec3A::new(pick(0), pick(1), pick(2))
+}
+
+/// Which primitives each tile of the image may show (see the module doc).
+#[derive(Clone, Debug)]
+pub struct ImageTiles {
+    view: ImageView,
+    width: f32,
+    height: f32,
+    cols: usize,
+    rows: usize,
+    /// Per tile, where its groups start in `near` (and, times `GROUP`, in `ids`); then the end.
+    starts: Box<[u32]>,
+    /// Per tile, its primitives nearest first, padded with the caller's `pad` to whole groups.
+    ids: Box<[u32]>,
+    /// Per group: no hit in its primitives lies closer to the eye than this.
+    near: Box<[f32]>,
+}
+
+/// Tiles `c0..=c1` of rows `r0..=r1` (none when `c0 > c1`).
+#[derive(Clone, Copy, Debug)]
+struct Rect {
+    c0: u16,
+    c1: u16,
+    r0: u16,
+    r1: u16,
+}
+
+impl Rect {
+    const NONE: Rect = Rect {
+        c0: 1,
+        c1: 0,
+        r0: 1,
+        r1: 0,
+    };
+
+    fn area(self) -> usize {
+        (usize::from(self.c1) + 1).saturating_sub(self.c0.into())
+            * (usize::from(self.r1) + 1).saturating_sub(self.r0.into())
+    }
+
+    /// Its tiles, row by row, numbered as in `ImageTiles::starts`.
+    fn tiles(self, cols: usize) -> impl Iterator<Item = usize> {
+        (usize::from(self.r0)..=usize::from(self.r1)).flat_map(move |row| {
+            (usize::from(self.c0)..=usize::from(self.c1)).map(move |col| row * cols + col)
+        })
+    }
+}
+
+/// Where a primitive's bounds appear on an image.
+enum Footprint {
+    /// Wholly behind the eye: no ray from it meets them.
+    Behind,
+    /// Reaching the plane through the eye: anywhere.
+    Around,
+    /// These tiles (none when off the image).
+    Tiles(Rect),
+}
+
+impl ImageTiles {
+    /// Tiles of the `width`×`height` image of `view` for the `n` primitives with (finite)
+    /// bounds `bound(i)`, numbered by `i`; lists are padded with `pad`, a number the
+    /// caller's tests never hit. `None` when too much lies around the eye or the lists would
+    /// hold too many entries (`AROUND_MAX`, `ENTRIES_PER_PRIMITIVE`), or the image has more
+    /// tiles along a side than a `u16` counts.
+    pub fn new(
+        view: ImageView,
+        (width, height): (u32, u32),
+        n: usize,
+        bound: impl Fn(usize) -> Aabb,
+        pad: u32,
+    ) -> Option<ImageTiles> {
+        let cols = (width as usize).div_ceil(TILE);
+        let rows = (height as usize).div_ceil(TILE);
+        if cols == 0 || rows == 0 || cols.max(rows) > usize::from(u16::MAX) {
+            return None;
+        }
+        let mut tiles = ImageTiles {
+            view,
+            width: width as f32,
+            height: height as f32,
+            cols,
+            rows,
+            starts: Box::default(),
+            ids: Box::default(),
+            near: Box::default(),
+        };
+        let everywhere = Rect {
+            c0: 0,
+            c1: (cols - 1) as u16,
+            r0: 0,
+            r1: (rows - 1) as u16,
+        };
+        let cap = ENTRIES_PER_PRIMITIVE * n + ENTRIES_PER_TILE * cols * rows;
+        let project = Projector::new(&view);
+        let mut count = vec![0u32; cols * rows];
+        let mut rects = Vec::with_capacity(n);
+        // Each primitive with a footprint as its distance's bits (which order like the
+        // distance, for one that is not negative) above its number: sorted, they come
+        // nearest first, and each tile's list is filled in that order.
+        let mut order = Vec::with_capacity(n);
+        let (mut entries, mut around) = (0, 0);
+        for i in 0..n {
+            let b = bound(i);
+            let rect = match tiles.footprint(&project, &b) {
+                Footprint::Behind => Rect::NONE,
+                Footprint::Around => {
+                    around += 1;
+                    everywhere
+                }
+                Footprint::Tiles(rect) => rect,
+            };
+            rects.push(rect);
+            if rect.area() == 0 {
+                continue;
+            }
+            entries += rect.area();
+            if around > AROUND_MAX || entries > cap {
+                return None;
+            }
+            rect.tiles(cols).for_each(|t| count[t] += 1);
+            let distance = (view.eye - view.eye.clamp(b.min, b.max)).length();
+            order.push(u64::from((distance * (1.0 - NEAR_SLACK)).to_bits()) << 32 | i as u64);
+        }
+        order.sort_unstable();
+        let mut starts = Vec::with_capacity(cols * rows + 1);
+        let mut groups = 0;
+        for &k in &count {
+            starts.push(groups);
+            groups += (k as usize).div_ceil(GROUP) as u32;
+        }
+        starts.push(groups);
+        let mut ids = vec![pad; groups as usize * GROUP];
+        let mut near = vec![0.0f32; groups as usize];
+        // `count` becomes each tile's entries placed so far.
+        count.fill(0);
+        for key in order {
+            let i = key as u32;
+            for t in rects[i as usize].tiles(cols) {
+                let k = count[t] as usize;
+                count[t] += 1;
+                let group = starts[t] as usize + k / GROUP;
+                ids[group * GROUP + k % GROUP] = i;
+                if k.is_multiple_of(GROUP) {
+                    near[group] = f32::from_bits((key >> 32) as u32);
+                }
+            }
+        }
+        tiles.starts = starts.into_boxed_slice();
+        tiles.ids = ids.into_boxed_slice();
+        tiles.near = near.into_boxed_slice();
+        Some(tiles)
+    }
+
+    /// Tiles of an image from `eye` that takes in all `n` primitives (bounds `bound(i)`, all
+    /// within `all`), for segments that end at `eye` (`towards`); `None` when no image
+    /// takes them in (`AROUND_TAN_MAX`) or as `new`.
+    pub fn around(
+        eye: Vec3A,
+        all: &Aabb,
+        n: usize,
+        bound: impl Fn(usize) -> Aabb,
+        pad: u32,
+    ) -> Option<ImageTiles> {
+        let tiles_per_side = ((TILES_PER_PRIMITIVE * n) as f64).sqrt().ceil() as usize;
+        let side = (TILE * tiles_per_side).clamp(4 * TILE, AROUND_SIDE_MAX);
+        let view = ImageView::around(eye, all, side)?;
+        ImageTiles::new(view, (side as u32, side as u32), n, bound, pad)
+    }
+
+    /// The tiles a box covers: the pixels between its corners' images, widened by `MARGIN`
+    /// (a box in front of the eye appears within the hull of its corners' images).
+    fn footprint(&self, project: &Projector, b: &Aabb) -> Footprint {
+        let corners = project.corners(b);
+        let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+        for c in corners {
+            (lo, hi) = (lo.min(c), hi.max(c));
+        }
+        if hi.z < 0.0 {
+            return Footprint::Behind;
+        }
+        // Also a box whose depths are not numbers: nothing can be said of where it is.
+        if lo.z.is_nan() || lo.z <= 0.0 {
+            return Footprint::Around;
+        }
+        // Image offsets from the centre, `x` rightwards and `y` upwards.
+        let (mut x0, mut x1, mut y0, mut y1) = (
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        );
+        for c in corners {
+            let r = 1.0 / c.z;
+            (x0, x1) = (x0.min(c.x * r), x1.max(c.x * r));
+            (y0, y1) = (y0.min(c.y * r), y1.max(c.y * r));
+        }
+        let view = &self.view;
+        let span = |lo: f32, hi: f32, size: f32, tiles: usize| {
+            let (lo, hi) = (lo - MARGIN, hi + MARGIN);
+            // Also a span that is not a number.
+            if !(hi >= 0.0 && lo < size) {
+                return None;
+            }
+            let tile = |p: f32| ((p.clamp(0.0, size) as usize) / TILE).min(tiles - 1) as u16;
+            Some((tile(lo), tile(hi)))
+        };
+        let cols = span(view.half_w + x0, view.half_w + x1, self.width, self.cols);
+        let rows = span(view.half_h - y1, view.half_h - y0, self.height, self.rows);
+        match (cols, rows) {
+            (Some((c0, c1)), Some((r0, r1))) => Footprint::Tiles(Rect { c0, c1, r0, r1 }),
+            _ => Footprint::Tiles(Rect::NONE),
+        }
+    }
+
+    /// The primitives a ray from `origin` along `dir` may meet, as a list padded to whole
+    /// groups of four, nearest first, with each group's least distance (see `near`), if the
+    /// ray starts at the eye and crosses the image.
+    #[inline]
+    pub fn candidates(&self, origin: Vec3A, dir: Vec3A) -> Option<(&[u32], &[f32])> {
+        if origin != self.view.eye {
+            return None;
+        }
+        self.tile_of(dir)
+    }
+
+    /// The primitives the segment from `from` to the eye may meet, as `candidates` gives
+    /// them (the segment's points are those of the eye's ray through `from` up to it).
+    #[inline]
+    pub fn towards(&self, from: Vec3A) -> Option<(&[u32], &[f32])> {
+        self.tile_of(from - self.view.eye)
+    }
+
+    /// The list of the tile the eye's ray along `dir` crosses, if it crosses the image.
+    #[inline]
+    fn tile_of(&self, dir: Vec3A) -> Option<(&[u32], &[f32])> {
+        let (x, y) = self.view.pixel_of(dir)?;
+        if !(x >= 0.0 && x < self.width && y >= 0.0 && y < self.height) {
+            return None;
+        }
+        let tile = (y as usize / TILE) * self.cols + x as usize / TILE;
+        let (from, to) = (self.starts[tile] as usize, self.starts[tile + 1] as usize);
+        Some((&self.ids[from * GROUP..to * GROUP], &self.near[from..to]))
+    }
+
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>() + (self.starts.len() + self.ids.len() + self.near.len()) * 4
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::segment_entry as entry;
+    use super::*;
+    use proptest::prelude::*;
+
+    fn vec3(scale: f32) -> impl Strategy<Value = Vec3A> {
+        (-scale..scale, -scale..scale, -scale..scale).prop_map(|(x, y, z)| Vec3A::new(x, y, z))
+    }
+
+    fn boxes() -> impl Strategy<Value = Vec<Aabb>> {
+        prop::collection::vec((vec3(10.0), vec3(2.0)), 1..=40).prop_map(|v| {
+            v.into_iter()
+                .map(|(c, e)| Aabb::new(c - e.abs(), c + e.abs()))
+                .collect()
+        })
+    }
+
+    /// A view from `eye` along `ahead` (not vertical) with `half_w`/`half_h` pixels and a
+    /// horizontal half-angle whose tangent is `spread`.
+    fn view(eye: Vec3A, ahead: Vec3A, spread: f32, (w, h): (u32, u32)) -> ImageView {
+        let ahead = ahead.normalize();
+        let right = ahead.cross(Vec3A::Y).normalize();
+        ImageView {
+            eye,
+            forward: ahead * (w as f32 / 2.0 / spread),
+            right,
+            up: right.cross(ahead),
+            half_w: w as f32 / 2.0,
+            half_h: h as f32 / 2.0,
+        }
+    }
+
+    /// Whether `list` (with its groups' distances) offers box `i`, no nearer than `t`.
+    fn offers((ids, near): (&[u32], &[f32]), i: usize, t: f64) -> bool {
+        let at = ids.iter().position(|&id| id as usize == i);
+        at.is_some_and(|k| near[k / GROUP] as f64 <= t)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(1000))]
+
+        /// Every box a ray from the eye through the image meets (boxes in front, behind and
+        /// around the eye) is in the list of the ray's tile, in a group listed no farther
+        /// than where the ray enters it; and groups come nearest first.
+        #[test]
+        fn a_camera_ray_finds_every_box_it_meets_in_its_tile(
+            eye in vec3(12.0),
+            ahead in vec3(1.0),
+            spread in 0.2f32..2.0,
+            bounds in boxes(),
+            at in (0.0f32..1.0, 0.0f32..1.0),
+        ) {
+            prop_assume!(ahead.length() > 0.1 && ahead.normalize().y.abs() < 0.99);
+            let size = (37, 23);
+            let v = view(eye, ahead, spread, size);
+            let Some(tiles) = ImageTiles::new(v, size, bounds.len(), |i| bounds[i], u32::MAX)
+            else {
+                // Only with more boxes around the eye than a tile list takes.
+                let around = bounds.iter().filter(|b| {
+                    (0..8).any(|k| v.depth(corner(b, k) - eye) <= 0.0)
+                }).count();
+                prop_assert!(around > AROUND_MAX);
+                return Ok(());
+            };
+            let sorted = tiles.starts.windows(2).all(|t| {
+                tiles.near[t[0] as usize..t[1] as usize].windows(2).all(|w| w[0] <= w[1])
+            });
+            prop_assert!(sorted);
+            let (x, y) = (at.0 * size.0 as f32, at.1 * size.1 as f32);
+            let dir = (v.forward + v.right * (x - v.half_w) + v.up * (v.half_h - y)).normalize();
+            let list = tiles.candidates(eye, dir);
+            prop_assert!(list.is_some(), "a ray through the image at ({x}, {y})");
+            for (i, b) in bounds.iter().enumerate() {
+                if let Some(t) = entry(b, eye, dir, f64::INFINITY) {
+                    prop_assert!(offers(list.unwrap(), i, t), "box {i} {b:?} met at {t}");
+                }
+            }
+            prop_assert!(tiles.candidates(eye + Vec3A::X * 1e-3, dir).is_none());
+        }
+
+        /// Around a point outside all the boxes (a light), every box a segment from a point
+        /// in view to that point meets is listed where the point sees the segment's start, no
+        /// farther than the box's nearest point on it.
+        #[test]
+        fn a_segment_to_the_light_finds_every_box_it_meets(
+            light in vec3(40.0),
+            bounds in boxes(),
+            from in vec3(12.0),
+        ) {
+            let all = bounds.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
+            let Some(tiles) = ImageTiles::around(light, &all, bounds.len(), |i| bounds[i], u32::MAX)
+            else {
+                return Ok(());
+            };
+            // A start the image does not take in (outside the scene's box) is left to the
+            // hierarchy.
+            let Some(list) = tiles.towards(from) else {
+                return Ok(());
+            };
+            let to_light = light - from;
+            let (dir, length) = (to_light.normalize(), to_light.length() as f64);
+            for (i, b) in bounds.iter().enumerate() {
+                if entry(b, from, dir, length).is_some() {
+                    // Where the segment enters the box, seen from the light.
+                    let t = entry(b, light, -dir, length).unwrap_or(length);
+                    prop_assert!(offers(list, i, t + 1e-3), "box {i} {b:?}");
+                }
+            }
+        }
+    }
+}
