@@ -9,7 +9,7 @@
 //! can lie on it.
 
 use crate::math::Aabb;
-use glam::Vec3A;
+use glam::{Vec3A, Vec4};
 
 /// Pixels per side of a tile: the blocks camera rays are traced in.
 const TILE: usize = 4;
@@ -30,9 +30,9 @@ const ENTRIES_PER_PRIMITIVE: usize = 8;
 const ENTRIES_PER_TILE: usize = 16;
 /// Lists are padded to a multiple of this many entries, so that they are tested four at once.
 const GROUP: usize = 4;
-/// Tiles of an image around a light, per primitive: footprints of a tile or two leave most
-/// tiles a few entries.
-const TILES_PER_PRIMITIVE: usize = 2;
+/// Tiles of an image around a light, per primitive. Against 2, grid10k and random1k at
+/// 1280×720 take 1.7 % and 3 % fewer instructions (shorter lists); 16 gains nothing more.
+const TILES_PER_PRIMITIVE: usize = 8;
 /// Most pixels along a side of an image around a light (1 MiB of tile starts).
 const AROUND_SIDE_MAX: usize = 2048;
 /// Widest half-angle an image around a light may take in (its tangent): wider, the pixels at
@@ -122,24 +122,21 @@ impl Projector {
         }
     }
 
-    /// Each corner of `b` (numbered as `corner`) as its offsets along the image's rows and
-    /// columns times its depth, and its depth: `x/z` and `y/z` place it on the image.
-    fn corners(&self, b: &Aabb) -> [Vec3A; 8] {
+    /// The corners of `b` as their offsets along the image's rows and columns times their
+    /// depth, and their depth (`x/z` and `y/z` place a corner on the image): per coordinate,
+    /// the four corners at the low end of `z`, then the four at its high end.
+    #[inline]
+    fn corners(&self, b: &Aabb) -> [[Vec4; 2]; 3] {
         let d = b.min - self.eye;
         let e = b.max - b.min;
         let [sx, sy, sz] = self.steps;
         let base = sx * d.x + sy * d.y + sz * d.z;
         let (ex, ey, ez) = (sx * e.x, sy * e.y, sz * e.z);
-        std::array::from_fn(|k| {
-            let pick = |axis: usize, step: Vec3A| {
-                if k >> axis & 1 == 0 {
-                    Vec3A::ZERO
-                } else {
-                    step
-                }
-            };
-            base + pick(0, ex) + pick(1, ey) + pick(2, ez)
-        })
+        let coordinate = |c: usize| {
+            let low = Vec4::splat(base[c]) + Vec4::new(0.0, ex[c], ey[c], ex[c] + ey[c]);
+            [low, low + Vec4::splat(ez[c])]
+        };
+        [coordinate(0), coordinate(1), coordinate(2)]
     }
 }
 
@@ -326,30 +323,20 @@ impl ImageTiles {
     /// The tiles a box covers: the pixels between its corners' images, widened by `MARGIN`
     /// (a box in front of the eye appears within the hull of its corners' images).
     fn footprint(&self, project: &Projector, b: &Aabb) -> Footprint {
-        let corners = project.corners(b);
-        let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-        for c in corners {
-            (lo, hi) = (lo.min(c), hi.max(c));
-        }
-        if hi.z < 0.0 {
+        let [xs, ys, zs] = project.corners(b);
+        if zs[0].max(zs[1]).max_element() < 0.0 {
             return Footprint::Behind;
         }
         // Also a box whose depths are not numbers: nothing can be said of where it is.
-        if lo.z.is_nan() || lo.z <= 0.0 {
+        let nearest = zs[0].min(zs[1]).min_element();
+        if nearest.is_nan() || nearest <= 0.0 {
             return Footprint::Around;
         }
         // Image offsets from the centre, `x` rightwards and `y` upwards.
-        let (mut x0, mut x1, mut y0, mut y1) = (
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-        );
-        for c in corners {
-            let r = 1.0 / c.z;
-            (x0, x1) = (x0.min(c.x * r), x1.max(c.x * r));
-            (y0, y1) = (y0.min(c.y * r), y1.max(c.y * r));
-        }
+        let (r0, r1) = (zs[0].recip(), zs[1].recip());
+        let (x, y) = ([xs[0] * r0, xs[1] * r1], [ys[0] * r0, ys[1] * r1]);
+        let (x0, x1) = (x[0].min(x[1]).min_element(), x[0].max(x[1]).max_element());
+        let (y0, y1) = (y[0].min(y[1]).min_element(), y[0].max(y[1]).max_element());
         let view = &self.view;
         let span = |lo: f32, hi: f32, size: f32, tiles: usize| {
             let (lo, hi) = (lo - MARGIN, hi + MARGIN);
