@@ -697,11 +697,13 @@ fn rays_through_image_tiles_meet_what_brute_force_meets() {
     use anim::scene::Camera;
     let mut rng = Rng(0xD1B54A32D192ED03);
     let (mut blocked, mut clear, mut seen_hits) = (0, 0, 0);
-    let (mixed, mixed_transforms) = mixed_instances(&mut rng, 60);
+    // Enough shapes for tiles around the lights too (64 bounded, `LIGHT_TILES_MIN`).
+    let (mixed, mixed_transforms) = mixed_instances(&mut rng, 120);
     let spheres = instances_only(mixed.clone(), &mixed_transforms, true);
+    assert!(spheres.len() >= 64);
     let scenes = [
         (mixed, mixed_transforms.clone()),
-        world_boxes(&mut rng, 40),
+        world_boxes(&mut rng, 80),
         (spheres, mixed_transforms),
     ];
     for (instances, transforms) in scenes {

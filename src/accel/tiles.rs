@@ -167,6 +167,10 @@ pub struct ImageTiles {
     ids: Box<[u32]>,
     /// Per group: no hit in its primitives lies closer to the eye than this.
     near: Box<[f32]>,
+    /// Whether every primitive appears within the image, none around the eye (as around a
+    /// light, `ImageTiles::around`): a ray from the eye that crosses the image plane outside
+    /// it, by more than `MARGIN`, then meets none of them.
+    holds_all: bool,
 }
 
 /// Tiles `c0..=c1` of rows `r0..=r1` (none when `c0 > c1`).
@@ -217,11 +221,22 @@ impl ImageTiles {
     /// tiles along a side than a `u16` counts.
     pub fn new(
         view: ImageView,
-        (width, height): (u32, u32),
+        size: (u32, u32),
         n: usize,
         bound: impl Fn(usize) -> Aabb,
         pad: u32,
     ) -> Option<ImageTiles> {
+        Some(ImageTiles::build(view, size, n, bound, pad)?.0)
+    }
+
+    /// `new`, and how many primitives reach the plane through the eye.
+    fn build(
+        view: ImageView,
+        (width, height): (u32, u32),
+        n: usize,
+        bound: impl Fn(usize) -> Aabb,
+        pad: u32,
+    ) -> Option<(ImageTiles, usize)> {
         let cols = (width as usize).div_ceil(TILE);
         let rows = (height as usize).div_ceil(TILE);
         if cols == 0 || rows == 0 || cols.max(rows) > usize::from(u16::MAX) {
@@ -236,6 +251,7 @@ impl ImageTiles {
             starts: Box::default(),
             ids: Box::default(),
             near: Box::default(),
+            holds_all: false,
         };
         let everywhere = Rect {
             c0: 0,
@@ -301,7 +317,7 @@ impl ImageTiles {
         tiles.starts = starts.into_boxed_slice();
         tiles.ids = ids.into_boxed_slice();
         tiles.near = near.into_boxed_slice();
-        Some(tiles)
+        Some((tiles, around))
     }
 
     /// Tiles of an image from `eye` that takes in all `n` primitives (bounds `bound(i)`, all
@@ -317,7 +333,12 @@ impl ImageTiles {
         let tiles_per_side = ((TILES_PER_PRIMITIVE * n) as f64).sqrt().ceil() as usize;
         let side = (TILE * tiles_per_side).clamp(4 * TILE, AROUND_SIDE_MAX);
         let view = ImageView::around(eye, all, side)?;
-        ImageTiles::new(view, (side as u32, side as u32), n, bound, pad)
+        let side = side as u32;
+        let (mut tiles, around) = ImageTiles::build(view, (side, side), n, bound, pad)?;
+        // The image takes in every corner of `all` (`ImageView::around`), so every primitive
+        // in front of the eye.
+        tiles.holds_all = around == 0;
+        Some(tiles)
     }
 
     /// The tiles a box covers: the pixels between its corners' images, widened by `MARGIN`
@@ -370,7 +391,8 @@ impl ImageTiles {
     /// them (the segment's points are those of the eye's ray through `from` up to it).
     #[inline]
     pub fn towards(&self, from: Vec3A) -> Option<(&[u32], &[f32])> {
-        self.tile_of(from - self.view.eye)
+        let dir = from - self.view.eye;
+        self.tile_of(dir).or_else(|| self.off_image(dir))
     }
 
     /// The list of the tile the eye's ray along `dir` crosses, if it crosses the image.
@@ -383,6 +405,17 @@ impl ImageTiles {
         let tile = (y as usize / TILE) * self.cols + x as usize / TILE;
         let (from, to) = (self.starts[tile] as usize, self.starts[tile + 1] as usize);
         Some((&self.ids[from * GROUP..to * GROUP], &self.near[from..to]))
+    }
+
+    /// For the eye's ray along `dir` that crosses no tile: an empty list when the image
+    /// holds every primitive and the ray crosses the image plane beyond their widened
+    /// footprints, else none.
+    #[cold]
+    #[inline(never)]
+    fn off_image(&self, dir: Vec3A) -> Option<(&[u32], &[f32])> {
+        let (x, y) = self.view.pixel_of(dir)?;
+        let beyond = |p: f32, size: f32| p < -MARGIN || p > size + MARGIN;
+        (self.holds_all && (beyond(x, self.width) || beyond(y, self.height))).then_some((&[], &[]))
     }
 
     pub fn memory_bytes(&self) -> usize {
@@ -485,20 +518,55 @@ mod tests {
             else {
                 return Ok(());
             };
-            // A start the image does not take in (outside the scene's box) is left to the
-            // hierarchy.
-            let Some(list) = tiles.towards(from) else {
+            check_segment(&tiles, light, &bounds, from)?;
+        }
+
+        /// The same for segments through the corner of the scene's box that sets the image's
+        /// width, which the light sees on the image's edge (just off it, by round-off).
+        #[test]
+        fn a_segment_through_the_widest_corner_finds_the_boxes_there(
+            light in vec3(40.0),
+            bounds in boxes(),
+            beyond in 1.0f32..3.0,
+        ) {
+            let all = bounds.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
+            let Some(tiles) = ImageTiles::around(light, &all, bounds.len(), |i| bounds[i], u32::MAX)
+            else {
                 return Ok(());
             };
-            let to_light = light - from;
-            let (dir, length) = (to_light.normalize(), to_light.length() as f64);
-            for (i, b) in bounds.iter().enumerate() {
-                if entry(b, from, dir, length).is_some() {
-                    // Where the segment enters the box, seen from the light.
-                    let t = entry(b, light, -dir, length).unwrap_or(length);
-                    prop_assert!(offers(list, i, t + 1e-3), "box {i} {b:?}");
-                }
+            let v = tiles.view;
+            let off = |k: usize| {
+                let d = corner(&all, k) - light;
+                d.dot(v.right).abs().max(d.dot(v.up).abs()) / d.dot(v.forward)
+            };
+            let widest = (0..8).max_by(|&a, &b| off(a).total_cmp(&off(b))).unwrap();
+            let from = light + (corner(&all, widest) - light) * beyond;
+            check_segment(&tiles, light, &bounds, from)?;
+        }
+    }
+
+    /// Every box the segment from `from` to `light` meets is offered where the light sees
+    /// `from` (if the tiles answer), no farther from the light than where the segment enters it.
+    fn check_segment(
+        tiles: &ImageTiles,
+        light: Vec3A,
+        bounds: &[Aabb],
+        from: Vec3A,
+    ) -> Result<(), TestCaseError> {
+        // A start the image does not take in (outside the scene's box) may be left to the
+        // hierarchy.
+        let Some(list) = tiles.towards(from) else {
+            return Ok(());
+        };
+        let to_light = light - from;
+        let (dir, length) = (to_light.normalize(), to_light.length() as f64);
+        for (i, b) in bounds.iter().enumerate() {
+            if entry(b, from, dir, length).is_some() {
+                // Where the segment enters the box, seen from the light.
+                let t = entry(b, light, -dir, length).unwrap_or(length);
+                prop_assert!(offers(list, i, t + 1e-3), "box {i} {b:?}");
             }
         }
+        Ok(())
     }
 }
