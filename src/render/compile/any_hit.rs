@@ -48,14 +48,16 @@ impl RenderScene {
         let listed = match self.light_cells.get(light) {
             Some(cells) => cells
                 .candidates(ray.origin, ray.dir, t_max)
-                .map(|listed| (listed, &[][..])),
+                .map(|listed| (listed, None)),
             None => self
                 .light_tiles
                 .get(light)
-                .and_then(|tiles| tiles.as_ref()?.towards(ray.origin)),
+                .and_then(|tiles| tiles.as_ref()?.towards(ray.origin))
+                .map(|(listed, near)| (listed, Some(near))),
         };
         match listed {
-            Some((listed, near)) => self.any_listed(ray, t_max, listed, near, stop),
+            Some((listed, None)) => self.any_listed::<false>(ray, t_max, listed, &[], stop),
+            Some((listed, Some(near))) => self.any_listed::<true>(ray, t_max, listed, near, stop),
             None => self.any_hit(ray, t_max, stop),
         }
         seen
@@ -63,13 +65,13 @@ impl RenderScene {
 
     /// `any_hit` for the bounded primitives of `listed` (`DirectionCells::candidates` or
     /// `ImageTiles::towards`, padded to a multiple of four) alone: the others are known to
-    /// lie off the ray. Where `near` gives each group of four a distance from the ray's far
-    /// end that none of it comes closer than (groups nearest first), the groups farther than
-    /// the ray is long are not tested.
+    /// lie off the ray. `NEAREST_FIRST`: `near` gives each group of four a distance from the
+    /// ray's far end that none of it comes closer than (groups nearest first), and the groups
+    /// farther than the ray is long are not tested.
     // Not inlined: in the scenes without cells or tiles, `shadow` stays the size it was, and
     // so do the inlining choices around it (inlined, random1k took 0.9 % more instructions).
     #[inline(never)]
-    fn any_listed(
+    fn any_listed<const NEAREST_FIRST: bool>(
         &self,
         ray: &Ray,
         t_max: f32,
@@ -85,7 +87,7 @@ impl RenderScene {
         let lanes = SphereRay::new(ray);
         let boxes = (!self.all_spheres).then(|| BoxRay::new(ray));
         for (group, ids) in fours(listed).enumerate() {
-            if near.get(group).is_some_and(|&n| n > t_max) {
+            if NEAREST_FIRST && near.get(group).is_some_and(|&n| n > t_max) {
                 return;
             }
             let id = |k: usize| ids[k];

@@ -79,11 +79,11 @@ impl RenderScene {
     pub fn closest_seen(&self, ray: &Ray) -> Option<(u32, SurfaceHit)> {
         if let Some(cells) = &self.eye_cells {
             if let Some(listed) = cells.candidates(ray.origin, ray.dir, f32::INFINITY) {
-                return self.closest_listed(ray, listed, &[]);
+                return self.closest_listed::<false>(ray, listed, &[]);
             }
         } else if let Some(tiles) = &self.eye_tiles {
             if let Some((listed, near)) = tiles.candidates(ray.origin, ray.dir) {
-                return self.closest_listed(ray, listed, near);
+                return self.closest_listed::<true>(ray, listed, near);
             }
         }
         self.closest(ray, f32::INFINITY)
@@ -103,18 +103,24 @@ impl RenderScene {
     /// `closest` (without limit) among the bounded primitives of `listed` alone
     /// (`DirectionCells::candidates` or `ImageTiles::candidates`, padded to a multiple of
     /// four): the others are known to lie off the ray, and which of those listed wins is
-    /// judged as `closest` judges it, by distance and number. Where `near` gives each group
-    /// of four a distance no hit in it comes closer than (groups nearest first), the groups
-    /// past the closest hit so far are not tested. Not inlined, as `RenderScene::any_listed`.
+    /// judged as `closest` judges it, by distance and number. `NEAREST_FIRST`: `near` gives
+    /// each group of four a distance no hit in it comes closer than (groups nearest first),
+    /// and the groups past the closest hit so far are not tested. Not inlined, as
+    /// `RenderScene::any_listed`.
     #[inline(never)]
-    fn closest_listed(&self, ray: &Ray, listed: &[u32], near: &[f32]) -> Option<(u32, SurfaceHit)> {
+    fn closest_listed<const NEAREST_FIRST: bool>(
+        &self,
+        ray: &Ray,
+        listed: &[u32],
+        near: &[f32],
+    ) -> Option<(u32, SurfaceHit)> {
         let mut won = None;
         let (mut best, mut t_max) = self.closest_unbounded_into(ray, f32::INFINITY, &mut won);
         let lanes = SphereRay::new(ray);
         let limit = t_max.next_up();
         let boxes = (!self.all_spheres).then(|| BoxRay::new(ray));
         for (group, ids) in fours(listed).enumerate() {
-            if near.get(group).is_some_and(|&n| n > t_max) {
+            if NEAREST_FIRST && near.get(group).is_some_and(|&n| n > t_max) {
                 break;
             }
             let id = |k: usize| ids[k];
