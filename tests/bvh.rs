@@ -701,10 +701,21 @@ fn rays_through_image_tiles_meet_what_brute_force_meets() {
     let (mixed, mixed_transforms) = mixed_instances(&mut rng, 120);
     let spheres = instances_only(mixed.clone(), &mixed_transforms, true);
     assert!(spheres.len() >= 64);
+    // And spheres packed close, where rays meet several and the nearest-first cut decides.
+    let dense = (0..400)
+        .map(|k| {
+            let geometry = Geometry::Sphere {
+                center: rng.vec(30.0) + DVec3::splat(10.0),
+                radius: 0.5 + rng.next() * 2.0,
+            };
+            Instance::new(geometry, k)
+        })
+        .collect();
     let scenes = [
         (mixed, mixed_transforms.clone()),
         world_boxes(&mut rng, 80),
         (spheres, mixed_transforms),
+        (dense, vec![Transform::IDENTITY]),
     ];
     for (instances, transforms) in scenes {
         let lights: Vec<DVec3> = (0..4)
@@ -723,6 +734,36 @@ fn rays_through_image_tiles_meet_what_brute_force_meets() {
         let (width, height) = (96, 54);
         let rays = CameraRays::new(&camera, width, height).unwrap();
         render.watch_image(rays.view(), (width, height), u64::MAX);
+        // Packets of a 4×4 block of pixels (one sample position each, as the uniform path
+        // traces them), and of a run of 8 pixels of a row: each ray's hit is its own.
+        for i in 0..300 {
+            let (bx, by) = (
+                (rng.next() * 24.0) as u32 * 4,
+                (rng.next() * 13.0) as u32 * 4,
+            );
+            let (dx, dy) = (rng.next() as f32, rng.next() as f32);
+            let at = |k: u32, w: u32| (bx + k % w) as f32 + dx;
+            let block: [Ray; 16] =
+                std::array::from_fn(|k| rays.ray(at(k as u32, 4), (by + k as u32 / 4) as f32 + dy));
+            let run: [Ray; 8] = std::array::from_fn(|k| rays.ray(at(k as u32, 8), by as f32 + dy));
+            let bits = |h: &Option<(u32, SurfaceHit)>| {
+                h.map(|(id, h)| (id, h.t.to_bits(), h.normal.to_array()))
+            };
+            for (ray, hit) in block.iter().zip(render.closest_seen_packet(&block)) {
+                assert_eq!(
+                    bits(&hit),
+                    bits(&render.closest_seen(ray)),
+                    "block {i}: {ray:?}"
+                );
+            }
+            for (ray, hit) in run.iter().zip(render.closest_seen_packet(&run)) {
+                assert_eq!(
+                    bits(&hit),
+                    bits(&render.closest_seen(ray)),
+                    "run {i}: {ray:?}"
+                );
+            }
+        }
         for i in 0..4000 {
             let (x, y) = (
                 rng.next() as f32 * 100.0 - 2.0,

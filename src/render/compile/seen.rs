@@ -89,15 +89,80 @@ impl RenderScene {
         self.closest(ray, f32::INFINITY)
     }
 
-    /// `closest_seen` of each ray of a packet of camera rays.
+    /// `closest_seen` of each ray of a packet of camera rays, which lie on the image within the
+    /// rectangle that the first and the last span (a block of pixels, or a run of a row).
     pub fn closest_seen_packet<const N: usize>(
         &self,
         rays: &[Ray; N],
     ) -> [Option<(u32, SurfaceHit)>; N] {
-        if self.eye_tiles.is_some() {
-            return std::array::from_fn(|r| self.closest_seen(&rays[r]));
+        let Some(tiles) = &self.eye_tiles else {
+            return self.closest_packet(rays, f32::INFINITY);
+        };
+        // Rays of one tile in a scene of packed spheres alone: each group of four spheres is
+        // put in lanes once for them all. The rays between the first and the last on the
+        // image lie in the tile of both (up to round-off, which the tiles' widening covers).
+        let ends = [&rays[0], &rays[N - 1]].map(|r| tiles.candidates(r.origin, r.dir));
+        match ends {
+            [Some(first), Some(last)] if self.all_spheres && std::ptr::eq(first.0, last.0) => {
+                let mut out = [None; N];
+                self.closest_in_tile(rays, (1 << N) - 1, first, &mut out);
+                out
+            }
+            _ => std::array::from_fn(|r| self.closest_seen(&rays[r])),
         }
-        self.closest_packet(rays, f32::INFINITY)
+    }
+
+    /// `closest_listed::<true>` of the `members` of `rays` (camera rays of one tile, whose
+    /// list and distances are `listed` and `near`) into `out`, in a scene of packed spheres
+    /// alone: a group is tested for the rays whose closest hit so far does not lie nearer.
+    #[inline(never)]
+    fn closest_in_tile<const N: usize>(
+        &self,
+        rays: &[Ray; N],
+        members: u64,
+        (listed, near): (&[u32], &[f32]),
+        out: &mut [Option<(u32, SurfaceHit)>; N],
+    ) {
+        let lanes: [SphereRay; N] = std::array::from_fn(|r| SphereRay::new(&rays[r]));
+        let mut best = [None; N];
+        let mut t_max = [f32::INFINITY; N];
+        let mut live = members;
+        for (group, ids) in fours(listed).enumerate() {
+            let mut rays = live;
+            while rays != 0 {
+                let r = rays.trailing_zeros() as usize;
+                rays &= rays - 1;
+                if near[group] > t_max[r] {
+                    live &= !(1 << r);
+                }
+            }
+            if live == 0 {
+                break;
+            }
+            let spheres = SphereRay::lanes(gather(&self.spheres, ids));
+            let mut rays = live;
+            while rays != 0 {
+                let r = rays.trailing_zeros() as usize;
+                rays &= rays - 1;
+                t_max[r] = self.closest_in_spheres(
+                    &lanes[r],
+                    &spheres,
+                    |k| ids[k],
+                    0xF,
+                    f32::INFINITY,
+                    t_max[r],
+                    &mut best[r],
+                );
+            }
+        }
+        let mut rays_left = members;
+        while rays_left != 0 {
+            let r = rays_left.trailing_zeros() as usize;
+            rays_left &= rays_left - 1;
+            out[r] = best[r].and_then(|b| {
+                self.surface_of(&rays[r], b, None::<&crate::render::primitive::Primitive>)
+            });
+        }
     }
 
     /// `closest` (without limit) among the bounded primitives of `listed` alone
