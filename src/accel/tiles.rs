@@ -68,6 +68,13 @@ impl ImageView {
         ))
     }
 
+    /// A direction (not unit) of the ray from the eye through image position (`x`, `y`): the
+    /// inverse of `pixel_of`.
+    #[inline]
+    pub fn through(&self, x: f32, y: f32) -> Vec3A {
+        self.forward + self.right * (x - self.half_w) + self.up * (self.half_h - y)
+    }
+
     /// Depth of the point `eye + d` in image-plane distances (positive in front of the eye).
     #[inline]
     fn depth(&self, d: Vec3A) -> f32 {
@@ -493,7 +500,7 @@ mod tests {
             });
             prop_assert!(sorted);
             let (x, y) = (at.0 * size.0 as f32, at.1 * size.1 as f32);
-            let dir = (v.forward + v.right * (x - v.half_w) + v.up * (v.half_h - y)).normalize();
+            let dir = v.through(x, y).normalize();
             let list = tiles.candidates(eye, dir);
             prop_assert!(list.is_some(), "a ray through the image at ({x}, {y})");
             for (i, b) in bounds.iter().enumerate() {

@@ -84,9 +84,7 @@ impl CameraRays {
     /// Ray through image position (`x`, `y`) in pixels from the top-left corner.
     #[inline]
     pub fn ray(&self, x: f32, y: f32) -> Ray {
-        let v = &self.view;
-        let dir = v.forward + v.right * (x - v.half_w) + v.up * (v.half_h - y);
-        Ray::new(v.eye, dir.normalize())
+        Ray::new(self.view.eye, self.view.through(x, y).normalize())
     }
 }
 

@@ -72,6 +72,7 @@ impl RenderScene {
             )
         }
     }
+
     /// `closest` of a camera ray, from the eye `watch_from` named through the image
     /// `watch_image` named (or, if it starts elsewhere or misses the image, as `closest`
     /// finds it), with no limit.
@@ -104,29 +105,25 @@ impl RenderScene {
         let ends = [&rays[0], &rays[N - 1]].map(|r| tiles.candidates(r.origin, r.dir));
         match ends {
             [Some(first), Some(last)] if self.all_spheres && std::ptr::eq(first.0, last.0) => {
-                let mut out = [None; N];
-                self.closest_in_tile(rays, (1 << N) - 1, first, &mut out);
-                out
+                self.closest_in_tile(rays, first)
             }
             _ => std::array::from_fn(|r| self.closest_seen(&rays[r])),
         }
     }
 
-    /// `closest_listed::<true>` of the `members` of `rays` (camera rays of one tile, whose
-    /// list and distances are `listed` and `near`) into `out`, in a scene of packed spheres
-    /// alone: a group is tested for the rays whose closest hit so far does not lie nearer.
+    /// `closest_listed::<true>` of each of `rays` (camera rays of one tile, whose list and
+    /// distances are `listed` and `near`) in a scene of packed spheres alone (so with nothing
+    /// unbounded): a group is tested for the rays whose closest hit so far does not lie nearer.
     #[inline(never)]
     fn closest_in_tile<const N: usize>(
         &self,
         rays: &[Ray; N],
-        members: u64,
         (listed, near): (&[u32], &[f32]),
-        out: &mut [Option<(u32, SurfaceHit)>; N],
-    ) {
+    ) -> [Option<(u32, SurfaceHit)>; N] {
         let lanes: [SphereRay; N] = std::array::from_fn(|r| SphereRay::new(&rays[r]));
         let mut best = [None; N];
         let mut t_max = [f32::INFINITY; N];
-        let mut live = members;
+        let mut live: u64 = (1 << N) - 1;
         for (group, ids) in fours(listed).enumerate() {
             let mut rays = live;
             while rays != 0 {
@@ -155,14 +152,13 @@ impl RenderScene {
                 );
             }
         }
-        let mut rays_left = members;
-        while rays_left != 0 {
-            let r = rays_left.trailing_zeros() as usize;
-            rays_left &= rays_left - 1;
-            out[r] = best[r].and_then(|b| {
-                self.surface_of(&rays[r], b, None::<&crate::render::primitive::Primitive>)
-            });
-        }
+        std::array::from_fn(|r| {
+            self.surface_of(
+                &rays[r],
+                best[r]?,
+                None::<&crate::render::primitive::Primitive>,
+            )
+        })
     }
 
     /// `closest` (without limit) among the bounded primitives of `listed` alone
