@@ -347,10 +347,15 @@ impl RenderScene {
         self.moving.as_ref()?.with(k & !MOVING, ray, f)
     }
 
-    /// The moving entry of kind `k` hit by the ray before `t_max`: its hit, and the entry
-    /// placed (for its surface).
-    fn moving_hit(&self, k: u32, ray: &Ray, t_max: f32) -> Option<(ShapeHit, Primitive)> {
-        self.moving_with(k, ray, |p| p.hit(ray, t_max).map(|h| (h, p.clone())))?
+    /// The world-space surface of moving entry of kind `k` where the ray hit it (`hit`): the
+    /// entry placed at the ray's time again, which is the same floats, rather than a copy of
+    /// it kept from the test (a clone and its free were 2 % of a blurred frame).
+    fn moving_surface(&self, k: u32, ray: &Ray, hit: &ShapeHit) -> Option<SurfaceHit> {
+        let moving = self.moving.as_ref()?;
+        moving.placed_with(k & !MOVING, ray.time, |p| match p.world_sphere() {
+            Some(s) => sphere_surface(&s.hit_at(ray, hit.t)),
+            None => p.surface(hit),
+        })
     }
 
     /// Where light `k` is at `time` (its position unless it moves).
@@ -441,11 +446,12 @@ impl RenderScene {
                 .intersect(ray, t_max)
                 .map(|h| sphere_surface(&h)),
             Some(k) if !is_use(k) => self.objects[k as usize].intersect(ray, t_max),
-            k => {
-                let p = match k {
-                    Some(k) if is_moving(k) => self.moving_hit(k, ray, t_max)?.1,
-                    _ => self.instanced(i)?,
-                };
+            Some(k) if is_moving(k) => {
+                let h = self.moving_with(k, ray, |p| p.hit(ray, t_max))??;
+                self.moving_surface(k, ray, &h)
+            }
+            _ => {
+                let p = self.instanced(i)?;
                 let h = p.hit(ray, t_max)?;
                 Some(match p.world_sphere() {
                     Some(s) => sphere_surface(&s.hit_at(ray, h.t)),
@@ -461,8 +467,8 @@ impl RenderScene {
     pub fn closest(&self, ray: &Ray, t_max: f32) -> Option<(u32, SurfaceHit)> {
         // Filled in place, not returned: a `Primitive` is 240 bytes, and moving even a `None`
         // of it in and out of calls cost 5 % of a render of the mirror-and-glass room.
+        let (mut best, t_best) = self.closest_unbounded(ray, t_max);
         let mut won = None;
-        let (mut best, t_best) = self.closest_unbounded_into(ray, t_max, &mut won);
         let lanes = SphereRay::new(ray);
         let flat = self.flat_leaf();
         if self.all_spheres {
@@ -495,24 +501,16 @@ impl RenderScene {
         is_flat(self.unbounded, self.moving.is_some()).then(|| &FLAT[..self.unbounded as usize])
     }
 
-    /// The nearest unbounded primitive's hit before `t_max` and the new `t_max`, with the
-    /// placed primitive left in `won` when the winner moves: what `closest` starts from. The
-    /// winner's object-space hit is kept for its surface (spheres recompute theirs).
+    /// The nearest unbounded primitive's hit before `t_max` and the new `t_max`: what
+    /// `closest` starts from. The winner's object-space hit is kept for its surface (spheres
+    /// recompute theirs).
     #[inline(always)]
-    fn closest_unbounded_into(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        won: &mut Option<Primitive>,
-    ) -> (Option<Best>, f32) {
+    fn closest_unbounded(&self, ray: &Ray, t_max: f32) -> (Option<Best>, f32) {
         let mut best: Option<Best> = None;
         let mut t_best = t_max;
         for i in self.unbounded..self.len() as u32 {
             let h = match self.kind[i as usize] {
-                k if is_moving(k) => self.moving_hit(k, ray, t_best).map(|(h, p)| {
-                    *won = Some(p);
-                    h
-                }),
+                k if is_moving(k) => self.moving_with(k, ray, |p| p.hit(ray, t_best)).flatten(),
                 _ => self.shape_hit(i, ray, t_best),
             };
             if let Some(h) = h {
@@ -540,7 +538,8 @@ impl RenderScene {
         let Best { id: i, t, hit, .. } = best;
         let surface = match (self.kind.get(i as usize).copied(), hit) {
             (Some(SPHERE), _) => sphere_surface(&self.sphere(i as usize).hit_at(ray, t)),
-            (Some(o), Some(h)) if !is_moving(o) => self.objects[o as usize].surface(&h),
+            (Some(o), Some(h)) if is_moving(o) => self.moving_surface(o, ray, &h)?,
+            (Some(o), Some(h)) => self.objects[o as usize].surface(&h),
             // A box hit by the four-at-a-time test: its own test finds the same `t`, and the
             // rest of the hit, for the winner alone.
             (Some(o), None) if !is_moving(o) => {
@@ -653,7 +652,6 @@ impl RenderScene {
                             key: self.key[i],
                             hit: Some(h),
                         });
-                        *won = self.moving_with(kind, ray, Primitive::clone);
                     }
                     continue;
                 }

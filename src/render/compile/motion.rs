@@ -439,6 +439,13 @@ impl Moving {
         if TOUCHED.with(Cell::get) < swept && self.met_by(k, ray) {
             TOUCHED.with(|t| t.set(swept));
         }
+        self.placed_with(k, time, f)
+    }
+
+    /// `f` of entry `k` placed at `time`, as [`Moving::with`] gives it to a ray of that time,
+    /// without noting it as met: for a shape a ray already met (its surface).
+    #[inline]
+    pub fn placed_with<R>(&self, k: u32, time: f32, f: impl FnOnce(&Primitive) -> R) -> Option<R> {
         if !self.placed.is_empty() {
             return self.placed_at(k, step(time))?.map(f);
         }

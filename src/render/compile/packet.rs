@@ -79,7 +79,7 @@ impl RenderScene {
         }
         let mut won: [Option<Primitive>; N] = std::array::from_fn(|_| None);
         for (r, ray) in rays.iter().enumerate() {
-            (best[r], t_best[r]) = self.closest_unbounded_into(ray, t_max, &mut won[r]);
+            (best[r], t_best[r]) = self.closest_unbounded(ray, t_max);
         }
         let boxes: [BoxRay; N] = std::array::from_fn(|r| BoxRay::new(&rays[r]));
         self.bvh

@@ -175,8 +175,8 @@ impl RenderScene {
         listed: &[u32],
         near: &[f32],
     ) -> Option<(u32, SurfaceHit)> {
+        let (mut best, mut t_max) = self.closest_unbounded(ray, f32::INFINITY);
         let mut won = None;
-        let (mut best, mut t_max) = self.closest_unbounded_into(ray, f32::INFINITY, &mut won);
         let lanes = SphereRay::new(ray);
         let limit = t_max.next_up();
         let boxes = (!self.all_spheres).then(|| BoxRay::new(ray));
