@@ -86,13 +86,20 @@ impl PixelPattern {
     /// exposure, and the first two dimensions keep their net).
     #[inline]
     pub fn time(&self, i: u32) -> f32 {
-        to_unit(owen_scramble(sobol3(i), self.keys[2]))
+        let t = match SOBOL_TABLE.get(i as usize) {
+            Some(&[_, t]) => t,
+            None => sobol3(i),
+        };
+        to_unit(owen_scramble(t, self.keys[2]))
     }
 
     /// Sample `i` of this pixel, in [0,1)².
     #[inline]
     pub fn sample(&self, i: u32) -> (f32, f32) {
-        let (a, b) = sobol2(i);
+        let (a, b) = match SOBOL_TABLE.get(i as usize) {
+            Some(&[b, _]) => (i.reverse_bits(), b),
+            None => sobol2(i),
+        };
         (
             to_unit(owen_scramble(a, self.keys[0])),
             to_unit(owen_scramble(b, self.keys[1])),
@@ -103,7 +110,7 @@ impl PixelPattern {
 /// The first two Sobol dimensions of point `i` as 32-bit fractions: the van der Corput
 /// sequence and the dimension whose generator matrix is Pascal's triangle mod 2.
 #[inline]
-pub fn sobol2(i: u32) -> (u32, u32) {
+pub const fn sobol2(i: u32) -> (u32, u32) {
     let mut v = 1u32 << 31;
     let mut y = 0u32;
     let mut bits = i;
@@ -133,7 +140,7 @@ const SOBOL3: [u32; 32] = {
 
 /// The third Sobol dimension of point `i` as a 32-bit fraction.
 #[inline]
-pub fn sobol3(i: u32) -> u32 {
+pub const fn sobol3(i: u32) -> u32 {
     let mut y = 0u32;
     let mut bits = i;
     let mut k = 0;
@@ -146,6 +153,19 @@ pub fn sobol3(i: u32) -> u32 {
     }
     y
 }
+
+/// The second and third Sobol dimensions of the first points, read from a table instead of
+/// computed bit by bit: every pixel's samples up to the default maximum (`--max-spp` 32)
+/// and beyond. The first dimension is a bit reversal, cheaper than a lookup.
+const SOBOL_TABLE: [[u32; 2]; 64] = {
+    let mut table = [[0u32; 2]; 64];
+    let mut i = 0;
+    while i < table.len() {
+        table[i] = [sobol2(i as u32).1, sobol3(i as u32)];
+        i += 1;
+    }
+    table
+};
 
 /// The instant of the exposure of sample `i` of `n` in pixel (`x`, `y`) under uniform
 /// sampling: the strata `(σ(i) + ½)/n`, with σ a stride through them that is coprime to `n`
@@ -345,6 +365,24 @@ mod tests {
         assert_eq!(sobol2(1), (half, half));
         assert_eq!(sobol2(2), (half >> 1, 3 << 30));
         assert_eq!(sobol2(3), (3 << 30, 1 << 30));
+    }
+
+    /// A pixel's samples and instants are the same from the table as computed bit by bit,
+    /// on both sides of the table's end.
+    #[test]
+    fn tabled_points_are_the_computed_ones() {
+        let pattern = PixelPattern::new(17, 5);
+        for i in 0..200u32 {
+            let (a, b) = sobol2(i);
+            let keys = pattern.keys;
+            let computed = (
+                to_unit(owen_scramble(a, keys[0])),
+                to_unit(owen_scramble(b, keys[1])),
+            );
+            assert_eq!(pattern.sample(i), computed, "sample {i}");
+            let time = to_unit(owen_scramble(sobol3(i), keys[2]));
+            assert_eq!(pattern.time(i), time, "instant {i}");
+        }
     }
 
     #[test]
