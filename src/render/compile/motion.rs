@@ -142,6 +142,9 @@ pub struct Moving {
     /// four (`[min, max]`; NaN past the last entry), for [`BoxRay::slabs4`]: part `i`'s
     /// groups are cells `i·groups` to `(i+1)·groups − 1`.
     part_boxes: Vec<[[Vec4; LANES]; 2]>,
+    /// Per part of the exposure: the union of its `part_boxes`, which a ray that meets none
+    /// of them may miss in one test (`Moving::blocks`).
+    part_union: Vec<Aabb>,
 }
 
 /// The instant camera samples at `time` are taken at: the middle of its part of the
@@ -174,6 +177,7 @@ impl Moving {
             poses: Vec::new(),
             convex: Vec::new(),
             part_boxes: Vec::new(),
+            part_union: Vec::new(),
             lights: scene.lights.iter().map(|l| l.position).collect(),
             placed: Vec::new(),
         })
@@ -202,6 +206,14 @@ impl Moving {
                     let lanes: [(Vec4, Vec4); LANES] =
                         std::array::from_fn(|lane| world(part, g * LANES + lane));
                     [lanes.map(|(min, _)| min), lanes.map(|(_, max)| max)]
+                })
+                .collect();
+            self.part_union = (0..POSE_PARTS)
+                .map(|part| {
+                    (0..self.entries.len()).fold(Aabb::EMPTY, |union, k| {
+                        let (min, max) = world(part, k);
+                        union.union(Aabb::new(min.truncate().into(), max.truncate().into()))
+                    })
                 })
                 .collect();
         }
@@ -286,6 +298,13 @@ impl Moving {
         // The part of the exposure the ray's instant lies in: the shapes' bounds in it are
         // much tighter than over the whole exposure.
         let part = ((ray.time * POSE_PARTS as f32) as usize).min(POSE_PARTS - 1);
+        // Most shadow rays pass far from every moving shape: one test of the box around them
+        // all says so. It misses only where every box inside it misses (the slab test is the
+        // same arithmetic, and monotone in the box), so the answer is the one below.
+        let union = self.part_union.get(part)?;
+        if union.hit_range(ray, ray.dir.recip(), 0.0, t_max).is_none() {
+            return Some(false);
+        }
         let boxes = BoxRay::new(ray);
         let n = self.entries.len();
         let groups = n.div_ceil(LANES);
@@ -502,6 +521,7 @@ impl Moving {
             + self.lights.capacity() * 24
             + self.placed.capacity() * std::mem::size_of::<OnceLock<Option<Primitive>>>()
             + self.part_boxes.capacity() * std::mem::size_of::<[[Vec4; LANES]; 2]>()
+            + self.part_union.capacity() * std::mem::size_of::<Aabb>()
     }
 }
 
