@@ -793,3 +793,82 @@ fn rays_through_image_tiles_meet_what_brute_force_meets() {
     );
     assert!(seen_hits > 3000, "{seen_hits} camera rays hit");
 }
+
+/// A frame with motion blur keeps its direction cells (a moving shape listed by its bounds
+/// over the exposure; no light keeps cells once a light moves): camera rays from the eye and
+/// shadow rays towards the lights, at instants all over the exposure, meet what the
+/// hierarchy finds, to the bit, moving shapes included.
+#[test]
+fn direction_cells_in_a_frame_with_motion_answer_as_the_hierarchy() {
+    let shapes = "define material m 0.1 0.1 0.1 0.5 0.5 0.5 0 0 0 1\n\
+        define shape box floor -8 -3 -20 8 -2.5 0 m\n\
+        define shape box wall -8 -3 -21 8 6 -20 m\n\
+        define shape sphere a -3 0 -12 1 m\n\
+        define shape sphere b 3 1 -14 1.5 m\n\
+        define shape cylinder post -5 -2.5 -16 -5 3 -16 0.4 m\n\
+        define shape box crate 1 -2.5 -9 2.5 -1 -7.5 m\n\
+        define shape sphere slide -4 -0.5 -8 1.5 m\n\
+        define shape box blade -3 1.2 -10 3 2.4 -9.6 m\n\
+        define shape sphere c1 0 -1 -11 0.9 m\n\
+        define shape box c2 -0.5 -2.5 -11.5 0.5 -2 -10.5 m\n\
+        define shape composite pair c1 c2\n\
+        define light key -6 8 -2 1 1 1 1\n\
+        define light fill 7 3 -4 1 1 1 1\n\
+        define camera eye 60\n\
+        motion slide 0 translate -1 0 0\nmotion slide 0.5\nmotion slide 1 translate 6 0 0\n\
+        motion blade 0 rotate -40 0 0 1\nmotion blade 0.5\nmotion blade 1 rotate 40 0 0 1\n\
+        motion pair 0 translate 0 2 0\nmotion pair 0.5\nmotion pair 1 translate 0 -0.4 3\n";
+    let mut rng = Rng(0xA0761D6478BD642F);
+    let (mut moving_hits, mut blocked, mut clear) = (0, 0, 0);
+    for light_moves in [false, true] {
+        let motion = if light_moves {
+            "motion fill 0 translate 0 -2 0\nmotion fill 0.5\nmotion fill 1 translate 0 2 0\n"
+        } else {
+            ""
+        };
+        let scene = loaded_scene(&format!("{shapes}{motion}render eye m.png 64 48\n"));
+        let (mut render, dropped) = RenderScene::compile(&scene);
+        assert!(dropped.is_empty() && render.has_motion());
+        render.watch_from(Vec3A::ZERO);
+        let lights = if light_moves { 0 } else { 2 };
+        assert_eq!(render.cells_kept(), (lights, true));
+        for i in 0..4000 {
+            let time = rng.next() as f32;
+            // Mostly across the image, some anywhere.
+            let spread = if i % 5 == 4 { 2.0 } else { 0.7 };
+            let towards = rng.vec(spread) - DVec3::new(spread / 2.0, spread / 2.0, 1.0);
+            let towards = Vec3A::from(towards.as_vec3());
+            let ray = Ray::new(Vec3A::ZERO, towards.normalize()).at_time(time);
+            let seen = render.closest_seen(&ray);
+            let found = render.closest(&ray, f32::INFINITY);
+            let bits = |h: Option<(u32, SurfaceHit)>| {
+                h.map(|(id, h)| (id, h.point.to_array(), h.normal.to_array()))
+            };
+            assert_eq!(bits(seen), bits(found), "camera ray {i}: {ray:?}");
+            moving_hits += seen.is_some_and(|(id, _)| render.moving_entry(id).is_some()) as usize;
+            for (k, light) in render.lights.clone().iter().enumerate() {
+                let Some((_, hit)) = found else { break };
+                let to = render.light_position(k, light, time) - hit.point;
+                let ray = hit.spawn_ray(to.normalize()).at_time(time);
+                let t_limit = (hit.point + to - ray.origin).dot(ray.dir);
+                let hierarchy = render.closest(&ray, t_limit).is_some();
+                match render.shadow(&ray, t_limit, k) {
+                    Shadow::Clear => assert!(!hierarchy, "light {k}, ray {i}: {ray:?}"),
+                    Shadow::Blocked(id) => {
+                        assert!(hierarchy && render.hit(id, &ray, t_limit).is_some());
+                    }
+                    other => panic!("opaque shapes only, yet {other:?}"),
+                }
+                *if hierarchy { &mut blocked } else { &mut clear } += 1;
+            }
+        }
+    }
+    assert!(
+        moving_hits > 500,
+        "{moving_hits} camera rays hit a moving shape"
+    );
+    assert!(
+        blocked > 500 && clear > 500,
+        "{blocked} blocked, {clear} clear"
+    );
+}

@@ -113,7 +113,7 @@ pub struct RenderScene {
     /// What moves during the exposure, if anything does.
     moving: Option<Box<Moving>>,
     bvh: Bvh,
-    /// Per light, in a scene of few primitives that hold still (`takes_cells`): which of
+    /// Per light, in a scene of few primitives, if the lights hold still (`takes_cells`): which of
     /// them a shadow ray towards the light may meet, by direction. Empty otherwise.
     light_cells: Vec<DirectionCells>,
     /// Per light, in a larger scene that holds still: which primitives a shadow ray towards
@@ -315,9 +315,11 @@ impl RenderScene {
             any_transparent,
             max_radiance,
         };
+        let lights_hold = scene.moving.as_ref().is_none_or(|m| !m.moves_lights());
         scene.light_cells = scene
             .lights
             .iter()
+            .filter(|_| lights_hold)
             .filter_map(|l| scene.cells_around(l.position))
             .collect();
         (scene, dropped)
@@ -752,6 +754,12 @@ impl RenderScene {
                 .sum::<usize>()
     }
 
+    /// How many lights keep direction cells, and whether the eye does (`takes_cells`,
+    /// `watch_from`): for tests and tools that report what a scene was given.
+    pub fn cells_kept(&self) -> (usize, bool) {
+        (self.light_cells.len(), self.eye_cells.is_some())
+    }
+
     /// Top-level uses of prototypes (each stands for all the shapes of its composite).
     pub fn instance_uses(&self) -> usize {
         self.instances.as_ref().map_or(0, |inst| inst.uses())
@@ -767,12 +775,15 @@ fn is_flat(bounded: u32, moving: bool) -> bool {
 }
 
 /// Whether a scene of `bounded` primitives with finite bounds keeps `DirectionCells` around
-/// each light and the eye, for the candidates of shadow and camera rays: in a flat scene
-/// (`is_flat`: the cells follow no moving shape or light) of more than one test of four. One
+/// each light and the eye, for the candidates of shadow and camera rays: in a scene that is
+/// flat but for what moves (at most `FLAT_MAX` of them) of more than one test of four. One
 /// test of four is all a list could save there; in the hierarchy of a larger scene, a light's
 /// cells list too many primitives to beat its walk (the showcase's 57: 4 % more instructions).
-fn takes_cells(bounded: u32, moving: bool) -> bool {
-    is_flat(bounded, moving) && bounded as usize > LANES
+/// A moving shape is listed by its bounds over the whole exposure, as the hierarchy bounds
+/// it, and tested where a ray's cell lists it (the hierarchy answers where a cell does not);
+/// cells around a light that moves would not hold, so then no light keeps them.
+fn takes_cells(bounded: u32) -> bool {
+    bounded as usize <= FLAT_MAX && bounded as usize > LANES
 }
 
 /// Whether a `kind` is a moving shape (which `is_use` also says, so that the paths of

@@ -281,6 +281,11 @@ impl Moving {
         )
     }
 
+    /// Whether a light moves during the exposure.
+    pub fn moves_lights(&self) -> bool {
+        self.motion.moves_lights()
+    }
+
     /// Whether [`Moving::blocks`] answers.
     pub fn answers_blocks(&self) -> bool {
         self.entries.len() <= BLOCKS_MAX

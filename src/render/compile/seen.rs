@@ -49,7 +49,7 @@ impl RenderScene {
 
     /// Cells around `centre` listing the bounded primitives, if the scene takes them.
     pub(super) fn cells_around(&self, centre: Vec3A) -> Option<DirectionCells> {
-        if !takes_cells(self.unbounded, self.moving.is_some()) {
+        if !takes_cells(self.unbounded) {
             return None;
         }
         let bounds: Vec<Aabb> = (0..self.unbounded as usize)
