@@ -113,8 +113,8 @@ pub struct RenderScene {
     /// What moves during the exposure, if anything does.
     moving: Option<Box<Moving>>,
     bvh: Bvh,
-    /// Per light, in a scene of few primitives, if the lights hold still (`takes_cells`): which of
-    /// them a shadow ray towards the light may meet, by direction. Empty otherwise.
+    /// Per light, in a scene of few primitives whose lights hold still (`takes_cells`):
+    /// which of them a shadow ray towards the light may meet, by direction. Empty otherwise.
     light_cells: Vec<DirectionCells>,
     /// Per light, in a larger scene that holds still: which primitives a shadow ray towards
     /// the light may meet, by where the light sees its start (`ImageTiles::around`). Empty
@@ -780,8 +780,9 @@ fn is_flat(bounded: u32, moving: bool) -> bool {
 /// test of four is all a list could save there; in the hierarchy of a larger scene, a light's
 /// cells list too many primitives to beat its walk (the showcase's 57: 4 % more instructions).
 /// A moving shape is listed by its bounds over the whole exposure, as the hierarchy bounds
-/// it, and tested where a ray's cell lists it (the hierarchy answers where a cell does not);
-/// cells around a light that moves would not hold, so then no light keeps them.
+/// it, and tested where a ray's cell lists it (the hierarchy answers where a cell does not).
+/// When a light moves no light keeps cells: its shadow rays end where it is at their
+/// instant, away from the cells' centre, where cells answer few rays.
 fn takes_cells(bounded: u32) -> bool {
     bounded as usize <= FLAT_MAX && bounded as usize > LANES
 }

@@ -155,8 +155,8 @@ pub const fn sobol3(i: u32) -> u32 {
 }
 
 /// The second and third Sobol dimensions of the first points, read from a table instead of
-/// computed bit by bit: every pixel's samples up to the default maximum (`--max-spp` 32)
-/// and beyond. The first dimension is a bit reversal, cheaper than a lookup.
+/// computed bit by bit: every pixel's samples up to the default maximum
+/// (`limits::DEFAULT_MAX_SPP`) and beyond. The first dimension is a bit reversal, cheaper than a lookup.
 const SOBOL_TABLE: [[u32; 2]; 64] = {
     let mut table = [[0u32; 2]; 64];
     let mut i = 0;
@@ -166,6 +166,7 @@ const SOBOL_TABLE: [[u32; 2]; 64] = {
     }
     table
 };
+const _: () = assert!(SOBOL_TABLE.len() >= crate::limits::DEFAULT_MAX_SPP as usize);
 
 /// The instant of the exposure of sample `i` of `n` in pixel (`x`, `y`) under uniform
 /// sampling: the strata `(σ(i) + ½)/n`, with σ a stride through them that is coprime to `n`
