@@ -579,20 +579,14 @@ fn rays_through_direction_cells_meet_what_brute_force_meets() {
             };
             seen_hits += check_seen(&render, &prims, &ray, i) as usize;
         }
-        for (k, light) in lights.iter().enumerate() {
-            let light = Vec3A::from(light.as_vec3());
-            for i in 0..3000 {
-                let (ray, t_limit) = if i % 5 == 4 {
-                    (random_ray(&mut rng, i), t_limit_of(i))
-                } else {
-                    shadow_ray(&mut rng, light, i)
-                };
-                match check_shadow(&render, &prims, &ray, t_limit, k) {
-                    true => blocked += 1,
-                    false => clear += 1,
-                }
+        let (b, c) = tally_shadows(&render, &prims, &lights, 3000, |light, i| {
+            if i % 5 == 4 {
+                (random_ray(&mut rng, i), t_limit_of(i))
+            } else {
+                shadow_ray(&mut rng, light, i)
             }
-        }
+        });
+        (blocked, clear) = (blocked + b, clear + c);
     }
     assert!(
         blocked > 5000 && clear > 5000,
@@ -683,6 +677,30 @@ fn check_shadow(
     }
     assert_eq!(found != Shadow::Clear, brute, "light {k}: {ray:?}");
     brute
+}
+
+/// `check_shadow` of `n` rays towards each of `lights` (`ray(light, i)`: ray `i` and its
+/// length); how many were blocked, and how many clear.
+fn tally_shadows(
+    render: &RenderScene,
+    prims: &[Primitive],
+    lights: &[DVec3],
+    n: usize,
+    mut ray: impl FnMut(Vec3A, usize) -> (Ray, f32),
+) -> (usize, usize) {
+    let (mut blocked, mut clear) = (0, 0);
+    for (k, light) in lights.iter().enumerate() {
+        let light = Vec3A::from(light.as_vec3());
+        for i in 0..n {
+            let (ray, t_limit) = ray(light, i);
+            *if check_shadow(render, prims, &ray, t_limit, k) {
+                &mut blocked
+            } else {
+                &mut clear
+            } += 1;
+        }
+    }
+    (blocked, clear)
 }
 
 /// Image tiles (`RenderScene::watch_image`): in scenes larger than a flat one (mixed kinds
@@ -776,16 +794,10 @@ fn rays_through_image_tiles_meet_what_brute_force_meets() {
             };
             seen_hits += check_seen(&render, &prims, &ray, i) as usize;
         }
-        for (k, light) in lights.iter().enumerate() {
-            let light = Vec3A::from(light.as_vec3());
-            for i in 0..4000 {
-                let (ray, t_limit) = shadow_ray(&mut rng, light, i);
-                match check_shadow(&render, &prims, &ray, t_limit, k) {
-                    true => blocked += 1,
-                    false => clear += 1,
-                }
-            }
-        }
+        let (b, c) = tally_shadows(&render, &prims, &lights, 4000, |light, i| {
+            shadow_ray(&mut rng, light, i)
+        });
+        (blocked, clear) = (blocked + b, clear + c);
     }
     assert!(
         blocked > 5000 && clear > 5000,
