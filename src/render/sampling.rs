@@ -88,21 +88,22 @@ impl PixelPattern {
     pub fn time(&self, i: u32) -> f32 {
         let t = match SOBOL_TABLE.get(i as usize) {
             Some(&[_, t]) => t,
-            None => sobol3(i),
+            None => sobol3(i).reverse_bits(),
         };
-        to_unit(owen_scramble(t, self.keys[2]))
+        to_unit(owen_scramble_reversed(t, self.keys[2]))
     }
 
     /// Sample `i` of this pixel, in [0,1)².
     #[inline]
     pub fn sample(&self, i: u32) -> (f32, f32) {
-        let (a, b) = match SOBOL_TABLE.get(i as usize) {
-            Some(&[b, _]) => (i.reverse_bits(), b),
-            None => sobol2(i),
+        // The first dimension is the bit reversal of `i`: reversed, it is `i` itself.
+        let b = match SOBOL_TABLE.get(i as usize) {
+            Some(&[b, _]) => b,
+            None => sobol2(i).1.reverse_bits(),
         };
         (
-            to_unit(owen_scramble(a, self.keys[0])),
-            to_unit(owen_scramble(b, self.keys[1])),
+            to_unit(owen_scramble_reversed(i, self.keys[0])),
+            to_unit(owen_scramble_reversed(b, self.keys[1])),
         )
     }
 }
@@ -154,14 +155,18 @@ pub const fn sobol3(i: u32) -> u32 {
     y
 }
 
-/// The second and third Sobol dimensions of the first points, read from a table instead of
-/// computed bit by bit: every pixel's samples up to the default maximum
-/// (`limits::DEFAULT_MAX_SPP`) and beyond. The first dimension is a bit reversal, cheaper than a lookup.
+/// The second and third Sobol dimensions of the first points, bit-reversed as
+/// [`owen_scramble_reversed`] takes them, read from a table instead of computed bit by bit:
+/// every pixel's samples up to the default maximum (`limits::DEFAULT_MAX_SPP`) and beyond.
+/// The first dimension reversed is the point's index, which needs no table.
 const SOBOL_TABLE: [[u32; 2]; 64] = {
     let mut table = [[0u32; 2]; 64];
     let mut i = 0;
     while i < table.len() {
-        table[i] = [sobol2(i as u32).1, sobol3(i as u32)];
+        table[i] = [
+            sobol2(i as u32).1.reverse_bits(),
+            sobol3(i as u32).reverse_bits(),
+        ];
         i += 1;
     }
     table
@@ -193,21 +198,29 @@ fn gcd(mut a: u64, mut b: u64) -> u64 {
     a
 }
 
-/// A nested uniform scramble of a 32-bit fraction: each digit is flipped or not depending
-/// only on the digits above it, which is what keeps every elementary interval of a net
-/// mapped onto another of the same shape. Working on the bit-reversed value turns "digits
-/// above" into "lower bits", where adding a key and XOR-ing with a multiple by an even
-/// number do exactly that (a carry or a product only moves upwards). The even multipliers
-/// come from the key too, so every pixel gets a different permutation, not just a shift.
+/// A nested uniform scramble of a 32-bit fraction given by its bit reversal `x` (the
+/// samplers keep their points reversed: the first dimension's reversal is its index, so a
+/// sample pays for one reversal per dimension instead of two; x86 has no instruction for it).
+/// Each digit is flipped or not depending only on the digits above it, which is what keeps
+/// every elementary interval of a net mapped onto another of the same shape. On the reversed
+/// value "digits above" are the lower bits, where adding a key and XOR-ing with a multiple by
+/// an even number do exactly that (a carry or a product only moves upwards). The even
+/// multipliers come from the key too, so every pixel gets a different permutation, not just a
+/// shift.
 #[inline]
-fn owen_scramble(v: u32, key: u64) -> u32 {
-    let mut x = v.reverse_bits();
+fn owen_scramble_reversed(mut x: u32, key: u64) -> u32 {
     x = x.wrapping_add(key as u32);
     let k = key >> 32;
     x ^= x.wrapping_mul(((k as u32) << 1) | 2);
     x ^= x.wrapping_mul((((k >> 15) as u32) << 1) | 2);
     x ^= x.wrapping_mul(0x6f4f_2a36);
     x.reverse_bits()
+}
+
+/// The scramble of a fraction given as it is: the tests' reference for the tables.
+#[cfg(test)]
+fn owen_scramble(v: u32, key: u64) -> u32 {
+    owen_scramble_reversed(v.reverse_bits(), key)
 }
 
 /// A 32-bit fraction as an f32 in [0,1): the top 24 bits fit the mantissa exactly.
