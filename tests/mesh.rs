@@ -176,7 +176,17 @@ fn errors_inside_the_obj_point_at_its_own_line() {
         (
             "v 0 0 0\nv 1 0 0\nv 0 1 zero\nf 1 2 3\n",
             "mesh.obj:3:7:",
-            "found 'zero'",
+            "expected the vertex's z coordinate (a number), found 'zero'",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5\nf 1 2 3\n",
+            "mesh.obj:4:7:",
+            "expected the texture coordinate v (a number), found end of line",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 up 1\nf 1 2 3\n",
+            "mesh.obj:4:6:",
+            "expected the normal's y component (a number), found 'up'",
         ),
         (
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n",

@@ -252,9 +252,15 @@ fn scan_line(s: &mut Scan, line: &str, line_no: u64) -> Result<(), LineProblem> 
         "v" => {
             let mut xyz = [0.0f32; 3];
             let mut spans = [(0usize, 0usize); 3];
-            for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+            // Written out, not formatted: this runs three times on each of a mesh's vertices.
+            let whats = [
+                "the vertex's x coordinate (a number)",
+                "the vertex's y coordinate (a number)",
+                "the vertex's z coordinate (a number)",
+            ];
+            for (i, what) in whats.into_iter().enumerate() {
                 let w = ws.next();
-                xyz[i] = number(w, &format!("the vertex's {axis} coordinate (a number)"))?;
+                xyz[i] = number(w, what)?;
                 spans[i] = w.map_or((end, end), |(a, t)| (a, a + t.len()));
             }
             let rest: Vec<(usize, &str)> = ws.collect();
@@ -289,15 +295,22 @@ fn scan_line(s: &mut Scan, line: &str, line_no: u64) -> Result<(), LineProblem> 
             s.counts[0] += 1;
         }
         "vt" => {
-            for what in ["the texture coordinate u", "the texture coordinate v"] {
-                number(ws.next(), &format!("{what} (a number)"))?;
+            for what in [
+                "the texture coordinate u (a number)",
+                "the texture coordinate v (a number)",
+            ] {
+                number(ws.next(), what)?;
             }
             s.counts[1] += 1;
         }
         "vn" => {
-            for axis in ["x", "y", "z"] {
+            for what in [
+                "the normal's x component (a number)",
+                "the normal's y component (a number)",
+                "the normal's z component (a number)",
+            ] {
                 let w = ws.next();
-                let v = number(w, &format!("the normal's {axis} component (a number)"))?;
+                let v = number(w, what)?;
                 if !v.is_finite() {
                     let (a, t) = w.unwrap_or((end, ""));
                     return Err((a, a + t.len(), "normal is not a finite number".to_string()));
