@@ -352,14 +352,21 @@ fn scan_line(s: &mut Scan, line: &str, line_no: u64) -> Result<(), LineProblem> 
 /// file, so the largest is kept for that check.
 fn face_vertex(s: &mut Scan, at: usize, word: &str, line_no: u64) -> Result<(), LineProblem> {
     let whole = (at, at + word.len());
-    let parts: Vec<&str> = word.split('/').collect();
-    if parts.len() > 3 {
-        return Err((
-            whole.0,
-            whole.1,
-            format!("expected a face vertex v, v/vt, v//vn or v/vt/vn, found '{word}'"),
-        ));
+    // In place, not collected: this runs on every corner of every face.
+    let mut parts = [""; 3];
+    let mut count = 0;
+    for part in word.split('/') {
+        if count == parts.len() {
+            return Err((
+                whole.0,
+                whole.1,
+                format!("expected a face vertex v, v/vt, v//vn or v/vt/vn, found '{word}'"),
+            ));
+        }
+        parts[count] = part;
+        count += 1;
     }
+    let parts = &parts[..count];
     let mut offset = at;
     for (kind, part) in parts.iter().enumerate() {
         let span = (offset, offset + part.len());
