@@ -214,6 +214,17 @@ fn build_subtree(
     bvh
 }
 
+/// The items a node of `len` bins when it bins one in `stride`: one from each run of
+/// `stride`, at a place in the run that changes from run to run (so that items laid out with
+/// a period, a mesh's rows, are not all sampled at the same place in it).
+fn sample(len: usize, stride: usize) -> impl Iterator<Item = usize> {
+    let runs = len / stride;
+    (0..runs).map(move |k| {
+        let jitter = (k as u32).wrapping_mul(0x9e37_79b1) >> 16;
+        k * stride + jitter as usize % stride
+    })
+}
+
 /// The bin of a centroid `x` bin widths from the lowest: `(x as usize).min(BINS - 1)` for
 /// every float (NaN and negatives to bin 0, large ones to the last), without that
 /// float-to-u64 conversion, which with an array map was a fifth of a 100k-sphere build's
@@ -246,14 +257,19 @@ fn find_split(items: &mut [BuildItem], extent: &Extent, stride: usize) -> Option
     };
     let mut bin_bounds = [[Aabb::EMPTY; BINS]; 3];
     let mut bin_counts = [[0usize; BINS]; 3];
+    let mut add = |it: &BuildItem| {
+        let b = bin_of(it.centroid);
+        for axis in 0..3 {
+            let bin = &mut bin_bounds[axis][b[axis]];
+            *bin = bin.union(it.bounds);
+            bin_counts[axis][b[axis]] += 1;
+        }
+    };
     if live.contains(&true) {
-        for it in items.iter().step_by(stride) {
-            let b = bin_of(it.centroid);
-            for axis in 0..3 {
-                let bin = &mut bin_bounds[axis][b[axis]];
-                *bin = bin.union(it.bounds);
-                bin_counts[axis][b[axis]] += 1;
-            }
+        if stride == 1 {
+            items.iter().for_each(&mut add);
+        } else {
+            sample(items.len(), stride).for_each(|i| add(&items[i]));
         }
     }
     let mut best: Option<(f32, usize, usize)> = None;
@@ -462,6 +478,30 @@ mod tests {
         }
     }
 
+    /// A sample takes one item from each whole run of `stride`, and not always from the same
+    /// place in the run: items laid out with that period are still seen at many places of
+    /// it.
+    #[test]
+    fn a_sample_takes_one_item_a_run_at_changing_places() {
+        for (len, stride) in [(4096, 4), (12_288, 12), (1_000_003, 976), (5000, 2000)] {
+            let picked: Vec<usize> = sample(len, stride).collect();
+            assert_eq!(picked.len(), len / stride);
+            for (k, &i) in picked.iter().enumerate() {
+                assert!(
+                    (k * stride..(k + 1) * stride).contains(&i),
+                    "{len} {stride}: {i}"
+                );
+            }
+            let mut places: Vec<usize> = picked.iter().map(|i| i % stride).collect();
+            places.sort_unstable();
+            places.dedup();
+            assert!(
+                places.len() >= (len / stride).min(stride) / 2,
+                "{len} {stride}"
+            );
+        }
+    }
+
     /// Every node's box is exactly the union of its primitives' boxes (no level measures its
     /// items: a split hands each side the union of its bins, or of its items where the split
     /// was chosen from a sample), every primitive is in one leaf, and no leaf is large. The
@@ -478,7 +518,10 @@ mod tests {
             (state >> 40) as f32 / (1u64 << 24) as f32
         };
         let count = 3 * SAMPLED_MIN;
-        let far = count / SAMPLED_ITEMS / 2;
+        let stride = count / SAMPLED_ITEMS;
+        let far = (0..count)
+            .find(|i| !sample(count, stride).any(|s| s == *i))
+            .expect("an item the root does not sample");
         let boxes: Vec<Aabb> = (0..count)
             .map(|i| {
                 let p = Vec3A::new(next(), next(), next()) * 50.0;
