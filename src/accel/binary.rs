@@ -10,10 +10,11 @@ const MAX_LEAF: usize = 4;
 /// Cost of one node visit relative to one primitive test, for the SAH.
 const TRAVERSAL_COST: f32 = 0.5;
 /// Nodes of at least this many primitives choose their split from a sample of about
-/// `SAMPLED_ITEMS` of them, evenly spaced in their order: binning is most of a large build,
-/// and a thousand centroids place a split among 16 bins about as well as all of them.
-/// Measured (BENCHMARKS.md §10.1): a million spheres' setup 4.6 % fewer instructions and
-/// their render unchanged to 0.2 %; at 2048/512 the bunny's render took 0.3 % more.
+/// `SAMPLED_ITEMS` of them, one from each run of their order (`sample`): binning is most of a
+/// large build, and a thousand centroids place a split among 16 bins about as well as all
+/// of them. Measured (BENCHMARKS.md §10.1): a million spheres' setup 5.7 % fewer
+/// instructions and their render unchanged to 0.2 %; at 2048/512 the bunny's render took
+/// 0.3 % more.
 const SAMPLED_MIN: usize = 4096;
 const SAMPLED_ITEMS: usize = 1024;
 /// Deepest level of the binary tree (the root is level 0); deeper nodes become leaves. The
