@@ -372,7 +372,8 @@ impl ImageTiles {
             if !(hi >= 0.0 && lo < size) {
                 return None;
             }
-            let tile = |p: f32| ((p.clamp(0.0, size) as usize) / TILE).min(tiles - 1) as u16;
+            // Through `i32`: one conversion instruction where `usize` takes several.
+            let tile = |p: f32| ((p.clamp(0.0, size) as i32 as usize) / TILE).min(tiles - 1) as u16;
             Some((tile(lo), tile(hi)))
         };
         let cols = span(view.half_w + x0, view.half_w + x1, self.width, self.cols);
