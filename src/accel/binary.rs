@@ -241,8 +241,9 @@ fn bin(x: f32) -> usize {
 /// One pass bins the items along all three axes at once (lane `a` of a bin index is the bin
 /// along axis `a`, the same float operations as binning each axis alone), and the partition
 /// pass gathers each side's centroid bounds; each side's bounds are the union of its bins'.
-/// With `stride` above 1 only every `stride`-th item is binned (the counts are scaled back
-/// for the cost), and the partition pass gathers each side's bounds too.
+/// With `stride` above 1 only one item of each run of `stride` is binned (`sample`; the
+/// counts are scaled back up for the cost), and the partition pass gathers each side's
+/// bounds too.
 fn find_split(items: &mut [BuildItem], extent: &Extent, stride: usize) -> Option<Split> {
     let centroid_bounds = &extent.centroids;
     let size = centroid_bounds.extent();
