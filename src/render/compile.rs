@@ -354,9 +354,8 @@ impl RenderScene {
     /// it kept from the test (a clone and its free were 2 % of a blurred frame).
     fn moving_surface(&self, k: u32, ray: &Ray, hit: &ShapeHit) -> Option<SurfaceHit> {
         let moving = self.moving.as_ref()?;
-        moving.placed_with(k & !MOVING, ray.time, |p| match p.world_sphere() {
-            Some(s) => sphere_surface(&s.hit_at(ray, hit.t)),
-            None => p.surface(hit),
+        moving.placed_with(k & !MOVING, ray.time, |p| {
+            placed_surface(p, ray, hit.t, hit)
         })
     }
 
@@ -455,10 +454,7 @@ impl RenderScene {
             _ => {
                 let p = self.instanced(i)?;
                 let h = p.hit(ray, t_max)?;
-                Some(match p.world_sphere() {
-                    Some(s) => sphere_surface(&s.hit_at(ray, h.t)),
-                    None => p.surface(&h),
-                })
+                Some(placed_surface(&p, ray, h.t, &h))
             }
         }
     }
@@ -548,14 +544,7 @@ impl RenderScene {
                 let p = &self.objects[o as usize];
                 p.surface(&p.hit(ray, t.next_up())?)
             }
-            (_, Some(h)) => {
-                let won = won?;
-                let p = won.borrow();
-                match p.world_sphere() {
-                    Some(s) => sphere_surface(&s.hit_at(ray, t)),
-                    None => p.surface(&h),
-                }
-            }
+            (_, Some(h)) => placed_surface(won?.borrow(), ray, t, &h),
             (_, None) => unreachable!("instanced and moving shapes keep their hit"),
         };
         Some((i, surface))
@@ -813,6 +802,17 @@ fn four(v: &[Vec4], i: usize) -> [Vec4; LANES] {
 #[inline(always)]
 fn is_use(kind: u32) -> bool {
     kind != SPHERE && kind & USE != 0
+}
+
+/// The world-space surface of placed primitive `p` (instanced or moving) where the ray hit
+/// it at `t` (`hit`, in its own space): a sphere that stays one in the world recomputes its
+/// hit there, as world-space spheres do.
+#[inline]
+fn placed_surface(p: &Primitive, ray: &Ray, t: f32, hit: &ShapeHit) -> SurfaceHit {
+    match p.world_sphere() {
+        Some(s) => sphere_surface(&s.hit_at(ray, t)),
+        None => p.surface(hit),
+    }
 }
 
 /// What `Primitive::surface` makes of a world-space hit: the normal renormalised.
