@@ -202,11 +202,42 @@ impl Rect {
             * (usize::from(self.r1) + 1).saturating_sub(self.r0.into())
     }
 
-    /// Its tiles, row by row, numbered as in `ImageTiles::starts`.
-    fn tiles(self, cols: usize) -> impl Iterator<Item = usize> {
-        (usize::from(self.r0)..=usize::from(self.r1)).flat_map(move |row| {
-            (usize::from(self.c0)..=usize::from(self.c1)).map(move |col| row * cols + col)
-        })
+    /// Its tiles, one range of them a row, numbered as in `ImageTiles::starts`.
+    fn rows(self, cols: usize) -> impl Iterator<Item = std::ops::Range<usize>> {
+        let (c0, c1) = (usize::from(self.c0), usize::from(self.c1) + 1);
+        (usize::from(self.r0)..=usize::from(self.r1))
+            .map(move |row| row * cols + c0..row * cols + c1)
+    }
+}
+
+/// Sorts `keys` by their upper halves, keeping the order of keys whose upper halves are
+/// equal: a least-significant-digit radix sort, 11 bits a pass. The tiles' keys are a
+/// distance's bits above a primitive's number, pushed in order of number, so this is their
+/// order as whole numbers, and on 10^5 keys it costs a fraction of a comparison sort.
+fn sort_by_upper_half(keys: &mut Vec<u64>) {
+    const DIGIT_BITS: u32 = 11;
+    const DIGITS: usize = 1 << DIGIT_BITS;
+    let mut sorted = vec![0u64; keys.len()];
+    for shift in (32..64).step_by(DIGIT_BITS as usize) {
+        let digit = |k: u64| (k >> shift) as usize & (DIGITS - 1);
+        let mut starts = vec![0usize; DIGITS];
+        for &k in keys.iter() {
+            starts[digit(k)] += 1;
+        }
+        // All keys share this digit: the pass would move nothing.
+        if starts.contains(&keys.len()) {
+            continue;
+        }
+        let mut at = 0;
+        for s in starts.iter_mut() {
+            (*s, at) = (at, at + *s);
+        }
+        for &k in keys.iter() {
+            let d = digit(k);
+            sorted[starts[d]] = k;
+            starts[d] += 1;
+        }
+        std::mem::swap(keys, &mut sorted);
     }
 }
 
@@ -293,11 +324,13 @@ impl ImageTiles {
             if around > AROUND_MAX || entries > cap {
                 return None;
             }
-            rect.tiles(cols).for_each(|t| count[t] += 1);
+            for row in rect.rows(cols) {
+                count[row].iter_mut().for_each(|c| *c += 1);
+            }
             let distance = (view.eye - view.eye.clamp(b.min, b.max)).length();
             order.push(u64::from((distance * (1.0 - NEAR_SLACK)).to_bits()) << 32 | i as u64);
         }
-        order.sort_unstable();
+        sort_by_upper_half(&mut order);
         let mut starts = Vec::with_capacity(cols * rows + 1);
         let mut groups = 0;
         for &k in &count {
@@ -311,13 +344,15 @@ impl ImageTiles {
         count.fill(0);
         for key in order {
             let i = key as u32;
-            for t in rects[i as usize].tiles(cols) {
-                let k = count[t] as usize;
-                count[t] += 1;
-                let group = starts[t] as usize + k / GROUP;
-                ids[group * GROUP + k % GROUP] = i;
-                if k.is_multiple_of(GROUP) {
-                    near[group] = f32::from_bits((key >> 32) as u32);
+            for row in rects[i as usize].rows(cols) {
+                for (placed, &start) in count[row.clone()].iter_mut().zip(&starts[row]) {
+                    let k = *placed as usize;
+                    *placed += 1;
+                    let group = start as usize + k / GROUP;
+                    ids[group * GROUP + k % GROUP] = i;
+                    if k.is_multiple_of(GROUP) {
+                        near[group] = f32::from_bits((key >> 32) as u32);
+                    }
                 }
             }
         }
@@ -472,6 +507,23 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(1000))]
+
+        /// The radix sort puts keys in the order of a stable sort by their upper halves:
+        /// upper halves from a few values (ties, and digits that all keys share) or from any,
+        /// lower halves in any order.
+        #[test]
+        fn keys_sort_by_upper_half_keeping_the_order_of_ties(
+            keys in prop::collection::vec(
+                (prop_oneof![0u64..4, 0u64..=u64::from(u32::MAX)], any::<u32>()),
+                0..3000,
+            ),
+        ) {
+            let mut keys: Vec<u64> = keys.into_iter().map(|(hi, lo)| hi << 32 | u64::from(lo)).collect();
+            let mut expected = keys.clone();
+            expected.sort_by_key(|k| k >> 32);
+            sort_by_upper_half(&mut keys);
+            prop_assert_eq!(keys, expected);
+        }
 
         /// Every box a ray from the eye through the image meets (boxes in front, behind and
         /// around the eye) is in the list of the ray's tile, in a group listed no farther
