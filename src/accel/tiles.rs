@@ -213,7 +213,8 @@ impl Rect {
 /// Sorts `keys` by their upper halves, keeping the order of keys whose upper halves are
 /// equal: a least-significant-digit radix sort, 11 bits a pass. The tiles' keys are a
 /// distance's bits above a primitive's number, pushed in order of number, so this is their
-/// order as whole numbers, and on 10^5 keys it costs a fraction of a comparison sort.
+/// order as whole numbers; on random100k's keys it takes half the instructions of a
+/// comparison sort (BENCHMARKS.md §9.11).
 fn sort_by_upper_half(keys: &mut Vec<u64>) {
     const DIGIT_BITS: u32 = 11;
     const DIGITS: usize = 1 << DIGIT_BITS;
@@ -518,7 +519,8 @@ mod tests {
                 0..3000,
             ),
         ) {
-            let mut keys: Vec<u64> = keys.into_iter().map(|(hi, lo)| hi << 32 | u64::from(lo)).collect();
+            let mut keys: Vec<u64> =
+                keys.into_iter().map(|(hi, lo)| hi << 32 | u64::from(lo)).collect();
             let mut expected = keys.clone();
             expected.sort_by_key(|k| k >> 32);
             sort_by_upper_half(&mut keys);
