@@ -588,10 +588,7 @@ fn rays_through_direction_cells_meet_what_brute_force_meets() {
         });
         (blocked, clear) = (blocked + b, clear + c);
     }
-    assert!(
-        blocked > 5000 && clear > 5000,
-        "{blocked} blocked, {clear} clear"
-    );
+    assert_both_kinds(blocked, clear, 5000);
     assert!(seen_hits > 2000, "{seen_hits} camera rays hit");
 }
 
@@ -677,6 +674,15 @@ fn check_shadow(
     }
     assert_eq!(found != Shadow::Clear, brute, "light {k}: {ray:?}");
     brute
+}
+
+/// That a test met more than `at_least` blocked and as many clear shadow rays: it checked
+/// both answers, not one.
+fn assert_both_kinds(blocked: usize, clear: usize, at_least: usize) {
+    assert!(
+        blocked > at_least && clear > at_least,
+        "{blocked} blocked, {clear} clear"
+    );
 }
 
 /// `check_shadow` of `n` rays towards each of `lights` (`ray(light, i)`: ray `i` and its
@@ -799,10 +805,7 @@ fn rays_through_image_tiles_meet_what_brute_force_meets() {
         });
         (blocked, clear) = (blocked + b, clear + c);
     }
-    assert!(
-        blocked > 5000 && clear > 5000,
-        "{blocked} blocked, {clear} clear"
-    );
+    assert_both_kinds(blocked, clear, 5000);
     assert!(seen_hits > 3000, "{seen_hits} camera rays hit");
 }
 
@@ -879,8 +882,5 @@ fn direction_cells_in_a_frame_with_motion_answer_as_the_hierarchy() {
         moving_hits > 500,
         "{moving_hits} camera rays hit a moving shape"
     );
-    assert!(
-        blocked > 500 && clear > 500,
-        "{blocked} blocked, {clear} clear"
-    );
+    assert_both_kinds(blocked, clear, 500);
 }
