@@ -1,11 +1,11 @@
 //! Command-line definitions (clap derive), resolved into configuration before any work starts.
 
 use crate::app::{CheckConfig, GenerateConfig, RenderConfig};
-use crate::bench::{BenchConfig, PovMode, Preset};
-use crate::limits;
-use crate::pipeline::{FrameOptions, Shard};
-use crate::render::RenderSettings;
-use crate::sdf::{LoadOptions, MaterialField, MaterialLayout, TransformOrder};
+use anim_bench::{BenchConfig, PovMode, Preset};
+use anim_core::limits;
+use anim_core::render::RenderSettings;
+use anim_core::sdf::{LoadOptions, MaterialField, MaterialLayout, TransformOrder};
+use anim_pipeline::frames::{FrameOptions, Shard};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::{Path, PathBuf};
 

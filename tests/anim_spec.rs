@@ -1,14 +1,14 @@
 //! The keyframe spec: parsing, located errors, interpolation values, the orbit camera and how
 //! keyed transforms compose with the base scene's own.
 
-use anim::anim::generate::{BaseScene, Generator};
-use anim::anim::interp::{sample, Interp, Key};
-use anim::anim::orbit::pose_at;
-use anim::anim::spec::{self, Animation, Orbit, Source};
-use anim::diag::Diagnostic;
-use anim::scene::RenderJob;
-use anim::sdf::ast::StatementKind;
-use anim::sdf::LoadOptions;
+use anim_core::diag::Diagnostic;
+use anim_core::scene::RenderJob;
+use anim_core::sdf::ast::StatementKind;
+use anim_core::sdf::LoadOptions;
+use anim_pipeline::keyframe::generate::{BaseScene, Generator};
+use anim_pipeline::keyframe::interp::{sample, Interp, Key};
+use anim_pipeline::keyframe::orbit::pose_at;
+use anim_pipeline::keyframe::spec::{self, Animation, Orbit, Source};
 use glam::{DVec3, Vec3};
 use std::path::Path;
 
@@ -30,7 +30,7 @@ transform cam translate 0 0 10
 
 fn base() -> BaseScene {
     let (statements, diags) =
-        anim::sdf::parse(BASE, Path::new("base.sdf"), &LoadOptions::default());
+        anim_core::sdf::parse(BASE, Path::new("base.sdf"), &LoadOptions::default());
     assert!(diags.is_empty(), "{diags:?}");
     BaseScene::new(statements)
 }
@@ -416,7 +416,7 @@ fn frame(text: &str, i: usize) -> RenderJob {
         .frame_text(i)
         .expect("frame");
     let mut loaded =
-        anim::scene::load_str(&frame_text, Path::new("frame.sdf"), &LoadOptions::default())
+        anim_core::scene::load_str(&frame_text, Path::new("frame.sdf"), &LoadOptions::default())
             .unwrap_or_else(|e| panic!("{frame_text}\n{e:?}"));
     assert_eq!(loaded.jobs.len(), 1);
     loaded.jobs.remove(0)
@@ -606,22 +606,22 @@ fn frames_keep_the_materials_of_a_base_scene_in_another_layout() {
         "(scene: File(\"base.sdf\"), length: Frames(1), resolution: (8, 6))\n",
     )
     .unwrap();
-    let config = anim::anim::GenerateConfig {
+    let config = anim_pipeline::keyframe::GenerateConfig {
         spec: dir.path().join("spec.ron"),
         out: Some(dir.path().join("frames")),
     };
-    anim::anim::run_generate(&config).unwrap_or_else(|e| panic!("{e:?}"));
+    anim_pipeline::keyframe::run_generate(&config).unwrap_or_else(|e| panic!("{e:?}"));
     let frame = dir.path().join("frames/frame_0000.sdf");
     let text = std::fs::read_to_string(&frame).unwrap();
     for layout in [
-        anim::sdf::MaterialLayout::Auto,
-        anim::sdf::MaterialLayout::standard(),
+        anim_core::sdf::MaterialLayout::Auto,
+        anim_core::sdf::MaterialLayout::standard(),
     ] {
         let opts = LoadOptions {
             material_fields: layout.clone(),
             ..LoadOptions::default()
         };
-        let loaded = anim::scene::load_str(&text, &frame, &opts)
+        let loaded = anim_core::scene::load_str(&text, &frame, &opts)
             .unwrap_or_else(|e| panic!("{layout:?}: {e:?}\n{text}"));
         let red = &loaded.jobs[0].scene.materials[0];
         assert_eq!(

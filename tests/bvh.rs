@@ -4,12 +4,12 @@
 //! render scene (spheres packed four to a test, leaf-ordered storage) is held to the same
 //! standard, and its hits to the bits `Primitive` computes.
 
-use anim::accel::{Bvh, Packet};
-use anim::math::{Ray, Transform};
-use anim::render::compile::{RenderScene, Shadow};
-use anim::render::primitive::{Primitive, SurfaceHit};
-use anim::scene::{Instance, Material, Scene};
-use anim::shape::Geometry;
+use anim_core::accel::{Bvh, Packet};
+use anim_core::math::{Ray, Transform};
+use anim_core::render::compile::{RenderScene, Shadow};
+use anim_core::render::primitive::{Primitive, SurfaceHit};
+use anim_core::scene::{Instance, Material, Scene};
+use anim_core::shape::Geometry;
 use glam::{DVec3, Vec3, Vec3A};
 
 struct Rng(u64);
@@ -371,7 +371,7 @@ fn check_packets(rng: &mut Rng, scene: &RenderScene, lo: DVec3, size: DVec3) -> 
         packets += usize::from(Packet::new(&rays).is_some());
         let together = scene.closest_packet(&rays, t_limit);
         for (k, ray) in rays.iter().enumerate() {
-            let bits = |h: Option<(u32, anim::render::primitive::SurfaceHit)>| {
+            let bits = |h: Option<(u32, anim_core::render::primitive::SurfaceHit)>| {
                 h.map(|(id, h)| {
                     (
                         id,
@@ -396,13 +396,13 @@ mod composites;
 
 /// The render scene of a file's first job.
 fn loaded_scene(text: &str) -> Scene {
-    let loaded = anim::scene::load_str(
+    let loaded = anim_core::scene::load_str(
         text,
         std::path::Path::new("scene.sdf"),
         // A small budget: the composites are then worth instancing.
-        &anim::sdf::LoadOptions {
+        &anim_core::sdf::LoadOptions {
             max_memory: 1 << 20,
-            ..anim::sdf::LoadOptions::default()
+            ..anim_core::sdf::LoadOptions::default()
         },
     )
     .unwrap_or_else(|d| panic!("{d:?}"));
@@ -473,7 +473,8 @@ fn instanced_render_scene_equals_flattened_and_brute_force() {
             let t_limit = t_limit_of(i);
             let brute = brute_in_tree_order(&prims, &ray, t_limit);
             let (ha, hb) = (a.closest(&ray, t_limit), b.closest(&ray, t_limit));
-            let bits = |h: &Option<(u32, anim::render::primitive::SurfaceHit)>, s: &RenderScene| {
+            let bits = |h: &Option<(u32, anim_core::render::primitive::SurfaceHit)>,
+                        s: &RenderScene| {
                 h.map(|(id, h)| {
                     (
                         h.t.to_bits(),
@@ -616,7 +617,7 @@ fn lit_scene(
         transforms,
         lights: lights
             .iter()
-            .map(|&position| anim::scene::Light {
+            .map(|&position| anim_core::scene::Light {
                 name: "l".into(),
                 position,
                 intensity: Vec3::ONE,
@@ -717,8 +718,8 @@ fn tally_shadows(
 /// are blocked exactly when brute force finds a hit before the light.
 #[test]
 fn rays_through_image_tiles_meet_what_brute_force_meets() {
-    use anim::render::camera::CameraRays;
-    use anim::scene::Camera;
+    use anim_core::render::camera::CameraRays;
+    use anim_core::scene::Camera;
     let mut rng = Rng(0xD1B54A32D192ED03);
     let (mut blocked, mut clear, mut seen_hits) = (0, 0, 0);
     // Enough shapes for tiles around the lights too (64 bounded, `LIGHT_TILES_MIN`).

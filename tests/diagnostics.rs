@@ -2,9 +2,9 @@
 //! diagnostic it must produce (or that it must produce none). The rows run through the
 //! library; a handful of error rows also run through the real `anim render` binary.
 
-use anim::diag::{Diagnostic, Severity};
-use anim::scene::load_str;
-use anim::sdf::LoadOptions;
+use anim_core::diag::{Diagnostic, Severity};
+use anim_core::scene::load_str;
+use anim_core::sdf::LoadOptions;
 use assert_cmd::Command;
 use std::path::Path;
 

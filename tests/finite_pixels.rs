@@ -4,9 +4,9 @@
 
 mod common;
 
-use anim::render::{render_job, RenderSettings};
-use anim::scene::load_file;
-use anim::sdf::LoadOptions;
+use anim_core::render::{render_job, RenderSettings};
+use anim_core::scene::load_file;
+use anim_core::sdf::LoadOptions;
 use std::path::{Path, PathBuf};
 
 /// Scene files below `dir`: `.sdf`, `.txt` and files without an extension (as the corpus

@@ -13,10 +13,10 @@
 //! `FUZZ_EXECS` (default 100 000), `FUZZ_SEED` (1), `FUZZ_CORPUS` (`../shared/corpus`),
 //! `FUZZ_TIMEOUT_MS` (2000), `FUZZ_OUT` (`target/fuzz-findings`).
 
-use anim::anim::generate::BaseScene;
-use anim::anim::spec::{self, Source};
-use anim::scene::load_str;
-use anim::sdf::{LoadOptions, MaterialField, TransformOrder};
+use anim_core::scene::load_str;
+use anim_core::sdf::{LoadOptions, MaterialField, TransformOrder};
+use anim_pipeline::keyframe::generate::BaseScene;
+use anim_pipeline::keyframe::spec::{self, Source};
 use std::panic::{self, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
@@ -348,7 +348,7 @@ fn execute(target: Target, input: &[u8], variant: u64, base: &BaseScene) {
                     ..LoadOptions::default()
                 },
                 _ => LoadOptions {
-                    material_fields: anim::sdf::MaterialLayout::Fields(vec![
+                    material_fields: anim_core::sdf::MaterialLayout::Fields(vec![
                         MaterialField::Reflectivity,
                         MaterialField::Transparency,
                         MaterialField::Ior,
@@ -376,8 +376,11 @@ fn execute(target: Target, input: &[u8], variant: u64, base: &BaseScene) {
             if let Ok(file) = spec::parse(&src) {
                 let names = match &file.scene {
                     spec::SceneSource::Inline(scene) => {
-                        let (statements, _) =
-                            anim::sdf::parse(scene, Path::new("fuzz.ron"), &LoadOptions::default());
+                        let (statements, _) = anim_core::sdf::parse(
+                            scene,
+                            Path::new("fuzz.ron"),
+                            &LoadOptions::default(),
+                        );
                         Some(BaseScene::new(statements))
                     }
                     spec::SceneSource::File(_) => None,
@@ -400,7 +403,8 @@ fn base_scene(repo: &Path) -> BaseScene {
         text.push_str(&std::fs::read_to_string(repo.join(f)).unwrap_or_default());
         text.push('\n');
     }
-    let (statements, _) = anim::sdf::parse(&text, Path::new("base.sdf"), &LoadOptions::default());
+    let (statements, _) =
+        anim_core::sdf::parse(&text, Path::new("base.sdf"), &LoadOptions::default());
     BaseScene::new(statements)
 }
 

@@ -4,15 +4,15 @@
 
 mod common;
 
-use anim::scene::probe::{classify, Classification};
-use anim::sdf::LoadOptions;
+use anim_core::scene::probe::{classify, Classification};
+use anim_core::sdf::LoadOptions;
 use common::{anim, shared_dir};
 use std::path::{Path, PathBuf};
 
 /// `--material-fields auto`, as the command line's default.
 fn auto() -> LoadOptions {
     LoadOptions {
-        material_fields: anim::sdf::MaterialLayout::Auto,
+        material_fields: anim_core::sdf::MaterialLayout::Auto,
         ..LoadOptions::default()
     }
 }

@@ -1,36 +1,55 @@
-//! The architecture, checked: imports run one way through the layers below, no two files
-//! import each other (directly or round a loop), only the command layer knows the command
-//! line, and no source file grows past what one reader can hold.
+//! The architecture, checked: crates depend one way (Cargo enforces it: the `anim` command
+//! → {anim-pipeline, anim-bench} → anim-core), imports inside each crate run one way through
+//! its layers below, no two files import each other (directly or round a loop), only the
+//! command layer knows the command line and prints, and no source file grows past what one
+//! reader can hold.
 //!
-//! The layers, top to bottom (a module may import only modules of lower layers):
+//! The layers of each crate, top to bottom (a module may import only modules of lower layers
+//! of its own crate):
 //!
 //! ```text
-//! cli → app → {pipeline, anim, bench} → render → scene → sdf → shape → accel → math
-//!     → limits → {diag, util}
+//! anim (the command):  cli → app
+//! anim-pipeline:       {frames, keyframe}
+//! anim-bench:          stress → report → {pov, rehit} → {plot, metrics}
+//! anim-core:           render → scene → sdf → shape → accel → math → limits → {diag, util}
 //! ```
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-const LAYERS: &[&[&str]] = &[
-    &["cli"],
-    &["app"],
-    &["pipeline", "anim", "bench"],
-    &["render"],
-    &["scene"],
-    &["sdf"],
-    &["shape"],
-    &["accel"],
-    &["math"],
-    &["limits"],
-    &["diag", "util"],
+/// Each crate of the workspace: its source folder (from the workspace root) and its layers.
+const CRATES: &[(&str, &[&[&str]])] = &[
+    ("src", &[&["cli"], &["app"]]),
+    ("crates/anim-pipeline/src", &[&["frames", "keyframe"]]),
+    (
+        "crates/anim-bench/src",
+        &[
+            &["stress"],
+            &["report"],
+            &["pov", "rehit"],
+            &["plot", "metrics"],
+        ],
+    ),
+    (
+        "crates/anim-core/src",
+        &[
+            &["render"],
+            &["scene"],
+            &["sdf"],
+            &["shape"],
+            &["accel"],
+            &["math"],
+            &["limits"],
+            &["diag", "util"],
+        ],
+    ),
 ];
 
 /// About as much as one reader holds in mind; tests beside the code may run longer.
 const MAX_LINES: usize = 900;
 
-fn layer_of(module: &str) -> Option<usize> {
-    LAYERS.iter().position(|l| l.contains(&module))
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -127,20 +146,32 @@ fn expand<'a>(text: &'a str, base: Vec<&'a str>, out: &mut Vec<Vec<&'a str>>) {
 }
 
 struct Crate {
+    /// The crate's source folder, from the workspace root.
+    src: &'static str,
+    layers: &'static [&'static [&'static str]],
     /// Module path → file.
     files: BTreeMap<Vec<String>, PathBuf>,
 }
 
 impl Crate {
-    fn load() -> Crate {
-        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-        let mut paths = Vec::new();
-        rust_files(&src, &mut paths);
-        let files = paths
-            .into_iter()
-            .map(|f| (module_path(&src, &f), f))
-            .collect();
-        Crate { files }
+    fn all() -> Vec<Crate> {
+        CRATES
+            .iter()
+            .map(|&(src, layers)| {
+                let dir = root().join(src);
+                let mut paths = Vec::new();
+                rust_files(&dir, &mut paths);
+                let files = paths
+                    .into_iter()
+                    .map(|f| (module_path(&dir, &f), f))
+                    .collect();
+                Crate { src, layers, files }
+            })
+            .collect()
+    }
+
+    fn layer_of(&self, module: &str) -> Option<usize> {
+        self.layers.iter().position(|l| l.contains(&module))
     }
 
     /// The longest module path of a file that prefixes `path`.
@@ -183,30 +214,38 @@ impl Crate {
 
 #[test]
 fn imports_run_down_the_layers() {
-    let krate = Crate::load();
     let mut problems = Vec::new();
-    // Tests beside the code may drive their module through higher layers (a parser test that
-    // builds the scene, say): they are not part of the layering.
-    for module in krate.files.keys().filter(|m| !krate.is_test_file(m)) {
-        let Some(top) = module.first() else { continue };
-        let Some(from) = layer_of(top) else {
-            if top != "main" {
-                problems.push(format!("src/{top}: not in any layer of this test"));
-            }
-            continue;
-        };
-        for target in krate.references(module) {
-            let to_top = &target[0];
-            if to_top == top {
+    for krate in Crate::all() {
+        // Tests beside the code may drive their module through higher layers (a parser test
+        // that builds the scene, say): they are not part of the layering.
+        for module in krate.files.keys().filter(|m| !krate.is_test_file(m)) {
+            let Some(top) = module.first() else { continue };
+            let Some(from) = krate.layer_of(top) else {
+                if top != "main" {
+                    problems.push(format!(
+                        "{}/{top}: not in any layer of this test",
+                        krate.src
+                    ));
+                }
                 continue;
-            }
-            match layer_of(to_top) {
-                Some(to) if to > from => {}
-                _ => problems.push(format!(
-                    "{} imports {} (layer {from} may import only lower layers)",
-                    module.join("::"),
-                    target.join("::")
-                )),
+            };
+            for target in krate.references(module) {
+                let Some(to_top) = target.first() else {
+                    // The crate's root (its `lib.rs`) is the crate's face.
+                    continue;
+                };
+                if to_top == top {
+                    continue;
+                }
+                match krate.layer_of(to_top) {
+                    Some(to) if to > from => {}
+                    _ => problems.push(format!(
+                        "{}: {} imports {} (layer {from} may import only lower layers)",
+                        krate.src,
+                        module.join("::"),
+                        target.join("::")
+                    )),
+                }
             }
         }
     }
@@ -218,7 +257,12 @@ fn imports_run_down_the_layers() {
 /// between it and its own files are not counted.
 #[test]
 fn no_import_circles_between_files() {
-    let krate = Crate::load();
+    for krate in Crate::all() {
+        no_circles_in(&krate);
+    }
+}
+
+fn no_circles_in(krate: &Crate) {
     let mut edges: BTreeMap<Vec<String>, BTreeSet<Vec<String>>> = BTreeMap::new();
     for module in krate.files.keys() {
         if krate.is_test_file(module) {
@@ -273,39 +317,53 @@ fn no_import_circles_between_files() {
 
 #[test]
 fn only_the_command_layer_knows_the_command_line() {
-    let krate = Crate::load();
-    let offenders: Vec<String> = krate
-        .files
-        .keys()
-        .filter(|m| m.first().is_some_and(|t| t != "cli" && t != "main"))
-        .filter(|m| krate.references(m).iter().any(|t| t[0] == "cli"))
-        .map(|m| m.join("::"))
-        .collect();
-    assert!(offenders.is_empty(), "import the CLI types: {offenders:?}");
-    // Printing and exit codes belong to the command layer too.
-    let mut printers = Vec::new();
-    for (module, file) in &krate.files {
-        if module.first().is_none_or(|t| t == "app" || t == "main") || krate.is_test_file(module) {
-            continue;
-        }
-        let text = std::fs::read_to_string(file).unwrap();
-        let body = text.split("#[cfg(test)]").next().unwrap_or("");
-        for word in ["println!", "eprintln!", "ExitCode"] {
-            if code_lines(body).any(|l| l.contains(word)) {
-                printers.push(format!("{} uses {word}", module.join("::")));
+    for krate in Crate::all() {
+        let offenders: Vec<String> = krate
+            .files
+            .keys()
+            .filter(|m| m.first().is_some_and(|t| t != "cli" && t != "main"))
+            .filter(|m| {
+                krate
+                    .references(m)
+                    .iter()
+                    .any(|t| t.first().is_some_and(|t| t == "cli"))
+            })
+            .map(|m| m.join("::"))
+            .collect();
+        assert!(offenders.is_empty(), "import the CLI types: {offenders:?}");
+        // Printing and exit codes belong to the command layer (of the `anim` crate) alone.
+        let mut printers = Vec::new();
+        for (module, file) in &krate.files {
+            let command_layer =
+                krate.src == "src" && module.first().is_none_or(|t| t == "app" || t == "main");
+            if command_layer || krate.is_test_file(module) {
+                continue;
+            }
+            let text = std::fs::read_to_string(file).unwrap();
+            let body = text.split("#[cfg(test)]").next().unwrap_or("");
+            for word in ["print!", "println!", "eprint!", "eprintln!", "ExitCode"] {
+                if code_lines(body).any(|l| l.contains(word)) {
+                    printers.push(format!("{}: {} uses {word}", krate.src, module.join("::")));
+                }
             }
         }
+        assert!(printers.is_empty(), "{}", printers.join("\n"));
     }
-    assert!(printers.is_empty(), "{}", printers.join("\n"));
+}
+
+/// Every Rust file of the workspace: the crates' sources and the integration tests.
+fn workspace_files() -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for (src, _) in CRATES {
+        rust_files(&root().join(src), &mut files);
+    }
+    rust_files(&root().join("tests"), &mut files);
+    files
 }
 
 #[test]
 fn no_source_file_is_longer_than_a_reader_can_hold() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut files = Vec::new();
-    rust_files(&root.join("src"), &mut files);
-    rust_files(&root.join("tests"), &mut files);
-    let long: Vec<String> = files
+    let long: Vec<String> = workspace_files()
         .iter()
         .filter_map(|f| {
             let n = std::fs::read_to_string(f).unwrap().lines().count();

@@ -106,7 +106,7 @@ fn to_rgb8(img: &Pfm) -> Rgb8 {
             .pixels
             .iter()
             .flatten()
-            .map(|&c| anim::render::film::tone_map_u8(c))
+            .map(|&c| anim_core::render::film::tone_map_u8(c))
             .collect(),
     }
 }

@@ -2,9 +2,9 @@
 //! the fraction of the exposure it covers each pixel (derived here), determinism across
 //! thread counts, and `motion` lines that move nothing leaving the frame as it was.
 
-use anim::render::{render_job, RenderSettings};
-use anim::scene::{load_str, RenderJob};
-use anim::sdf::LoadOptions;
+use anim_core::render::{render_job, RenderSettings};
+use anim_core::scene::{load_str, RenderJob};
+use anim_core::sdf::LoadOptions;
 use std::path::Path;
 
 const W: u32 = 48;

@@ -1,9 +1,9 @@
 //! Motion blur in the keyframe pipeline: the spec's `shutter`, the `motion` lines of blurred
 //! frames (docs/scene-language.md §10) and how `anim check` reads them.
 
-use anim::math::Transform;
-use anim::sdf::ast::{Statement, StatementKind, TransformOp};
-use anim::sdf::LoadOptions;
+use anim_core::math::Transform;
+use anim_core::sdf::ast::{Statement, StatementKind, TransformOp};
+use anim_core::sdf::LoadOptions;
 use assert_cmd::Command;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
@@ -188,7 +188,7 @@ fn a_shutter_outside_0_to_1_is_a_located_error() {
 
 fn statements(text: &str) -> Vec<Statement> {
     let (statements, diags) =
-        anim::sdf::parse(text, Path::new("frame.sdf"), &LoadOptions::default());
+        anim_core::sdf::parse(text, Path::new("frame.sdf"), &LoadOptions::default());
     assert!(diags.is_empty(), "{diags:?}\n{text}");
     statements
 }

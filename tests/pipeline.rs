@@ -3,7 +3,7 @@
 
 use anim::app::RenderConfig;
 use anim::cli::{Cli, Command as Sub};
-use anim::pipeline::{self, record_path, Summary};
+use anim_pipeline::frames::{self, record_path, Summary};
 use assert_cmd::Command;
 use clap::Parser;
 use std::io::Write as _;
@@ -49,13 +49,13 @@ fn args(dir: &Path, extra: &[&str]) -> RenderConfig {
 }
 
 /// Renders a frame directory through the library, as `anim render DIR` does.
-fn run(dir: &Path, config: &RenderConfig) -> Result<Summary, Vec<anim::diag::Diagnostic>> {
-    pipeline::render_dir(
+fn run(dir: &Path, config: &RenderConfig) -> Result<Summary, Vec<anim_core::diag::Diagnostic>> {
+    frames::render_dir(
         dir,
         &config.settings,
         &config.load,
         &config.frames,
-        &pipeline::NoProgress,
+        &frames::NoProgress,
     )
 }
 
@@ -465,7 +465,7 @@ fn committed_animations_generate_frames_that_load() {
             Sub::Generate(a) => a.config(),
             _ => unreachable!("a generate command"),
         };
-        let report = anim::anim::run_generate(&args).unwrap_or_else(|e| {
+        let report = anim_pipeline::keyframe::run_generate(&args).unwrap_or_else(|e| {
             panic!(
                 "{spec}: {}",
                 e.iter()
@@ -478,7 +478,7 @@ fn committed_animations_generate_frames_that_load() {
         assert!(report.warnings.is_empty(), "{spec}: {:?}", report.warnings);
         for i in [0, frames / 2, frames - 1] {
             let path = out.path().join(format!("frame_{i:04}.sdf"));
-            let loaded = anim::scene::load_file(&path, &Default::default())
+            let loaded = anim_core::scene::load_file(&path, &Default::default())
                 .unwrap_or_else(|e| panic!("{}: {e:?}", path.display()));
             assert_eq!(loaded.jobs.len(), 1);
             assert_eq!(

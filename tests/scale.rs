@@ -4,8 +4,8 @@
 
 mod common;
 
-use anim::limits::scene_memory;
-use anim::util::human_bytes;
+use anim_core::limits::scene_memory;
+use anim_core::util::human_bytes;
 use common::{anim, read_ppm};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -120,7 +120,7 @@ fn random_spheres(n: usize) -> String {
 }
 
 /// The whole front end of `anim render` before the hierarchy is built: reading the file
-/// from disk, tokenizing, parsing and building the scene (`anim::scene::load_file`, with the
+/// from disk, tokenizing, parsing and building the scene (`anim_core::scene::load_file`, with the
 /// command line's default options), on a flat file of a million random spheres, in lines per
 /// CPU-second of the loading thread; it fails below 1.5 M lines/s (BENCHMARKS.md §10: about
 /// 2 M measured, 1 M before the reader took flat lines directly). A measurement, run by
@@ -135,15 +135,15 @@ fn the_loader_loads_one_and_a_half_million_lines_a_second() {
     let text = random_spheres(n);
     let lines = text.lines().count();
     std::fs::write(&path, text).unwrap();
-    let opts = anim::sdf::LoadOptions {
-        material_fields: anim::sdf::MaterialLayout::Auto,
+    let opts = anim_core::sdf::LoadOptions {
+        material_fields: anim_core::sdf::MaterialLayout::Auto,
         infer_transform_order: true,
-        ..anim::sdf::LoadOptions::default()
+        ..anim_core::sdf::LoadOptions::default()
     };
     let mut best = f64::INFINITY;
     for _ in 0..5 {
         let start = cpu_time::ThreadTime::now();
-        let loaded = anim::scene::load_file(&path, &opts).expect("loads");
+        let loaded = anim_core::scene::load_file(&path, &opts).expect("loads");
         let seconds = start.elapsed().as_secs_f64();
         assert_eq!(loaded.jobs[0].scene.instances.len(), n);
         drop(loaded);
@@ -157,7 +157,7 @@ fn the_loader_loads_one_and_a_half_million_lines_a_second() {
     assert!(rate >= 1.5e6, "{:.2} M lines/s", rate / 1e6);
 }
 
-/// The reader alone (`anim::sdf::parse_source`, no scene building) on a flat file of a million
+/// The reader alone (`anim_core::sdf::parse_source`, no scene building) on a flat file of a million
 /// random spheres, in lines per CPU-second of the reading thread, against issue 8's target of
 /// 2 M lines/s. A measurement, run by scripts/bench-scale.sh:
 /// `cargo test --release --test scale -- --ignored --nocapture the_reader_reads`.
@@ -167,11 +167,11 @@ fn the_reader_reads_two_million_lines_a_second() {
     let n = 1_000_000;
     let text = random_spheres(n);
     let lines = text.lines().count();
-    let opts = anim::sdf::LoadOptions::default();
+    let opts = anim_core::sdf::LoadOptions::default();
     let mut best = f64::INFINITY;
     for _ in 0..5 {
         let start = cpu_time::ThreadTime::now();
-        let parsed = anim::sdf::parse_source(&text, Path::new("spheres.sdf"), &opts);
+        let parsed = anim_core::sdf::parse_source(&text, Path::new("spheres.sdf"), &opts);
         let seconds = start.elapsed().as_secs_f64();
         assert_eq!(parsed.shapes.len(), n);
         assert!(parsed.diagnostics.iter().all(|d| !d.is_error()));

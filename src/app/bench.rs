@@ -1,6 +1,6 @@
 //! `anim bench`: progress on stderr, the Markdown tables on stdout, files in `--out`.
 
-use crate::bench::{self, stress, BenchConfig};
+use anim_bench::{stress, BenchConfig};
 use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -17,10 +17,10 @@ pub fn run(config: &BenchConfig, stress_table: bool, out: Option<&Path>) -> Exit
             }
         })
     } else {
-        bench::run(config, &mut progress).and_then(|report| {
-            print!("{}", bench::markdown(&report));
+        anim_bench::run(config, &mut progress).and_then(|report| {
+            print!("{}", anim_bench::markdown(&report));
             match out {
-                Some(dir) => bench::write_outputs(&report, dir),
+                Some(dir) => anim_bench::write_outputs(&report, dir),
                 None => Ok(Vec::new()),
             }
         })

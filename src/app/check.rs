@@ -1,8 +1,8 @@
 //! `anim check FILE|DIR...`: load scene files without rendering and report every problem.
 
-use crate::diag::Diagnostic;
-use crate::scene::{load_file, probe};
-use crate::sdf::LoadOptions;
+use anim_core::diag::Diagnostic;
+use anim_core::scene::{load_file, probe};
+use anim_core::sdf::LoadOptions;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 

@@ -1,11 +1,11 @@
 //! `anim generate SPEC.ron`: one SDF file per frame of a keyframe spec.
 
-use crate::anim::{self, GenerateConfig};
+use anim_pipeline::keyframe::{self, GenerateConfig};
 use std::process::ExitCode;
 
 /// Prints warnings (unless `quiet`), errors and what was written.
 pub fn run(config: &GenerateConfig, quiet: bool) -> ExitCode {
-    match anim::run_generate(config) {
+    match keyframe::run_generate(config) {
         Ok(report) => {
             if !quiet {
                 for w in &report.warnings {
@@ -13,7 +13,7 @@ pub fn run(config: &GenerateConfig, quiet: bool) -> ExitCode {
                 }
                 let length = format!(
                     "{} s at {} fps",
-                    anim::tidy::tidy(report.frames as f64 / report.fps as f64),
+                    keyframe::tidy::tidy(report.frames as f64 / report.fps as f64),
                     report.fps
                 );
                 let mut line = if report.written == report.frames {

@@ -8,12 +8,12 @@ mod generate;
 mod progress;
 mod render;
 
-pub use crate::anim::GenerateConfig;
-pub use crate::bench::BenchConfig;
+pub use anim_bench::BenchConfig;
+pub use anim_pipeline::keyframe::GenerateConfig;
 pub use check::CheckConfig;
 pub use render::RenderConfig;
 
-use crate::limits;
+use anim_core::limits;
 use std::path::PathBuf;
 use std::process::ExitCode;
 

@@ -1,7 +1,7 @@
 //! Progress on the terminal: a bar for a long single-file render, and for a frame directory a
 //! bar on a terminal or one plain line per frame otherwise (logs, Slurm output).
 
-use crate::pipeline::{FrameObserver, FrameOutcome, ImageProgress};
+use anim_pipeline::frames::{FrameObserver, FrameOutcome, ImageProgress};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};

@@ -2,9 +2,9 @@
 //! directories rendered frames in parallel; warnings, errors and a summary on stderr.
 
 use super::progress::{plural, FrameLog, LazyBar};
-use crate::pipeline::{self, FrameOptions, Summary};
-use crate::render::RenderSettings;
-use crate::sdf::LoadOptions;
+use anim_core::render::RenderSettings;
+use anim_core::sdf::LoadOptions;
+use anim_pipeline::frames::{self, FrameOptions, Summary};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -39,7 +39,7 @@ pub fn run(config: &RenderConfig) -> ExitCode {
 fn render_file(input: &Path, config: &RenderConfig) -> bool {
     let start = Instant::now();
     let bar = LazyBar::new(!config.quiet);
-    match pipeline::render_scene_file(input, &config.load, &config.settings, &bar) {
+    match frames::render_scene_file(input, &config.load, &config.settings, &bar) {
         Ok(outcome) => {
             if !config.quiet {
                 for w in &outcome.warnings {
@@ -77,7 +77,7 @@ fn render_file(input: &Path, config: &RenderConfig) -> bool {
 /// directory cannot be read or holds no `.sdf` file).
 fn render_dir(dir: &Path, config: &RenderConfig) -> bool {
     let log = FrameLog::new(config.quiet);
-    match pipeline::render_dir(dir, &config.settings, &config.load, &config.frames, &log) {
+    match frames::render_dir(dir, &config.settings, &config.load, &config.frames, &log) {
         Ok(summary) => {
             print_summary(dir, &summary, config.quiet);
             summary.failed.is_empty()

@@ -14,9 +14,9 @@
 //! Randomness is a seeded SplitMix64, so every failure message (kind, seed, object, ray)
 //! reproduces exactly.
 
-use anim::math::{Ray, Transform};
-use anim::render::primitive::{Primitive, SurfaceHit};
-use anim::scene::Geometry;
+use anim_core::math::{Ray, Transform};
+use anim_core::render::primitive::{Primitive, SurfaceHit};
+use anim_core::scene::Geometry;
 use glam::{DVec3, Vec3A};
 use proptest::prelude::*;
 use std::collections::HashMap;

@@ -1,7 +1,7 @@
 //! The checked animation: what the generator needs, with every value valid.
 
-use crate::anim::interp::{sample, Interp, Key, Keyable};
-use crate::limits;
+use crate::keyframe::interp::{sample, Interp, Key, Keyable};
+use anim_core::limits;
 use glam::DVec3;
 
 /// A keyed channel with the path of its key list (for messages about interpolated values).

@@ -12,9 +12,9 @@
 use super::rehit::{self, RehitCount, KINDS};
 use super::report::write_text;
 use super::{load_scenes, render_measured, BenchConfig, BenchScene};
-use crate::math::Transform;
-use crate::render::RenderSettings;
-use crate::scene::RenderJob;
+use anim_core::math::Transform;
+use anim_core::render::RenderSettings;
+use anim_core::scene::RenderJob;
 use glam::DVec3;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -105,7 +105,7 @@ pub struct StressReport {
 /// difference is one ray's difference, not averaged away.
 pub const STRESS_SPP: u32 = 1;
 
-fn nonfinite(hdr: &crate::render::HdrImage) -> usize {
+fn nonfinite(hdr: &anim_core::render::HdrImage) -> usize {
     hdr.pixels.iter().filter(|p| !p.is_finite()).count()
 }
 
@@ -125,10 +125,14 @@ const ANISOTROPIC_SDF: &str = include_str!("anisotropic.sdf");
 
 fn anisotropic_scene() -> Result<BenchScene, String> {
     let file = PathBuf::from("anisotropic.sdf (built in)");
-    let job = crate::scene::load_str(ANISOTROPIC_SDF, &file, &crate::sdf::LoadOptions::default())
-        .map_err(|d| format!("the built-in stress scene does not load: {d:?}"))?
-        .jobs
-        .remove(0);
+    let job = anim_core::scene::load_str(
+        ANISOTROPIC_SDF,
+        &file,
+        &anim_core::sdf::LoadOptions::default(),
+    )
+    .map_err(|d| format!("the built-in stress scene does not load: {d:?}"))?
+    .jobs
+    .remove(0);
     Ok(BenchScene {
         name: ANISOTROPIC.into(),
         file,
@@ -281,8 +285,8 @@ pub fn write_outputs(report: &StressReport, dir: &Path) -> Result<Vec<PathBuf>, 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::load_str;
-    use crate::sdf::LoadOptions;
+    use anim_core::scene::load_str;
+    use anim_core::sdf::LoadOptions;
 
     #[test]
     fn within_1lsb_counts_pixels() {

@@ -10,8 +10,8 @@
 use super::orbit::{self, Pose};
 use super::spec::{Animation, Track};
 use super::tidy::{tidy, tidy3};
-use crate::limits;
-use crate::sdf::ast::TransformOp;
+use anim_core::limits;
+use anim_core::sdf::ast::TransformOp;
 use glam::{DMat3, DQuat, DVec3};
 
 /// Where a track puts its target at one instant: its keyed translation, turn and scale.
@@ -251,7 +251,7 @@ pub fn steps(anim: &Animation, i: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::Transform;
+    use anim_core::math::Transform;
 
     fn matrix(ops: &[TransformOp]) -> Transform {
         ops.iter().fold(Transform::IDENTITY, |m, op| {

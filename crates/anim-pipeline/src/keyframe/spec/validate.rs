@@ -5,11 +5,11 @@
 use super::model::{Animation, Channel, NamePattern, Orbit, SceneNames, TargetKind, Track};
 use super::raw::{KeySpec, Length, OrbitSpec, Rgb, Scale, SpecFile, TrackSpec, V3};
 use super::source::Source;
-use crate::anim::interp::Key;
-use crate::anim::locate::{field, index};
-use crate::anim::tidy::tidy;
-use crate::diag::{suggest, Diagnostic};
-use crate::limits;
+use crate::keyframe::interp::Key;
+use crate::keyframe::locate::{field, index};
+use crate::keyframe::tidy::tidy;
+use anim_core::diag::{suggest, Diagnostic};
+use anim_core::limits;
 use glam::DVec3;
 
 /// Largest frame count accepted: far beyond any real use, small enough to catch `fps: 24000`.

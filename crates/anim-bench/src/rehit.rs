@@ -18,13 +18,13 @@
 //! negligible rays) plus two directions drawn at random on each side of the surface, so that
 //! rays leave at every angle, grazing ones included.
 
-use crate::math::{reflect, Ray};
-use crate::render::camera::CameraRays;
-use crate::render::compile::RenderScene;
-use crate::render::integrator::fresnel;
-use crate::render::primitive::SurfaceHit;
-use crate::scene::RenderJob;
-use crate::shape::Shape;
+use anim_core::math::{reflect, Ray};
+use anim_core::render::camera::CameraRays;
+use anim_core::render::compile::RenderScene;
+use anim_core::render::integrator::fresnel;
+use anim_core::render::primitive::SurfaceHit;
+use anim_core::scene::RenderJob;
+use anim_core::shape::Shape;
 use glam::Vec3A;
 use rayon::prelude::*;
 
@@ -197,8 +197,8 @@ pub fn count(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::load_str;
-    use crate::sdf::LoadOptions;
+    use anim_core::scene::load_str;
+    use anim_core::sdf::LoadOptions;
     use std::path::Path;
 
     fn job(text: &str) -> RenderJob {

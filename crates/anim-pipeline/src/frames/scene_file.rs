@@ -1,13 +1,13 @@
 //! One scene file from text to image files: load it, render every image its render lines ask
 //! for, and write each atomically (a reader never sees a half-written image).
 
-use crate::diag::{Diagnostic, Severity};
-use crate::limits;
-use crate::render::camera::CameraError;
-use crate::render::film::{self, ImageBytes, ImageFormat};
-use crate::render::{render_job, RayCounts, RenderSettings, Rendered};
-use crate::scene::RenderJob;
-use crate::sdf::LoadOptions;
+use anim_core::diag::{Diagnostic, Severity};
+use anim_core::limits;
+use anim_core::render::camera::CameraError;
+use anim_core::render::film::{self, ImageBytes, ImageFormat};
+use anim_core::render::{render_job, RayCounts, RenderSettings, Rendered};
+use anim_core::scene::RenderJob;
+use anim_core::sdf::LoadOptions;
 use std::path::{Component, Path, PathBuf};
 
 /// An image file written, with what was written to it.
@@ -124,11 +124,11 @@ pub fn render_scene_file(
     settings: &RenderSettings,
     progress: &dyn ImageProgress,
 ) -> Result<FileOutcome, Vec<Diagnostic>> {
-    let loaded = crate::scene::load_file(path, load)?;
+    let loaded = anim_core::scene::load_file(path, load)?;
     let mut warnings = loaded.diagnostics;
     // A file that loads but would render one flat colour says why, instead of handing back a
     // blank image in silence.
-    warnings.extend(crate::scene::probe::blank_image_warnings(
+    warnings.extend(anim_core::scene::probe::blank_image_warnings(
         &loaded.jobs,
         path,
     ));

@@ -8,10 +8,10 @@ use super::cache::{
 };
 use super::scene_file::{render_scene_file, NoProgress};
 use super::Shard;
-use crate::diag::Diagnostic;
-use crate::render::RenderSettings;
-use crate::sdf::LoadOptions;
-use crate::util::remove_stale_temp_files;
+use anim_core::diag::Diagnostic;
+use anim_core::render::RenderSettings;
+use anim_core::sdf::LoadOptions;
+use anim_core::util::remove_stale_temp_files;
 use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::collections::BTreeMap;

@@ -44,7 +44,7 @@ pub fn pose_at(orbit: &Orbit, t: f64, duration: f64) -> Option<Pose> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::anim::interp::Interp;
+    use crate::keyframe::interp::Interp;
 
     fn orbit() -> Orbit {
         Orbit {

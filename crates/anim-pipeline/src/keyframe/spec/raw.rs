@@ -1,7 +1,7 @@
 //! The spec as the user writes it: serde types that mirror the RON text one to one, so that
 //! ron rejects every unknown field and variant with its position.
 
-use crate::anim::interp::Interp;
+use crate::keyframe::interp::Interp;
 use glam::DVec3;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;

@@ -7,7 +7,7 @@ use plotters::prelude::*;
 use std::path::Path;
 use std::sync::OnceLock;
 
-const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+const FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
 const SIZE: (u32, u32) = (800, 560);
 
 /// plotters' `ab_glyph` text looks fonts up by family name; the default family of labels is
@@ -104,7 +104,7 @@ pub fn time_vs_error(path: &Path, scene: &str, rows: &[&Row]) -> Result<(), Stri
     let mut png = std::io::Cursor::new(Vec::new());
     rgb.write_to(&mut png, image::ImageFormat::Png)
         .map_err(|e| format!("cannot encode {}: {e}", path.display()))?;
-    crate::util::write_atomically(path, |w| std::io::Write::write_all(w, png.get_ref()))
+    anim_core::util::write_atomically(path, |w| std::io::Write::write_all(w, png.get_ref()))
         .map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 

@@ -136,7 +136,7 @@ pub fn write_outputs(report: &BenchReport, dir: &Path) -> Result<Vec<PathBuf>, S
 }
 
 pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), String> {
-    crate::util::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes()))
+    anim_core::util::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes()))
         .map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 

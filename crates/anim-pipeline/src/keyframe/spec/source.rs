@@ -1,8 +1,8 @@
 //! The spec's text with the position of every value in it, and ron's errors turned into
 //! located diagnostics in the user's terms.
 
-use crate::anim::locate::{Locations, Pos};
-use crate::diag::{suggest, Diagnostic, Loc, Severity};
+use crate::keyframe::locate::{Locations, Pos};
+use anim_core::diag::{suggest, Diagnostic, Loc, Severity};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -15,12 +15,12 @@ pub struct Source {
 
 impl Source {
     /// The largest spec read: as for scene files (`--max-input`'s default).
-    pub const MAX_BYTES: u64 = crate::limits::DEFAULT_MAX_INPUT;
+    pub const MAX_BYTES: u64 = anim_core::limits::DEFAULT_MAX_INPUT;
 
     /// Reads a spec file: refused unread when larger than `limit` bytes (a device or pipe
     /// after `limit + 1` bytes), when it holds NUL bytes, or when it is not UTF-8.
     pub fn read(path: &Path, limit: u64) -> Result<Source, Vec<Diagnostic>> {
-        let bytes = crate::scene::read_input(path, limit, "the spec")?;
+        let bytes = anim_core::scene::read_input(path, limit, "the spec")?;
         let text = String::from_utf8(bytes)
             .map_err(|_| vec![Diagnostic::file_error(path, "the spec is not UTF-8 text")])?;
         Ok(Source::new(path, text))

@@ -14,7 +14,7 @@ pub use raw::{KeySpec, Length, OrbitSpec, Rgb, Scale, SceneSource, SpecFile, Tra
 pub use source::Source;
 pub use validate::validate;
 
-use crate::diag::Diagnostic;
+use anim_core::diag::Diagnostic;
 
 /// Reads the spec's RON text. ron stops at the first problem: `Err` holds it, located in
 /// `source`.

@@ -18,10 +18,10 @@ pub mod stress;
 
 pub use report::{markdown, write_outputs};
 
-use crate::render::{self, film, RayCounts, RenderSettings};
-use crate::scene;
-use crate::scene::RenderJob;
-use crate::sdf::LoadOptions;
+use anim_core::render::{self, film, RayCounts, RenderSettings};
+use anim_core::scene;
+use anim_core::scene::RenderJob;
+use anim_core::sdf::LoadOptions;
 use cpu_time::ProcessTime;
 use metrics::ErrorStats;
 use std::fmt::Write as _;
@@ -339,7 +339,7 @@ pub fn render_measured(job: &RenderJob, settings: &RenderSettings) -> Result<Tim
 
 /// Writes 8-bit RGB as binary PPM (the cache's format: no encoder, exact bytes).
 fn write_ppm(path: &Path, rgb: &[u8], width: u32, height: u32) -> Result<(), String> {
-    crate::util::write_atomically(path, |w| {
+    anim_core::util::write_atomically(path, |w| {
         use std::io::Write;
         write!(w, "P6\n{width} {height}\n255\n")?;
         w.write_all(rgb)

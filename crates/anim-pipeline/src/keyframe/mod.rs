@@ -14,9 +14,9 @@ pub mod shutter;
 pub mod spec;
 pub mod tidy;
 
-use crate::diag::{Diagnostic, Loc};
-use crate::sdf::LoadOptions;
-use crate::util::write_atomically;
+use anim_core::diag::{Diagnostic, Loc};
+use anim_core::sdf::LoadOptions;
+use anim_core::util::write_atomically;
 use generate::{BaseScene, Generator};
 use spec::{Animation, SceneSource, Source};
 use std::collections::HashSet;
@@ -186,19 +186,19 @@ fn load_base(
     scene: &SceneSource,
     spec_dir: &Path,
     src: &Source,
-) -> Result<(Vec<crate::sdf::ast::Statement>, Vec<Diagnostic>), Vec<Diagnostic>> {
+) -> Result<(Vec<anim_core::sdf::ast::Statement>, Vec<Diagnostic>), Vec<Diagnostic>> {
     // The base scene is a file written by hand, read as `anim render` reads one: with its
     // material layout inferred. The frames then print the materials in the standard layout,
     // which inference reads back as written.
     let opts = LoadOptions {
-        material_fields: crate::sdf::MaterialLayout::Auto,
+        material_fields: anim_core::sdf::MaterialLayout::Auto,
         ..LoadOptions::default()
     };
     let (statements, mut diags, path) = match scene {
         SceneSource::File(rel) => {
             let path = spec_dir.join(rel);
-            let bytes =
-                crate::scene::read_input(&path, opts.max_input, "the base scene").map_err(|e| {
+            let bytes = anim_core::scene::read_input(&path, opts.max_input, "the base scene")
+                .map_err(|e| {
                     // The reader's own words, naming the file.
                     let why = e.first().map_or(String::new(), |d| d.message.clone());
                     let named = format!("the base scene '{}'", path.display());
@@ -208,18 +208,18 @@ fn load_base(
                     )]
                 })?;
             let (statements, diags) =
-                crate::sdf::parse(&String::from_utf8_lossy(&bytes), &path, &opts);
+                anim_core::sdf::parse(&String::from_utf8_lossy(&bytes), &path, &opts);
             (statements, diags, path)
         }
         SceneSource::Inline(text) => {
-            let (statements, diags) = crate::sdf::parse(text, &src.path, &opts);
+            let (statements, diags) = anim_core::sdf::parse(text, &src.path, &opts);
             (statements, diags, src.path.to_path_buf())
         }
     };
     // Building the scene finds what parsing alone cannot (an unknown material, a composite
     // child defined nowhere), located in the base scene rather than in a generated frame.
     if !diags.iter().any(Diagnostic::is_error) {
-        if let Err(built) = crate::scene::build(&statements, &path, &opts) {
+        if let Err(built) = anim_core::scene::build(&statements, &path, &opts) {
             diags.extend(built.into_iter().filter(Diagnostic::is_error));
         }
     }
@@ -236,13 +236,13 @@ fn load_base(
 /// same files from the frame directory, where the frames are read. Each mesh was loaded with
 /// the base scene, so it exists; a path that cannot be expressed is an error at the spec.
 fn rebase_mesh_files(
-    statements: &mut [crate::sdf::ast::Statement],
+    statements: &mut [anim_core::sdf::ast::Statement],
     base_dir: &Path,
     frame_dir: &Path,
     src: &Source,
 ) -> Result<(), Vec<Diagnostic>> {
-    use crate::scene::Geometry;
-    use crate::sdf::ast::StatementKind;
+    use anim_core::scene::Geometry;
+    use anim_core::sdf::ast::StatementKind;
     for s in statements {
         let StatementKind::Shape {
             geometry: Geometry::Mesh(m),
@@ -251,7 +251,7 @@ fn rebase_mesh_files(
         else {
             continue;
         };
-        let rebased = crate::util::path_from(frame_dir, &base_dir.join(&m.file));
+        let rebased = anim_core::util::path_from(frame_dir, &base_dir.join(&m.file));
         match rebased.as_ref().map(|p| p.to_str()) {
             // A file name the SDF reader would split into two words cannot be written.
             Ok(Some(p)) if !p.contains(char::is_whitespace) => m.file = p.to_string(),
@@ -314,7 +314,7 @@ fn checked_frame_text(
 ) -> Result<String, Vec<Diagnostic>> {
     let text = generator.frame_text(i)?;
     let path: Arc<Path> = Arc::from(dir.join(anim.output.sdf(i, anim.digits())).as_path());
-    if let Err(diags) = crate::scene::load_str(&text, &path, &LoadOptions::default()) {
+    if let Err(diags) = anim_core::scene::load_str(&text, &path, &LoadOptions::default()) {
         // A frame that does not load is a bug or a combination the spec checks missed;
         // show the loader's own words with the frame text they are about.
         let mut out = vec![Diagnostic::file_error(

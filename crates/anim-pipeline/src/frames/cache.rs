@@ -12,9 +12,9 @@
 //! finished: the next run renders that frame again.
 
 use super::scene_file::Output;
-use crate::render::RenderSettings;
-use crate::sdf::LoadOptions;
-use crate::util::{write_atomically, Fnv64};
+use anim_core::render::RenderSettings;
+use anim_core::sdf::LoadOptions;
+use anim_core::util::{write_atomically, Fnv64};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -163,7 +163,7 @@ pub(super) fn is_up_to_date(out_dir: &Path, name: &str, hash: u64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sdf::{MaterialField, MaterialLayout, TransformOrder};
+    use anim_core::sdf::{MaterialField, MaterialLayout, TransformOrder};
 
     /// Changing any one setting changes the key. The structs are taken apart field by field
     /// without `..`, so a new setting does not compile here until it has a case of its own.

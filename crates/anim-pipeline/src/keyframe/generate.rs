@@ -18,11 +18,11 @@ use super::orbit;
 use super::shutter::{self, TrackPose};
 use super::spec::{Animation, SceneNames, Source, TargetKind, Track};
 use super::tidy::{tidy, tidy3};
-use crate::diag::{Diagnostic, Loc};
-use crate::limits;
-use crate::math::Transform;
-use crate::scene::Geometry;
-use crate::sdf::ast::{MotionDef, NameRef, RenderDef, Statement, StatementKind, TransformOp};
+use anim_core::diag::{Diagnostic, Loc};
+use anim_core::limits;
+use anim_core::math::Transform;
+use anim_core::scene::Geometry;
+use anim_core::sdf::ast::{MotionDef, NameRef, RenderDef, Statement, StatementKind, TransformOp};
 use glam::{DVec3, Vec3};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -153,7 +153,7 @@ fn op_transform(op: &TransformOp) -> Option<Transform> {
     }
 }
 
-/// An axis-aligned box in f64. `crate::math::Aabb` is f32 and padded for ray traversal; the
+/// An axis-aligned box in f64. `anim_core::math::Aabb` is f32 and padded for ray traversal; the
 /// default pivots written into frames need the exact centre.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Bounds {
@@ -542,7 +542,7 @@ impl<'a> Generator<'a> {
             tidy(anim.time(i)),
             anim.fps,
             self.spec_name,
-            crate::sdf::GENERATED_FRAME_SIGNATURE,
+            anim_core::sdf::GENERATED_FRAME_SIGNATURE,
             env!("CARGO_PKG_VERSION")
         );
         if anim.shutter > 0.0 {
