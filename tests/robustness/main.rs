@@ -15,7 +15,7 @@
 //! reproduces exactly.
 
 use anim_core::math::{Ray, Transform};
-use anim_core::render::primitive::{Primitive, SurfaceHit};
+use anim_core::render::geometry::{Primitive, SurfaceHit};
 use anim_core::scene::Geometry;
 use glam::{DVec3, Vec3A};
 use proptest::prelude::*;

@@ -19,10 +19,10 @@
 //! rays leave at every angle, grazing ones included.
 
 use anim_core::math::{reflect, Ray};
-use anim_core::render::camera::CameraRays;
-use anim_core::render::compile::RenderScene;
+use anim_core::render::camera::PinholeCamera;
+use anim_core::render::compile::{RayHint, RenderScene};
+use anim_core::render::geometry::{Scratch, SurfaceHit};
 use anim_core::render::integrator::fresnel;
-use anim_core::render::primitive::SurfaceHit;
 use anim_core::scene::RenderJob;
 use anim_core::shape::Shape;
 use glam::Vec3A;
@@ -95,20 +95,22 @@ impl Rng {
 struct Walk<'a> {
     scene: &'a RenderScene,
     max_depth: u32,
+    scratch: Scratch,
 }
 
 impl Walk<'_> {
     /// Spawns one ray from `hit` of primitive `prim` towards `dir`, as the renderer does
     /// (`SurfaceHit::spawn_ray`), and judges it.
     fn spawn(&self, prim: u32, hit: &SurfaceHit, dir: Vec3A, out: &mut RehitCount) {
-        let shape = self.scene.object_shape(prim);
+        let geometry = &self.scene.geometry;
+        let shape = geometry.object_shape(prim);
         let Some(kind) = kind_index(shape) else {
             return;
         };
         let normal = hit.normal;
         let ray = hit.spawn_ray(dir);
         out.by_kind[kind].0 += 1;
-        let Some(again) = self.scene.intersect(prim, &ray, f32::INFINITY) else {
+        let Some(again) = geometry.intersect(prim, &ray, f32::INFINITY, &self.scratch) else {
             return;
         };
         let outward = normal.dot(dir) >= 0.0;
@@ -119,17 +121,21 @@ impl Walk<'_> {
     }
 
     fn trace(&self, ray: &Ray, depth: u32, rng: &mut Rng, out: &mut RehitCount) {
-        let Some((prim, hit)) = self.scene.closest(ray, f32::INFINITY) else {
+        let hint = RayHint::Secondary;
+        let Some((prim, hit)) = self
+            .scene
+            .intersect(ray, f32::INFINITY, hint, &self.scratch)
+        else {
             return;
         };
         if hit.normal == Vec3A::ZERO {
             return;
         }
         let scene = self.scene;
-        let mat = &scene.materials[scene.material_of(prim) as usize];
+        let mat = &scene.shading.materials[scene.geometry.material_of(prim) as usize];
         let entering = hit.normal.dot(ray.dir) < 0.0;
         let n = if entering { hit.normal } else { -hit.normal };
-        for light in &scene.lights {
+        for light in &scene.shading.lights {
             let l = (light.position - hit.point).normalize_or_zero();
             if n.dot(l) > 0.0 {
                 self.spawn(prim, &hit, l, out);
@@ -168,16 +174,17 @@ pub fn count(
     height: u32,
     max_depth: u32,
 ) -> Result<RehitCount, String> {
-    let camera = CameraRays::new(&job.camera, width, height)
+    let camera = PinholeCamera::new(&job.camera, width, height)
         .map_err(|e| format!("camera '{}': {e:?}", job.camera.name))?;
-    let (scene, _) = RenderScene::compile(&job.scene);
-    let walk = Walk {
-        scene: &scene,
-        max_depth,
-    };
+    let (scene, _) = RenderScene::compile(&job.scene, None);
     let rows: Vec<RehitCount> = (0..height)
         .into_par_iter()
         .map(|y| {
+            let walk = Walk {
+                scene: &scene,
+                max_depth,
+                scratch: Scratch::default(),
+            };
             let mut out = RehitCount::default();
             for x in 0..width {
                 let mut rng = Rng(u64::from(y) << 32 | u64::from(x));
@@ -230,10 +237,11 @@ mod tests {
             define shape sphere s 0 0 -5 2 m\n\
             define camera c 40\n\
             render c x.png 4 4\n");
-        let (scene, _) = RenderScene::compile(&j.scene);
+        let (scene, _) = RenderScene::compile(&j.scene, None);
         let walk = Walk {
             scene: &scene,
             max_depth: 0,
+            scratch: Scratch::default(),
         };
         let mut out = RehitCount::default();
         // A "surface point" 1 % inside, claimed to leave outwards.

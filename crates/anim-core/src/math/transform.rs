@@ -50,6 +50,7 @@ impl Transform {
     }
 
     /// `self` applied after `inner`: maps through `inner` first.
+    #[inline]
     pub fn then_after(&self, inner: &Transform) -> Transform {
         Transform {
             world_from_object: self.world_from_object * inner.world_from_object,

@@ -1,24 +1,27 @@
-//! Primary rays: pinhole camera with a horizontal field of view, rays through sub-pixel
-//! positions, row 0 at the top of the image.
+//! The camera model: a pinhole camera with a horizontal field of view, rays through sub-pixel
+//! positions, row 0 at the top of the image. The renderer's camera rays and the blank-image
+//! probe's come from it alike.
 
 use crate::accel::ImageView;
 use crate::math::Ray;
 use crate::scene::Camera;
 use glam::{DVec3, Vec3A};
 
+/// A pinhole camera placed in the scene, with the size of its image.
 #[derive(Clone, Debug)]
-pub struct CameraRays {
+pub struct PinholeCamera {
     /// Its image-plane distance is `(w/2)/tan(fov/2)` pixels.
     view: ImageView,
 }
 
+/// Why a camera cannot make rays.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum CameraError {
     Fov,
     Orientation,
 }
 
-impl CameraRays {
+impl PinholeCamera {
     pub fn new(cam: &Camera, width: u32, height: u32) -> Result<Self, CameraError> {
         if !(cam.fov_x_deg > 0.0 && cam.fov_x_deg < 180.0) {
             return Err(CameraError::Fov);
@@ -31,7 +34,7 @@ impl CameraRays {
         let u = r.cross(d);
         let dist = (width as f64 / 2.0) / (cam.fov_x_deg.to_radians() / 2.0).tan();
         let v = |x: DVec3| Vec3A::from(x.as_vec3());
-        Ok(CameraRays {
+        Ok(PinholeCamera {
             view: ImageView {
                 eye: v(cam.eye),
                 forward: v(d * dist),
@@ -68,7 +71,7 @@ impl CameraRays {
     }
 
     /// Whether `other` looks the same way through the same image plane (its eye aside).
-    pub fn same_view(&self, other: &CameraRays) -> bool {
+    pub fn same_view(&self, other: &PinholeCamera) -> bool {
         ImageView {
             eye: other.view.eye,
             ..self.view
@@ -76,7 +79,7 @@ impl CameraRays {
     }
 
     /// The image position (pixels from the top-left corner) at which `p` is seen, if it lies
-    /// in front of the eye: the inverse of [`CameraRays::ray`].
+    /// in front of the eye: the inverse of [`PinholeCamera::ray`].
     pub fn project(&self, p: Vec3A) -> Option<(f32, f32)> {
         self.view.pixel_of(p - self.view.eye)
     }
@@ -88,30 +91,6 @@ impl CameraRays {
     }
 }
 
-/// Sub-pixel sample positions in [0,1)²: a k×k stratified grid when `n = k²`, otherwise a
-/// Hammersley set. Fixed, so renders are reproducible.
-pub fn sample_offsets(n: u32) -> Vec<(f32, f32)> {
-    let n = n.max(1);
-    if n == 1 {
-        return vec![(0.5, 0.5)];
-    }
-    let k = (n as f64).sqrt().round() as u32;
-    if k * k == n {
-        let step = 1.0 / k as f32;
-        return (0..n)
-            .map(|i| (((i % k) as f32 + 0.5) * step, ((i / k) as f32 + 0.5) * step))
-            .collect();
-    }
-    (0..n)
-        .map(|i| {
-            (
-                (i as f32 + 0.5) / n as f32,
-                (i.reverse_bits() as f64 / 4294967296.0) as f32,
-            )
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -119,7 +98,7 @@ mod tests {
     #[test]
     fn centre_ray_looks_down_minus_z_and_edges_span_the_fov() {
         let cam = Camera::default_with_fov("c", 90.0);
-        let rays = CameraRays::new(&cam, 200, 100).unwrap();
+        let rays = PinholeCamera::new(&cam, 200, 100).unwrap();
         let c = rays.ray(100.0, 50.0);
         assert!((c.dir - Vec3A::NEG_Z).length() < 1e-6);
         // The left edge of the image is 45° off axis for a 90° horizontal fov.
@@ -135,7 +114,7 @@ mod tests {
         let mut cam = Camera::default_with_fov("c", 70.0);
         cam.eye = DVec3::new(1.0, -2.0, 3.0);
         cam.dir = DVec3::new(0.3, -0.2, -1.0);
-        let rays = CameraRays::new(&cam, 64, 48).unwrap();
+        let rays = PinholeCamera::new(&cam, 64, 48).unwrap();
         for (x, y) in [(0.5, 0.5), (32.0, 24.0), (63.2, 11.7)] {
             let r = rays.ray(x, y);
             let (px, py) = rays.project(r.at(7.5)).expect("in front");
@@ -145,28 +124,16 @@ mod tests {
     }
 
     #[test]
-    fn stratified_grid_for_squares() {
-        let s = sample_offsets(4);
-        assert_eq!(
-            s,
-            vec![(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)]
-        );
-        assert_eq!(sample_offsets(1), vec![(0.5, 0.5)]);
-        let h = sample_offsets(10);
-        assert_eq!(h.len(), 10);
-        assert!(h
-            .iter()
-            .all(|&(x, y)| (0.0..1.0).contains(&x) && (0.0..1.0).contains(&y)));
-    }
-
-    #[test]
     fn degenerate_cameras_are_rejected() {
         let mut cam = Camera::default_with_fov("c", 180.0);
-        assert_eq!(CameraRays::new(&cam, 10, 10).unwrap_err(), CameraError::Fov);
+        assert_eq!(
+            PinholeCamera::new(&cam, 10, 10).unwrap_err(),
+            CameraError::Fov
+        );
         cam.fov_x_deg = 60.0;
         cam.up = DVec3::NEG_Z;
         assert_eq!(
-            CameraRays::new(&cam, 10, 10).unwrap_err(),
+            PinholeCamera::new(&cam, 10, 10).unwrap_err(),
             CameraError::Orientation
         );
     }

@@ -2,27 +2,52 @@
 //! linear radiance itself as PFM (`--hdr`), and atomic writes (a reader never sees a
 //! half-written image).
 
-use super::HdrImage;
-
+use glam::{Vec3, Vec3A};
 use std::io::{self, Write};
 use std::path::Path;
 
-/// docs/shading.md §4: `c_ldr = c_hdr / (c_hdr + 1)`, stored as `round(255·c_ldr)`. Negative or
-/// non-finite input (which the renderer never produces) maps to 0 rather than wrapping.
+/// Linear (HDR) radiance per pixel, row 0 at the top: what the samplers fill.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HdrImage {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<Vec3>,
+}
+
+/// The tone map of one channel (docs/shading.md §4): `c_ldr = c_hdr / (c_hdr + 1)`, in
+/// [0, 1]. Negative or NaN input (which the renderer never produces) maps to 0, infinity to 1.
+/// Adaptive sampling judges a pixel's error in these units too, times 255.
+#[inline]
+pub fn tone(c: f32) -> f32 {
+    if c > 0.0 {
+        if c == f32::INFINITY {
+            1.0
+        } else {
+            c / (c + 1.0)
+        }
+    } else {
+        0.0
+    }
+}
+
+/// [`tone`] of each channel.
+#[inline]
+pub fn tone3(c: Vec3A) -> Vec3A {
+    Vec3A::new(tone(c.x), tone(c.y), tone(c.z))
+}
+
+/// One channel as stored in an 8-bit image: `round(255·tone(c))`.
 #[inline]
 pub fn tone_map_u8(c: f32) -> u8 {
-    if c.is_nan() || c <= 0.0 {
+    // Black (and NaN) without the rounding: much of many images is black background.
+    if c.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return 0;
     }
-    if c == f32::INFINITY {
-        return 255;
-    }
-    round_level(255.0 * (c / (c + 1.0)))
+    round_level(255.0 * tone(c))
 }
 
 /// `v.round() as u8` for `v` in [0, 255], without the library call `f32::round` is on CPUs the
-/// build does not assume to round in hardware (three per pixel, 1.9 % of a 10k-sphere
-/// render's instructions). Exact: `v` minus its whole part is a float subtraction without
+/// build does not assume to round in hardware (three calls a pixel). Exact: `v` minus its whole part is a float subtraction without
 /// rounding (the two are within a factor two of each other, or the whole part is 0).
 #[inline]
 fn round_level(v: f32) -> u8 {

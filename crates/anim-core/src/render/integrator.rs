@@ -1,9 +1,10 @@
 //! Whitted-style shading: the local Phong model of docs/shading.md §2 with hard shadows, mirror
 //! reflection and Fresnel refraction.
 
-use super::camera::CameraRays;
-use super::compile::{RenderScene, ShadeMaterial, Shadow};
-use super::primitive::SurfaceHit;
+use super::camera::PinholeCamera;
+use super::compile::{Occlusion, RayHint, RenderScene};
+use super::geometry::{PrimId, Scratch, SurfaceHit};
+use super::shading::ShadeMaterial;
 use super::RayCounts;
 use crate::math::{reflect, Ray};
 use glam::Vec3A;
@@ -16,7 +17,7 @@ const NEGLIGIBLE: f32 = 0.5 / 255.0;
 const MAX_SHADOW_CROSSINGS: usize = 64;
 
 /// The primitive index reported for a camera ray that hit nothing.
-pub const NO_HIT: u32 = u32::MAX;
+pub const NO_HIT: PrimId = PrimId::MAX;
 
 /// Lights whose last blocker a [`TraceState`] remembers (the others go without).
 const CACHED_LIGHTS: usize = 8;
@@ -57,11 +58,10 @@ impl LastShadows {
     }
 }
 
-/// What one worker keeps between the rays it traces: its ray counts, and per light the
-/// opaque primitive that last blocked a shadow ray (see [`Integrator::visibility`]). The
-/// cache only saves work, never changes a value, so images do not depend on which worker
-/// traced which pixel.
-#[derive(Clone, Debug)]
+/// What one worker keeps between the rays it traces: its ray counts, per light the opaque
+/// primitive that last blocked a shadow ray (see [`Integrator::visibility`]), and the
+/// scratch its scene queries keep. The caches only save work, never change a value, so
+/// images do not depend on which worker traced which pixel.
 pub struct TraceState {
     pub counts: RayCounts,
     shadows: [LastShadows; CACHED_LIGHTS],
@@ -69,19 +69,46 @@ pub struct TraceState {
     /// its shadow ray: 0 (every shadow ray traced) except for adaptive sampling's refining
     /// samples ([`TraceState::refining`]).
     shadow_cut: f32,
-    /// Bit k: a shadow ray towards light k found it not fully visible (blocked, or through
-    /// glass) since this was last cleared (adaptive sampling's first pass reads it per pixel).
-    pub not_clear: u32,
-    /// Bit k: light k is taken as fully visible at the surface a camera ray hits, without a
-    /// shadow ray, because no shadow ray of the first pass around this pixel found otherwise
-    /// (set by adaptive sampling for the samples it adds).
+    /// Bit k: a shadow ray towards light k of the current camera sample's tree found it not
+    /// fully visible (blocked, or through glass); [`CameraSample::not_clear`].
+    not_clear: u32,
+    /// What the scene's queries keep between rays (the moving shapes placed at the current
+    /// instant, and what a watched centre sample met).
+    pub scratch: Scratch,
+}
+
+/// What adaptive sampling's first pass learned about a pixel, handed to the integrator for
+/// each sample it adds there: the lights every shadow ray of the centres around the pixel
+/// saw fully, taken as visible at the surface a camera ray hits without a shadow ray.
+#[derive(Clone, Debug, Default)]
+pub struct PixelPrior {
+    /// Bit k: light k is known to be fully visible.
     pub known_clear: u32,
     /// In a frame with motion, `known_clear` speaks for the shapes that hold still only: a
     /// sample still asks the moving shapes at its own instant. And it holds for camera hits
     /// near the first pass's hits around the pixel only (`KnownNear`).
-    pub known_clear_near: Option<KnownNear>,
-    /// The moving entry the latest camera ray hit, whose shadow rays leave it.
-    lit_from: Option<u32>,
+    pub near: Option<KnownNear>,
+}
+
+impl PixelPrior {
+    /// Nothing known: every shadow ray is traced.
+    pub const NONE: PixelPrior = PixelPrior {
+        known_clear: 0,
+        near: None,
+    };
+}
+
+/// Radiance along a camera ray and what the integrator found on its way.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraSample {
+    pub radiance: Vec3A,
+    /// The primitive hit ([`NO_HIT`] for the background), which adaptive sampling compares
+    /// between neighbouring pixels.
+    pub prim: PrimId,
+    /// How far along the ray the surface is (`None`: the background).
+    pub t: Option<f32>,
+    /// Bit k: some shadow ray of the sample's tree towards light k did not see it fully.
+    pub not_clear: u32,
 }
 
 /// Where a camera hit of a frame with motion must lie for the lights the first pass's
@@ -96,7 +123,7 @@ pub struct KnownNear {
     pub depth: (f32, f32),
     /// Under a moving camera: that eye's view, and the window of image positions (left, top,
     /// right, bottom) spanned by the centres, in which the hit must be seen from it.
-    pub seen_from: Option<(CameraRays, [f32; 4])>,
+    pub seen_from: Option<(PinholeCamera, [f32; 4])>,
 }
 
 impl KnownNear {
@@ -123,28 +150,42 @@ impl Default for TraceState {
             shadows: [LastShadows::NONE; CACHED_LIGHTS],
             shadow_cut: 0.0,
             not_clear: 0,
-            known_clear: 0,
-            known_clear_near: None,
-            lit_from: None,
+            scratch: Scratch::default(),
         }
     }
 }
 
 impl TraceState {
     /// For the samples adaptive sampling adds to a pixel. More than half of their shadow
-    /// rays (58 % in the mirror-and-glass room, most of them from deep inside glass and
-    /// mirror trees or for highlights of exponent 300 and more far from their peak) decide
-    /// a term that could not move the pixel by half an 8-bit step even fully lit, the
-    /// bound below which reflected and refracted rays are not traced either ([`NEGLIGIBLE`]).
-    /// Such a term is counted lit: right for most of them, and off by less than that bound
-    /// where it is not. Uniform sampling and adaptive sampling's first pass trace them all,
-    /// so their images do not change.
+    /// rays (most of them from deep inside glass and mirror trees, or for highlights of
+    /// exponent 300 and more far from their peak) decide a term that could not move the
+    /// pixel by half an 8-bit step even fully lit, the bound below which reflected and
+    /// refracted rays are not traced either ([`NEGLIGIBLE`]). Such a term is counted lit:
+    /// right for most of them, and off by less than that bound where it is not. Uniform
+    /// sampling and adaptive sampling's first pass trace them all, so their images do not
+    /// change.
     pub fn refining() -> Self {
         TraceState {
             shadow_cut: NEGLIGIBLE,
             ..TraceState::default()
         }
     }
+}
+
+/// The lights taken as visible at a camera hit without a shadow ray ([`PixelPrior`]).
+#[derive(Clone, Copy, Debug)]
+struct KnownLit {
+    lights: u32,
+    /// In a frame with motion (the prior knows only of what holds still): the moving shapes
+    /// are still asked, from the moving entry the hit lies on if any.
+    ask_moving: Option<Option<u32>>,
+}
+
+impl KnownLit {
+    const NONE: KnownLit = KnownLit {
+        lights: 0,
+        ask_moving: None,
+    };
 }
 
 pub struct Integrator<'a> {
@@ -167,60 +208,98 @@ pub fn fresnel(cos_i: f32, eta: f32) -> (f32, f32) {
 }
 
 impl Integrator<'_> {
-    /// Radiance arriving along `ray` (unit direction). `weight` is the ray's share of the
-    /// pixel, `depth` the number of bounces so far.
+    /// Radiance arriving along a reflected or refracted `ray` (unit direction). `weight` is
+    /// the ray's share of the pixel, `depth` the number of bounces so far.
     #[inline]
     pub fn trace(&self, ray: &Ray, depth: u32, weight: f32, st: &mut TraceState) -> Vec3A {
-        match self.scene.closest(ray, f32::INFINITY) {
-            Some((prim, hit)) => self.shade(ray, prim, &hit, depth, weight, st),
-            None => self.scene.background,
+        let hit = self
+            .scene
+            .intersect(ray, f32::INFINITY, RayHint::Secondary, &st.scratch);
+        match hit {
+            Some((prim, hit)) => self.shade(ray, prim, &hit, depth, weight, KnownLit::NONE, st),
+            None => self.scene.shading.background,
         }
     }
 
-    /// Radiance along a camera ray and the primitive it hit ([`NO_HIT`] for the background),
-    /// which adaptive sampling compares between neighbouring pixels. The uniform path keeps
-    /// calling [`Integrator::trace`].
-    pub fn trace_primary(&self, ray: &Ray, st: &mut TraceState) -> (Vec3A, u32) {
-        let (colour, prim, _) = self.trace_primary_hit(ray, st);
-        (colour, prim)
+    /// Radiance along a camera ray, with what the sampler knows of its pixel (`prior`).
+    #[inline]
+    pub fn camera_sample(
+        &self,
+        ray: &Ray,
+        prior: &PixelPrior,
+        st: &mut TraceState,
+    ) -> CameraSample {
+        let hit = self
+            .scene
+            .intersect(ray, f32::INFINITY, RayHint::Camera, &st.scratch);
+        self.shade_camera_hit(ray, hit.as_ref(), prior, st)
     }
 
-    /// `trace_primary`, and how far along the ray the surface is (`None`: the background).
-    pub fn trace_primary_hit(&self, ray: &Ray, st: &mut TraceState) -> (Vec3A, u32, Option<f32>) {
-        match self.scene.closest_seen(ray) {
-            Some((prim, hit)) => (self.shade(ray, prim, &hit, 0, 1.0, st), prim, Some(hit.t)),
-            None => (self.scene.background, NO_HIT, None),
+    /// [`Integrator::camera_sample`] of a camera ray whose closest hit (`hit`) is known.
+    #[inline]
+    pub fn shade_camera_hit(
+        &self,
+        ray: &Ray,
+        hit: Option<&(PrimId, SurfaceHit)>,
+        prior: &PixelPrior,
+        st: &mut TraceState,
+    ) -> CameraSample {
+        st.not_clear = 0;
+        let Some((prim, hit)) = hit else {
+            return CameraSample {
+                radiance: self.scene.shading.background,
+                prim: NO_HIT,
+                t: None,
+                not_clear: 0,
+            };
+        };
+        let known = self.known_at(prior, *prim, hit);
+        CameraSample {
+            radiance: self.shade(ray, *prim, hit, 0, 1.0, known, st),
+            prim: *prim,
+            t: Some(hit.t),
+            not_clear: st.not_clear,
+        }
+    }
+
+    /// What `prior` says of the lights at camera hit `hit` on primitive `prim`: its known
+    /// lights where the hit lies among the first pass's (`KnownNear`), none elsewhere.
+    #[inline]
+    fn known_at(&self, prior: &PixelPrior, prim: PrimId, hit: &SurfaceHit) -> KnownLit {
+        match &prior.near {
+            None => KnownLit {
+                lights: prior.known_clear,
+                ask_moving: None,
+            },
+            Some(near) if near.holds(hit.point, hit.t) => KnownLit {
+                lights: prior.known_clear,
+                ask_moving: Some(self.scene.geometry.moving_entry(prim)),
+            },
+            Some(_) => KnownLit::NONE,
         }
     }
 
     /// Radiance leaving the surface point `hit` of primitive `prim` back along `ray`.
     #[inline]
-    pub(super) fn shade(
+    #[allow(clippy::too_many_arguments)]
+    fn shade(
         &self,
         ray: &Ray,
-        prim: u32,
+        prim: PrimId,
         hit: &SurfaceHit,
         depth: u32,
         weight: f32,
+        known: KnownLit,
         st: &mut TraceState,
     ) -> Vec3A {
-        let scene = self.scene;
-        let mat = &scene.materials[scene.material_of(prim) as usize];
+        let shading = &self.scene.shading;
+        let mat = &shading.materials[self.scene.geometry.material_of(prim) as usize];
         let entering = hit.normal.dot(ray.dir) < 0.0;
         // Shading normal faces the incoming ray; the geometric one decides inside/outside.
         let n = if entering { hit.normal } else { -hit.normal };
         let (rho, alpha) = (mat.reflectivity, mat.opacity);
-        let near = |k: &KnownNear| k.holds(hit.point, hit.t);
-        let known_clear = if depth == 0 && st.known_clear_near.as_ref().is_none_or(near) {
-            if st.known_clear_near.is_some() {
-                st.lit_from = scene.moving_entry(prim);
-            }
-            st.known_clear
-        } else {
-            0
-        };
         if rho == 0.0 && alpha == 1.0 {
-            return self.local(mat, hit, n, -ray.dir, ray.time, (weight, known_clear), st);
+            return self.local(mat, hit, n, -ray.dir, ray.time, (weight, known), st);
         }
 
         // c = α·((1−ρ)·c_local + ρ·c_r) + (1−α)·(F·c_r + (1−F)·c_t)
@@ -243,19 +322,12 @@ impl Integrator<'_> {
         let mut c = if w_local == 0.0 {
             Vec3A::ZERO
         } else {
-            self.local(
-                mat,
-                hit,
-                n,
-                -ray.dir,
-                ray.time,
-                (weight * w_local, known_clear),
-                st,
-            ) * w_local
+            let v = -ray.dir;
+            self.local(mat, hit, n, v, ray.time, (weight * w_local, known), st) * w_local
         };
         let can_recurse = depth < self.max_depth;
         let worth =
-            |w: f32| can_recurse && w > 0.0 && weight * w * scene.max_radiance >= NEGLIGIBLE;
+            |w: f32| can_recurse && w > 0.0 && weight * w * shading.max_radiance >= NEGLIGIBLE;
         if worth(w_reflect) {
             let dir = reflect(ray.dir, n);
             st.counts.reflected += 1;
@@ -273,8 +345,7 @@ impl Integrator<'_> {
     /// `Ka·I_ambient + Σ vis·I·(Kd·max(N·L,0) + Ks·max(R·V,0)^m)`, specular only where N·L > 0.
     /// Lights and shadowing geometry are taken at `time`, the instant of the exposure;
     /// `weight` is the result's share of the pixel (for `TraceState::shadow_cut`), and
-    /// `known_clear` the lights taken as visible here without a shadow ray
-    /// (`TraceState::known_clear`, at camera hits only).
+    /// `known` the lights taken as visible here without a shadow ray (at camera hits only).
     #[inline]
     #[allow(clippy::too_many_arguments)]
     fn local(
@@ -284,15 +355,15 @@ impl Integrator<'_> {
         n: Vec3A,
         v: Vec3A,
         time: f32,
-        (weight, known_clear): (f32, u32),
+        (weight, known): (f32, KnownLit),
         st: &mut TraceState,
     ) -> Vec3A {
-        let scene = self.scene;
-        let mut c = mat.ka * scene.ambient;
+        let shading = &self.scene.shading;
+        let mut c = mat.ka * shading.ambient;
         // `ks·spec` is exactly zero without a specular colour (spec is at most 1 for m ≥ 0).
         let specular = mat.ks != Vec3A::ZERO || mat.m < 0.0 || mat.m.is_nan();
-        for (k, light) in scene.lights.iter().enumerate() {
-            let to_light = scene.light_position(k, light, time) - hit.point;
+        for (k, light) in shading.lights.iter().enumerate() {
+            let to_light = shading.light_position(k, light, time) - hit.point;
             let dist = to_light.length();
             if dist == 0.0 {
                 continue;
@@ -321,15 +392,16 @@ impl Integrator<'_> {
             }
             let lit = light.intensity * unshadowed;
             if lit.max_element() * weight < st.shadow_cut
-                || ((known_clear >> k.min(31)) & 1 != 0
-                    && !(st.known_clear_near.is_some()
-                        && self.moving_blocks(hit, l, dist, time, st.lit_from)))
+                || ((known.lights >> k.min(31)) & 1 != 0
+                    && !known.ask_moving.is_some_and(|from| {
+                        self.moving_blocks(hit, l, dist, time, from, &st.scratch)
+                    }))
             {
                 c += lit;
                 continue;
             }
             st.counts.shadow += 1;
-            let vis = self.visibility(hit, k, l, dist, time, st.shadows.get_mut(k));
+            let vis = self.visibility(hit, k, l, dist, time, st);
             if vis < 1.0 {
                 st.not_clear |= 1 << k.min(31);
             }
@@ -351,10 +423,14 @@ impl Integrator<'_> {
         dist: f32,
         time: f32,
         from: Option<u32>,
+        scratch: &Scratch,
     ) -> bool {
         let ray = hit.spawn_ray(l).at_time(time);
         let remaining = (hit.point + l * dist - ray.origin).dot(l);
-        self.scene.moving_blocks(&ray, remaining, from) != Some(false)
+        self.scene
+            .geometry
+            .moving_blocks(&ray, remaining, from, scratch)
+            != Some(false)
     }
 
     /// Fraction of a light's intensity reaching `p`: 0 behind an opaque object, attenuated by
@@ -362,10 +438,9 @@ impl Integrator<'_> {
     /// either way: the first opaque blocker ends the query, and crossings of transparent
     /// objects multiply in whatever order the hierarchy offers them.
     ///
-    /// `last` is this light's entry of the worker's [`TraceState`] ([`LastShadows`]): the
-    /// opaque primitive that last blocked a shadow ray towards it is tried first while it is
-    /// likely to block again; an opaque hit means no light whatever else the ray crosses, so
-    /// the answer is the same as without the cache.
+    /// The opaque primitive that last blocked a shadow ray towards this light (the worker's
+    /// [`LastShadows`]) is tried first while it is likely to block again; an opaque hit means
+    /// no light whatever else the ray crosses, so the answer is the same as without the cache.
     fn visibility(
         &self,
         hit: &SurfaceHit,
@@ -373,28 +448,32 @@ impl Integrator<'_> {
         l: Vec3A,
         dist: f32,
         time: f32,
-        mut last: Option<&mut LastShadows>,
+        st: &mut TraceState,
     ) -> f32 {
         let scene = self.scene;
+        let geometry = &scene.geometry;
         let ray = hit.spawn_ray(l).at_time(time);
         let light = hit.point + l * dist;
         let remaining = (light - ray.origin).dot(l);
+        let scratch = &st.scratch;
+        let mut last = st.shadows.get_mut(light_index);
         if let Some(b) = last.as_deref().and_then(LastShadows::guess) {
-            if scene.hit(b, &ray, remaining).is_some() {
+            if geometry.hit(b, &ray, remaining, scratch).is_some() {
                 return 0.0;
             }
         }
         // Most shadow rays meet nothing at all, or one glass object: the any-hit query
         // (packed primitives four at a time) says so, looking past glass for an opaque
         // blocker, which means no light whatever else the ray crosses.
-        match scene.shadow(&ray, remaining, light_index) {
-            Shadow::Clear => {
+        let hint = RayHint::Shadow(light_index);
+        match scene.occlusion(&ray, remaining, hint, scratch) {
+            Occlusion::Clear => {
                 if let Some(last) = last {
                     last.clear_run = last.clear_run.saturating_add(1);
                 }
                 return 1.0;
             }
-            Shadow::Blocked(first) => {
+            Occlusion::Blocked(first) => {
                 if let Some(last) = last {
                     last.blocked_by(first);
                 }
@@ -402,24 +481,25 @@ impl Integrator<'_> {
             }
             // One object's crossings alone: the walk below would multiply the same factors
             // in the same order, and nothing else.
-            Shadow::Through(i) => {
-                return self.transmittance(&ray, i, l, light, remaining, 1.0);
+            Occlusion::Through(i) => {
+                return self.transmittance(&ray, i, l, light, remaining, 1.0, scratch);
             }
-            Shadow::Walk => {}
+            Occlusion::Walk => {}
         }
         // Glass of several objects: the walk tells glass from opaque, and names the blocker
         // for the next ray.
         let mut transmit = 1.0f32;
-        let blocked = scene.any_candidate(&ray, remaining, |i| {
-            let opacity = scene.materials[scene.material_of(i) as usize].opacity;
+        let materials = &scene.shading.materials;
+        let blocked = geometry.any_candidate(&ray, remaining, |i| {
+            let opacity = materials[geometry.material_of(i) as usize].opacity;
             if opacity >= 1.0 {
-                let hit = scene.hit(i, &ray, remaining).is_some();
+                let hit = geometry.hit(i, &ray, remaining, scratch).is_some();
                 if let Some(last) = last.as_deref_mut().filter(|_| hit) {
                     last.blocked_by(i);
                 }
                 return hit;
             }
-            transmit = self.transmittance(&ray, i, l, light, remaining, transmit);
+            transmit = self.transmittance(&ray, i, l, light, remaining, transmit, scratch);
             transmit == 0.0
         });
         if blocked {
@@ -431,21 +511,23 @@ impl Integrator<'_> {
 
     /// `transmit` times `1 − α` for every crossing of transparent primitive `i` along `ray`
     /// (unit direction `l`) before `remaining`, the distance to `light`, stepping past each.
+    #[allow(clippy::too_many_arguments)]
     fn transmittance(
         &self,
         ray: &Ray,
-        i: u32,
+        i: PrimId,
         l: Vec3A,
         light: Vec3A,
         remaining: f32,
         mut transmit: f32,
+        scratch: &Scratch,
     ) -> f32 {
-        let scene = self.scene;
-        let opacity = scene.materials[scene.material_of(i) as usize].opacity;
+        let geometry = &self.scene.geometry;
+        let opacity = self.scene.shading.materials[geometry.material_of(i) as usize].opacity;
         let mut segment = *ray;
         let mut left = remaining;
         for _ in 0..MAX_SHADOW_CROSSINGS {
-            let Some(hit) = scene.intersect(i, &segment, left) else {
+            let Some(hit) = geometry.intersect(i, &segment, left, scratch) else {
                 break;
             };
             transmit *= 1.0 - opacity;
@@ -504,7 +586,7 @@ mod tests {
             ambient: Vec3::splat(0.2),
             ..Scene::default()
         };
-        let (scene, _) = RenderScene::compile(&scene);
+        let (scene, _) = RenderScene::compile(&scene, None);
         let integrator = Integrator {
             scene: &scene,
             max_depth: 4,
@@ -513,10 +595,17 @@ mod tests {
         let mut exact = TraceState::default();
         let mut refining = TraceState::refining();
         let mut known = TraceState::refining();
-        known.known_clear = 1;
-        let shadowed = integrator.trace(&ray, 0, 1.0, &mut exact).x;
-        let refined = integrator.trace(&ray, 0, 1.0, &mut refining).x;
-        let assumed = integrator.trace(&ray, 0, 1.0, &mut known).x;
+        let lit = PixelPrior {
+            known_clear: 1,
+            near: None,
+        };
+        let none = &PixelPrior::NONE;
+        let shadowed = integrator.camera_sample(&ray, none, &mut exact).radiance.x;
+        let refined = integrator
+            .camera_sample(&ray, none, &mut refining)
+            .radiance
+            .x;
+        let assumed = integrator.camera_sample(&ray, &lit, &mut known).radiance.x;
         (shadowed, refined, assumed, refining.counts.shadow)
     }
 

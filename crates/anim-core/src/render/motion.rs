@@ -1,11 +1,14 @@
 //! The exposure of a frame in which something moves (docs/scene-language.md §10): each camera
 //! sample gets an instant `u` of the exposure, its ray and every ray spawned from it carry
 //! that instant (`Ray::time`), and the camera is placed at it. A frame in which nothing moves
-//! never builds a [`Shutter`] and renders by the path it always took.
+//! never builds a [`Shutter`] and renders by the path it always took. Also what adaptive
+//! sampling asks of the motion: whether a pixel changes during the exposure, and the streak
+//! a moving camera draws. Siblings: `crate::render::geometry::motion` (the moving shapes),
+//! `crate::scene::motion` (what moves in a scene description).
 
-use super::camera::CameraRays;
-use super::integrator::{Integrator, TraceState};
-use super::sampling::{tone3, FLAT_CONTRAST};
+use super::camera::PinholeCamera;
+use super::integrator::{Integrator, PixelPrior, TraceState};
+use super::sampler::pattern::{tone3, FLAT_CONTRAST};
 use crate::limits::MOTION_TIME_STEPS;
 use crate::math::Ray;
 use crate::scene::motion::Motion;
@@ -36,7 +39,7 @@ pub struct Shutter {
     width: u32,
     height: u32,
     /// The camera at instants spread over the exposure, when it moves.
-    sweep: Vec<CameraRays>,
+    sweep: Vec<PinholeCamera>,
     /// When the camera slides without turning, with every eye of `sweep` on the way between
     /// the first and the last: how far (world units) one strays from that segment at most,
     /// times the view's `reach`. Then a point's image moves along a straight line (a line
@@ -44,7 +47,7 @@ pub struct Shutter {
     slide_stray: Option<f32>,
     /// The camera at each instant camera samples are rounded to, when it moves (`None` where
     /// it is degenerate then): placed once per frame, not once per sample.
-    at_step: Vec<Option<CameraRays>>,
+    at_step: Vec<Option<PinholeCamera>>,
     /// The angle one pixel spans at the image centre (radians).
     pixel_angle: f32,
 }
@@ -93,19 +96,19 @@ impl Shutter {
         self.motion.moves_lights()
     }
 
-    fn camera_at(&self, time: f32) -> Option<CameraRays> {
+    fn camera_at(&self, time: f32) -> Option<PinholeCamera> {
         let cam = self.motion.camera_at(&self.camera, time as f64);
-        CameraRays::new(&cam, self.width, self.height).ok()
+        PinholeCamera::new(&cam, self.width, self.height).ok()
     }
 
     /// The camera ray through (`x`, `y`) at instant `time`; `still` is the camera at the
     /// middle of the exposure (used as it is when the camera does not move, or where its
     /// placement at `time` is degenerate).
     /// The time is rounded to the instants moving shapes are placed at
-    /// (`compile::motion::quantize`), so every thing of the scene is seen at one instant.
+    /// (`geometry::motion::quantize`), so every thing of the scene is seen at one instant.
     #[inline]
-    pub fn ray(&self, still: &CameraRays, x: f32, y: f32, time: f32) -> Ray {
-        let step = super::compile::motion::step(time);
+    pub fn ray(&self, still: &PinholeCamera, x: f32, y: f32, time: f32) -> Ray {
+        let step = super::geometry::motion::step(time);
         let camera = self
             .at_step
             .get(step as usize)
@@ -113,7 +116,7 @@ impl Shutter {
             .unwrap_or(still);
         camera
             .ray(x, y)
-            .at_time(super::compile::motion::quantize(time))
+            .at_time(super::geometry::motion::quantize(time))
     }
 
     /// Where (pixels, from the centre of (`x`, `y`)) the point its middle-instant centre ray
@@ -123,7 +126,7 @@ impl Shutter {
     /// than `MAX_FLAT_SWEEP`, or strays more than a pixel from the two straight halves.
     pub fn camera_sweep(
         &self,
-        still: &CameraRays,
+        still: &PinholeCamera,
         x: u32,
         y: u32,
         t: Option<f32>,
@@ -135,7 +138,7 @@ impl Shutter {
         let ray = still.ray(cx, cy);
         // The background: a point far enough that the eye's slide does not move it.
         let p: Vec3A = ray.at(t.unwrap_or(1e7));
-        let end = |c: &CameraRays| c.project(p).map(|(px, py)| (px - cx, py - cy));
+        let end = |c: &PinholeCamera| c.project(p).map(|(px, py)| (px - cx, py - cy));
         let ends = [end(first)?, end(last)?];
         if ends
             .iter()
@@ -180,7 +183,7 @@ impl Shutter {
     pub fn changes(
         &self,
         integrator: &Integrator,
-        still: &CameraRays,
+        still: &PinholeCamera,
         (x, y): (u32, u32),
         centre: (Vec3A, u32),
         swept: f32,
@@ -197,7 +200,8 @@ impl Shutter {
         for i in order.filter(|&i| 2 * i != parts) {
             let u = i as f32 / parts as f32;
             let ray = self.ray(still, x as f32 + 0.5, y as f32 + 0.5, u);
-            let (c, prim) = integrator.trace_primary(&ray, st);
+            let sample = integrator.camera_sample(&ray, &PixelPrior::NONE, st);
+            let (c, prim) = (sample.radiance, sample.prim);
             st.counts.primary += 1;
             if prim != centre.1 || 255.0 * (tone3(c) - tone).abs().max_element() > FLAT_CONTRAST {
                 return true;
@@ -247,7 +251,7 @@ impl Shutter {
 const SLIDE_SLACK: f32 = 1.0 / 64.0;
 
 /// `Shutter::slide_stray` of a camera seen at the instants `sweep`.
-fn slide_stray(sweep: &[CameraRays]) -> Option<f32> {
+fn slide_stray(sweep: &[PinholeCamera]) -> Option<f32> {
     let (first, last) = (sweep.first()?, sweep.last()?);
     let way = last.eye() - first.eye();
     let mut stray = 0.0f32;
@@ -298,7 +302,7 @@ mod tests {
         }
     }
 
-    fn view(eye: [f64; 3], dir: [f64; 3]) -> CameraRays {
+    fn view(eye: [f64; 3], dir: [f64; 3]) -> PinholeCamera {
         let cam = Camera {
             name: "eye".into(),
             fov_x_deg: 50.0,
@@ -306,7 +310,7 @@ mod tests {
             dir: dir.into(),
             up: [0.0, 1.0, 0.0].into(),
         };
-        CameraRays::new(&cam, 64, 36).expect("a camera")
+        PinholeCamera::new(&cam, 64, 36).expect("a camera")
     }
 
     #[test]

@@ -101,6 +101,7 @@ impl Scene {
     /// The frame of local slot `slot` of prototype `p` used in frame `frame`, composed as the
     /// flattening composes it: from the use's frame down, each object's own transform after
     /// its parent's.
+    #[inline]
     pub fn prototype_world(&self, p: &Prototype, frame: &Transform, slot: u32) -> Transform {
         let mut chain: ArrayVec<u32, { MAX_NESTING + 2 }> = ArrayVec::new();
         let mut k = slot;
@@ -126,6 +127,7 @@ impl Scene {
     }
 
     /// `world` moved by the transforms [`Scene::transform_all`] applied, in order.
+    #[inline]
     pub fn moved(&self, world: Transform) -> Transform {
         self.moves.iter().fold(world, |w, t| t.then_after(&w))
     }

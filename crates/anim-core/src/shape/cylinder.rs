@@ -395,7 +395,7 @@ impl Cylinder {
     /// The side and the nearer cap around `point` (in the cylinder's space), with its
     /// distances from them; both at 0 on a rim, where `intersect` snaps hits (see
     /// `AxisFrame::faces_near`). Spawned rays leave clear of both
-    /// (`crate::render::primitive::Primitive::surface`), whatever normal the hit reported.
+    /// (`crate::render::geometry::Primitive::surface`), whatever normal the hit reported.
     pub fn faces_near(&self, point: Vec3A) -> NearFaces {
         let local = self.frame.point_to_local(point.as_dvec3());
         let (r, h) = (self.radius as f64, self.frame.height);

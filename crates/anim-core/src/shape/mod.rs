@@ -102,7 +102,7 @@ impl Shape {
     }
 
     /// The faces a kept hit lies on or near, for lifting rays spawned from it off all of them
-    /// (`crate::render::primitive::Primitive::surface`). Only the kept hit asks, once.
+    /// (`crate::render::geometry::Primitive::surface`). Only the kept hit asks, once.
     // Always inlined: with a second caller of `surface` (moving shapes) it was not, and the
     // call cost still frames 0.7 % more instructions.
     #[inline(always)]

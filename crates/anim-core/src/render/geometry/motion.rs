@@ -1,6 +1,11 @@
-//! The moving part of a render scene (docs/scene-language.md §10): shapes whose transform
-//! slot moves during the exposure, each a top-level entry of the hierarchy bounded over the
-//! whole exposure and placed at the time of the ray that tests it; and moving lights.
+//! The moving part of a compiled scene's geometry (docs/scene-language.md §10): shapes whose
+//! transform slot moves during the exposure, each a primitive of the geometry's table
+//! (`Kind::Moving`, pbrt's `AnimatedPrimitive`) bounded over the whole exposure and placed at
+//! the time of the ray that tests it. Siblings: `crate::math::motion` (keys and their
+//! interpolation), `crate::sdf::parse::motion` (the `motion` statements),
+//! `crate::scene::motion` (what moves in a scene description) and `crate::render::motion`
+//! (the exposure: instants of camera samples, the camera at an instant, and what adaptive
+//! sampling asks of motion). Moving lights are shading data (`crate::render::shading`).
 //!
 //! Static geometry pays nothing: its primitives and their tests are those of a frame without
 //! motion. A moving shape is placed by `Motion::slot_matrix` at the ray's time, a function of
@@ -8,9 +13,9 @@
 //! same floats, and the spawn bounds of `Primitive::surface` hold between them as for a
 //! static shape.
 
+use super::Primitive;
 use crate::limits::{MOTION_MAX_PLACED, MOTION_TIME_STEPS};
 use crate::math::{Aabb, Ray, Transform};
-use crate::render::primitive::Primitive;
 use crate::scene::motion::Motion;
 use crate::scene::{Instance, Scene};
 use crate::shape::{BoxRay, Geometry};
@@ -31,9 +36,6 @@ const POSE_PARTS: usize = 32;
 
 /// Steps per half part over which a pose's drift is measured (and at the keys' instants).
 const DRIFT_STEPS: usize = 2;
-/// Most moving shapes a shadow ray asks one by one whether they block it
-/// ([`Moving::blocks`]); past this, asking them costs about what the hierarchy does.
-const BLOCKS_MAX: usize = 16;
 /// Boxes slab-tested at once by [`Moving::blocks`].
 const LANES: usize = 4;
 
@@ -76,19 +78,6 @@ impl Pose {
     }
 }
 
-thread_local! {
-    /// While adaptive sampling's first pass watches a centre sample ([`watch`]): the largest
-    /// angle (radians, as the eye sees it) swept by the moving shapes its rays may have met at
-    /// some instant of the exposure. NaN while nobody watches, so that the test in
-    /// [`Moving::with`] is one comparison that fails.
-    static TOUCHED: Cell<f32> = const { Cell::new(f32::NAN) };
-    /// The moving entries this thread placed at the time of its latest ray: every ray of a
-    /// camera sample (primary, shadow, reflected) has that sample's time, so each entry is
-    /// placed once per sample, not once per test. Only saves work: an entry placed again at
-    /// the same time is the same floats.
-    static PLACED: RefCell<Placed> = RefCell::new(Placed::default());
-}
-
 /// Numbers the moving parts made, so that a thread's cache knows whose entries it holds.
 static NEXT_ID: AtomicU64 = AtomicU64::new(1);
 
@@ -102,19 +91,46 @@ struct Placed {
     entries: Vec<(u64, Option<Primitive>)>,
 }
 
-/// Starts watching which moving shapes this thread's queries meet ([`take_touched`]).
-pub fn watch() {
-    TOUCHED.with(|t| t.set(0.0));
+/// What one worker's queries keep between rays: owned by the worker (`TraceState`) and
+/// handed to every query, so nothing flows between layers behind the callers' backs.
+pub struct Scratch {
+    /// While adaptive sampling's first pass watches a centre sample ([`Scratch::watch`]): the
+    /// largest angle (radians, as the eye sees it) swept by the moving shapes its rays may
+    /// have met at some instant of the exposure. NaN while nobody watches, so that the test
+    /// in [`Moving::with`] is one comparison that fails.
+    watched: Cell<f32>,
+    /// The moving entries placed at the time of the worker's latest ray: every ray of a
+    /// camera sample (primary, shadow, reflected) has that sample's time, so each entry is
+    /// placed once per sample, not once per test. Only saves work: an entry placed again at
+    /// the same time is the same floats.
+    placed: RefCell<Placed>,
 }
 
-/// The largest angle (radians) swept, as the eye sees it, by the moving shapes that this
-/// thread's queries may have met at some instant since [`watch`] (see [`Moving::met_by`]);
-/// 0 when they met none. Stops watching.
-pub fn take_touched() -> f32 {
-    TOUCHED.with(|t| t.replace(f32::NAN)).max(0.0)
+impl Default for Scratch {
+    fn default() -> Self {
+        Scratch {
+            watched: Cell::new(f32::NAN),
+            placed: RefCell::new(Placed::default()),
+        }
+    }
 }
 
-/// The moving shapes and lights of a scene.
+impl Scratch {
+    /// Starts watching which moving shapes the queries given this scratch meet
+    /// ([`Scratch::take_touched`]).
+    pub fn watch(&self) {
+        self.watched.set(0.0);
+    }
+
+    /// The largest angle (radians) swept, as the eye sees it, by the moving shapes that the
+    /// queries may have met at some instant since [`Scratch::watch`] (see
+    /// [`Moving::met_by`]); 0 when they met none. Stops watching.
+    pub fn take_touched(&self) -> f32 {
+        self.watched.replace(f32::NAN).max(0.0)
+    }
+}
+
+/// The moving shapes of a scene.
 #[derive(Clone, Debug)]
 pub struct Moving {
     id: u64,
@@ -134,8 +150,6 @@ pub struct Moving {
     /// Per moving entry: all its poses at once, as one box in the space of one of them
     /// (`reach_of`); `None` where a pose cannot be told.
     reach: Vec<Option<Pose>>,
-    /// Scene light positions (moved with the scene), for moving lights.
-    lights: Vec<DVec3>,
     /// Entry `k` placed at instant `i` (of `MOTION_TIME_STEPS`) in cell `k·steps + i`, made
     /// by the first ray that needs it; empty when the scene has too many moving shapes for
     /// it (each worker then places them per camera sample).
@@ -164,10 +178,10 @@ pub fn step(time: f32) -> u32 {
 }
 
 impl Moving {
-    /// The moving part of `scene`, if anything in it moves (geometry or lights).
+    /// The moving part of `scene`, if a shape in it moves.
     pub fn new(scene: &Scene) -> Option<Moving> {
         let motion = scene.motion.as_ref()?;
-        if !(motion.moves_geometry() || motion.moves_lights()) {
+        if !motion.moves_geometry() {
             return None;
         }
         Some(Moving {
@@ -182,7 +196,6 @@ impl Moving {
             convex: Vec::new(),
             part_boxes: Vec::new(),
             part_union: Vec::new(),
-            lights: scene.lights.iter().map(|l| l.position).collect(),
             placed: Vec::new(),
         })
     }
@@ -295,14 +308,9 @@ impl Moving {
         )
     }
 
-    /// Whether a light moves during the exposure.
-    pub fn moves_lights(&self) -> bool {
-        self.motion.moves_lights()
-    }
-
     /// Whether [`Moving::blocks`] answers.
     pub fn answers_blocks(&self) -> bool {
-        self.entries.len() <= BLOCKS_MAX
+        self.entries.len() <= crate::render::policy::MOVING_BLOCKS_MAX
     }
 
     /// Whether some moving shape blocks (wholly or in part) a ray before `t_max`, at the
@@ -310,7 +318,13 @@ impl Moving {
     /// are more moving shapes than it pays to ask one by one.
     /// For shadow rays whose light no static shape blocks (adaptive sampling's known-clear
     /// lights in frames with motion), which need not walk the whole hierarchy.
-    pub fn blocks(&self, ray: &Ray, t_max: f32, from: Option<u32>) -> Option<bool> {
+    pub fn blocks(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        from: Option<u32>,
+        scratch: &Scratch,
+    ) -> Option<bool> {
         if !self.answers_blocks() {
             return None;
         }
@@ -341,7 +355,8 @@ impl Moving {
                 if from == Some(k as u32) && self.convex[k] {
                     continue;
                 }
-                if self.with(k as u32, ray, |p| p.hit(ray, t_max).is_some()) == Some(true) {
+                let hit = |p: &Primitive| p.hit(ray, t_max).is_some();
+                if self.with(k as u32, ray, scratch, hit) == Some(true) {
                     return Some(true);
                 }
             }
@@ -469,41 +484,53 @@ impl Moving {
 
     /// `f` of entry `k` placed at the ray's time; `None` where it is degenerate then.
     #[inline]
-    pub fn with<R>(&self, k: u32, ray: &Ray, f: impl FnOnce(&Primitive) -> R) -> Option<R> {
+    pub fn with<R>(
+        &self,
+        k: u32,
+        ray: &Ray,
+        scratch: &Scratch,
+        f: impl FnOnce(&Primitive) -> R,
+    ) -> Option<R> {
         let time = ray.time;
         let swept = self.sweep.get(k as usize).copied().unwrap_or(f32::INFINITY);
         // Asked also outside a traversal (a shadow ray tries the last blocker first): only a
         // ray that meets the shape at some instant counts.
-        if TOUCHED.with(Cell::get) < swept && self.met_by(k, ray) {
-            TOUCHED.with(|t| t.set(swept));
+        if scratch.watched.get() < swept && self.met_by(k, ray) {
+            scratch.watched.set(swept);
         }
-        self.placed_with(k, time, f)
+        self.placed_with(k, time, scratch, f)
     }
 
     /// `f` of entry `k` placed at `time`, as [`Moving::with`] gives it to a ray of that time,
     /// without noting it as met: for a shape a ray already met (its surface).
     #[inline]
-    pub fn placed_with<R>(&self, k: u32, time: f32, f: impl FnOnce(&Primitive) -> R) -> Option<R> {
+    pub fn placed_with<R>(
+        &self,
+        k: u32,
+        time: f32,
+        scratch: &Scratch,
+        f: impl FnOnce(&Primitive) -> R,
+    ) -> Option<R> {
         if !self.placed.is_empty() {
             return self.placed_at(k, step(time))?.map(f);
         }
-        PLACED.with_borrow_mut(|c| {
-            if c.owner != self.id || c.time != time.to_bits() {
-                c.owner = self.id;
-                c.time = time.to_bits();
-                c.generation += 1;
-                if c.entries.len() != self.entries.len() {
-                    c.entries.clear();
-                    c.entries.resize_with(self.entries.len(), || (0, None));
-                }
+        let mut cache = scratch.placed.borrow_mut();
+        let c = &mut *cache;
+        if c.owner != self.id || c.time != time.to_bits() {
+            c.owner = self.id;
+            c.time = time.to_bits();
+            c.generation += 1;
+            if c.entries.len() != self.entries.len() {
+                c.entries.clear();
+                c.entries.resize_with(self.entries.len(), || (0, None));
             }
-            let generation = c.generation;
-            let slot = c.entries.get_mut(k as usize)?;
-            if slot.0 != generation {
-                *slot = (generation, self.place(k, time));
-            }
-            slot.1.as_ref().map(f)
-        })
+        }
+        let generation = c.generation;
+        let slot = c.entries.get_mut(k as usize)?;
+        if slot.0 != generation {
+            *slot = (generation, self.place(k, time));
+        }
+        slot.1.as_ref().map(f)
     }
 
     /// Entry `k`'s bounds over the whole exposure.
@@ -523,22 +550,12 @@ impl Moving {
         })
     }
 
-    /// Where light `k` is at `time`.
-    #[inline]
-    pub fn light_position(&self, k: usize, time: f32) -> Vec3A {
-        let p = self.lights.get(k).map_or(DVec3::ZERO, |&p| {
-            self.motion.light_position(k, p, time as f64)
-        });
-        Vec3A::from(p.as_vec3())
-    }
-
     pub fn memory_bytes(&self) -> usize {
         self.entries.capacity() * 4
             + self.sweep.capacity() * 4
             + self.bounds.capacity() * std::mem::size_of::<Aabb>()
             + self.poses.capacity() * std::mem::size_of::<Option<Pose>>()
             + self.reach.capacity() * std::mem::size_of::<Option<Pose>>()
-            + self.lights.capacity() * 24
             + self.placed.capacity() * std::mem::size_of::<OnceLock<Option<Primitive>>>()
             + self.part_boxes.capacity() * std::mem::size_of::<[[Vec4; LANES]; 2]>()
             + self.part_union.capacity() * std::mem::size_of::<Aabb>()
@@ -759,7 +776,7 @@ mod tests {
             prop_assert!(moving.met_by(k, &ray), "entry {k} hit at step {step}, not met");
             // And a shadow ray at that instant asks it (its bounds in that part hold it).
             let at = ray.at_time(u as f32);
-            let blocks = moving.blocks(&at, f32::INFINITY, None);
+            let blocks = moving.blocks(&at, f32::INFINITY, None, &Scratch::default());
             prop_assert_eq!(blocks, Some(true), "entry {} at step {}", k, step);
         }
     }
@@ -791,13 +808,25 @@ mod tests {
         let moving = moving_things();
         // Down through the ball's centre at the middle of the exposure, (3, 0, 0).
         let at = |time: f32| Ray::new(Vec3A::new(3.0, 0.0, 5.0), Vec3A::NEG_Z).at_time(time);
-        assert_eq!(moving.blocks(&at(0.5), f32::INFINITY, None), Some(true));
+        assert_eq!(
+            moving.blocks(&at(0.5), f32::INFINITY, None, &Scratch::default()),
+            Some(true)
+        );
         // Early on the ball is 8 units to the left; the bar and the post are never there.
-        assert_eq!(moving.blocks(&at(0.1), f32::INFINITY, None), Some(false));
+        assert_eq!(
+            moving.blocks(&at(0.1), f32::INFINITY, None, &Scratch::default()),
+            Some(false)
+        );
         // The light is nearer than the ball.
-        assert_eq!(moving.blocks(&at(0.5), 4.0, None), Some(false));
+        assert_eq!(
+            moving.blocks(&at(0.5), 4.0, None, &Scratch::default()),
+            Some(false)
+        );
         // A ray said to leave the ball's own surface (entry 1) does not ask the ball.
-        assert_eq!(moving.blocks(&at(0.5), f32::INFINITY, Some(1)), Some(false));
+        assert_eq!(
+            moving.blocks(&at(0.5), f32::INFINITY, Some(1), &Scratch::default()),
+            Some(false)
+        );
         assert!(moving.answers_blocks());
     }
 

@@ -1,5 +1,9 @@
 //! The prototypes of a scene's instanced composites, compiled: one hierarchy each, over its
-//! shapes and nested uses in its own frame, entered by a use's transform.
+//! shapes and nested uses in its own frame, entered by a use's transform (pbrt's
+//! `TransformedPrimitive`). A top-level use is one primitive of the geometry's table
+//! (`Kind::Instance`). Siblings: `crate::scene::instancing` (what a composite drawn in
+//! several places expands to) and `crate::scene::build::instancing` (when a composite is
+//! kept once).
 //!
 //! The hierarchies only cull. A shape they offer is placed with the world transform the
 //! flattened tree gives it (`Scene::prototype_world`, composed top-down as the flattening
@@ -8,36 +12,16 @@
 //! rounding differs from the world ray's; boxes and distances are widened by
 //! [`CULL_MARGIN`] so that it never drops a shape the world test would hit.
 
+use super::leaf::Best;
+use super::Primitive;
 use crate::accel::Bvh;
 use crate::math::{Aabb, Ray, Transform};
-use crate::render::primitive::Primitive;
 use crate::scene::{Instance, Prototype, Scene, Use};
-use crate::shape::ShapeHit;
 use glam::Vec3A;
 
 /// Relative widening of the culling boxes and distances of prototypes (far beyond the f32
 /// rounding of a ray moved into a prototype's frame).
 const CULL_MARGIN: f32 = 1e-3;
-
-/// The closest hit so far: the id of what was hit, its distance, the depth-first number
-/// that breaks ties (0 for unbounded primitives, which keep their ties), and the
-/// object-space hit of a primitive that is not a packed sphere.
-#[derive(Clone, Copy, Debug)]
-pub struct Best {
-    pub id: u32,
-    pub t: f32,
-    pub key: u32,
-    pub hit: Option<ShapeHit>,
-}
-
-impl Best {
-    /// Whether a hit at `t` numbered `key` wins over this one: closer, or as close and
-    /// earlier in the flattened tree.
-    #[inline(always)]
-    pub fn loses_to(best: &Option<Best>, t_max: f32, t: f32, key: u32) -> bool {
-        t < t_max || (t == t_max && best.is_some_and(|b| key < b.key))
-    }
-}
 
 #[derive(Clone, Debug)]
 struct Compiled {

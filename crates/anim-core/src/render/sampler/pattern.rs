@@ -35,24 +35,7 @@ pub const FLAT_CONTRAST: f32 = 2.0;
 /// RMSE of 0.483 instead of 0.50; 0.2 is what keeps it within a third of uniform 16 spp.
 const EDGE_ERROR_SHARE: f32 = 0.2;
 
-/// Tone map of one channel as the film does it (`c/(c+1)`), before the ×255.
-#[inline]
-pub fn tone(c: f32) -> f32 {
-    if c > 0.0 {
-        if c == f32::INFINITY {
-            1.0
-        } else {
-            c / (c + 1.0)
-        }
-    } else {
-        0.0
-    }
-}
-
-#[inline]
-pub fn tone3(c: Vec3A) -> Vec3A {
-    Vec3A::new(tone(c.x), tone(c.y), tone(c.z))
-}
+pub use crate::render::film::{tone, tone3};
 
 /// splitmix64's finaliser: a bijective mixer whose every output bit depends on every input bit.
 #[inline]

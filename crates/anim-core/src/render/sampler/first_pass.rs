@@ -1,0 +1,296 @@
+//! Adaptive sampling's first pass: one ray through every pixel centre (exactly `--spp 1`),
+//! and what the later passes read of it: which pixels are flat and keep their centre sample
+//! ([`FirstPass::refinement`]), and what a refined pixel's samples may take as known of the
+//! lights ([`FirstPass::prior`]).
+
+use super::packet;
+use super::pattern::{tone3, FLAT_CONTRAST};
+use super::Frame;
+use crate::render::integrator::{KnownNear, PixelPrior, TraceState};
+use crate::render::motion::Shutter;
+use crate::render::RayCounts;
+use glam::Vec3A;
+use rayon::prelude::*;
+
+/// How a pixel's centre ray saw the motion of a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Sweep {
+    /// Its rays may meet a moving shape (`Moving::met_by`), and it changes during the exposure
+    /// (`Shutter::changes`).
+    touched: bool,
+    /// The ends of the streak the camera's motion draws its hit point along (pixels from
+    /// its centre), along which the image must be flat for it to keep its centre sample;
+    /// `None` when it sweeps too far for that (`Shutter::camera_sweep`).
+    streak: Option<[(f32, f32); 2]>,
+    /// How far along its centre ray the surface it hit lies, where its shadow rays' findings
+    /// are kept for the shapes that hold still (NaN where they are not).
+    depth: f32,
+}
+
+impl Default for Sweep {
+    fn default() -> Self {
+        Sweep {
+            touched: false,
+            streak: Some([(0.0, 0.0); 2]),
+            depth: f32::NAN,
+        }
+    }
+}
+
+/// What the first pass saw, per pixel (row-major).
+pub(super) struct FirstPass<'f> {
+    frame: &'f Frame<'f>,
+    /// The centre sample's radiance and the primitive it hit.
+    pub centres: Vec<(Vec3A, u32)>,
+    /// The centres tone-mapped: a pixel's neighbourhood, and its streak under a moving
+    /// camera, read many of them.
+    tones: Vec<Vec3A>,
+    /// In a frame with motion: how each centre ray saw it (empty otherwise).
+    sweeps: Vec<Sweep>,
+    /// The lights some shadow ray of the centre's tree did not see fully
+    /// (`CameraSample::not_clear`); all of them where that is not recorded.
+    not_clear: Vec<u32>,
+    /// Whether the centres' shadow findings speak for the shapes that hold still, with the
+    /// depth of their hits (a frame with motion whose lights hold still and whose moving
+    /// shapes are few enough to ask at each sample's instant).
+    known_of_still: bool,
+}
+
+impl<'f> FirstPass<'f> {
+    /// Traces the centre of every pixel of `frame`.
+    pub fn trace(frame: &'f Frame<'f>) -> (FirstPass<'f>, RayCounts) {
+        let (w, h) = frame.size;
+        let mut pass = FirstPass {
+            frame,
+            centres: vec![(Vec3A::ZERO, 0); w * h],
+            tones: Vec::new(),
+            sweeps: vec![Sweep::default(); if frame.shutter.is_some() { w * h } else { 0 }],
+            not_clear: vec![u32::MAX; w * h],
+            known_of_still: frame.shutter.is_some_and(|s| !s.lights_move())
+                && frame.integrator.scene.geometry.answers_moving_blocks(),
+        };
+        let counts = match frame.shutter {
+            None => pass.trace_still(),
+            Some(s) => pass.trace_moving(s),
+        };
+        pass.tones = pass.centres.par_iter().map(|(c, _)| tone3(*c)).collect();
+        (pass, counts)
+    }
+
+    /// The centres of a frame in which nothing moves, a row at a time (in packets where the
+    /// scene's plan says so).
+    fn trace_still(&mut self) -> RayCounts {
+        let frame = self.frame;
+        let w = frame.size.0;
+        self.centres
+            .par_chunks_mut(w)
+            .zip(self.not_clear.par_chunks_mut(w))
+            .enumerate()
+            .map(|(y, (row, not_clear_row))| {
+                let mut st = TraceState::default();
+                if packet::trace_centres(frame, y, row, not_clear_row, &mut st) {
+                    return st.counts;
+                }
+                for (x, (px, nc)) in row.iter_mut().zip(not_clear_row).enumerate() {
+                    let ray = frame.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
+                    let sample = frame
+                        .integrator
+                        .camera_sample(&ray, &PixelPrior::NONE, &mut st);
+                    *px = (sample.radiance, sample.prim);
+                    *nc = sample.not_clear;
+                }
+                st.counts.primary += row.len() as u64;
+                st.counts
+            })
+            .reduce(RayCounts::default, RayCounts::sum)
+    }
+
+    /// The centres of a frame with motion, at the middle of the exposure, each watched for
+    /// the moving shapes its rays may meet.
+    fn trace_moving(&mut self, shutter: &Shutter) -> RayCounts {
+        let frame = self.frame;
+        let w = frame.size.0;
+        // A light a centre's shadow rays saw fully stays so only while it holds still.
+        // Then, where the moving shapes are few enough to ask at each sample's instant, what
+        // they saw is kept as news of the shapes that hold still, with how far the centre's
+        // hit is (see `KnownNear`); otherwise, only while the camera holds still too (so
+        // that the refined samples hit near the centres), for centres none of whose rays may
+        // meet anything moving.
+        let of_still = frame.integrator.scene.geometry.answers_moving_blocks();
+        let shadows_hold = !shutter.lights_move() && (of_still || !shutter.camera_moves());
+        self.centres
+            .par_chunks_mut(w)
+            .zip(self.sweeps.par_chunks_mut(w))
+            .zip(self.not_clear.par_chunks_mut(w))
+            .enumerate()
+            .map(|(y, ((row, sweep_row), not_clear_row))| {
+                let mut st = TraceState::default();
+                let pixels = row.iter_mut().zip(sweep_row).zip(not_clear_row);
+                for (x, ((px, sw), nc)) in pixels.enumerate() {
+                    let (x, y) = (x as u32, y as u32);
+                    let ray = frame.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
+                    st.scratch.watch();
+                    let sample = frame
+                        .integrator
+                        .camera_sample(&ray, &PixelPrior::NONE, &mut st);
+                    *px = (sample.radiance, sample.prim);
+                    let swept = st.scratch.take_touched();
+                    if shadows_hold && (of_still || swept == 0.0) {
+                        *nc = sample.not_clear;
+                        if of_still {
+                            sw.depth = sample.t.unwrap_or(f32::NAN);
+                        }
+                    }
+                    sw.touched = swept > 0.0
+                        && shutter.changes(
+                            frame.integrator,
+                            frame.camera,
+                            (x, y),
+                            *px,
+                            swept,
+                            &mut st,
+                        );
+                    if shutter.camera_moves() {
+                        sw.streak = shutter.camera_sweep(frame.camera, x, y, sample.t);
+                    }
+                }
+                st.counts.primary += row.len() as u64;
+                st.counts
+            })
+            .reduce(RayCounts::default, RayCounts::sum)
+    }
+
+    /// Whether pixel (x, y) is refined, and if so the largest tone-mapped difference (8-bit
+    /// levels) between its centre and those around it and whether motion touches it; `None`
+    /// if it is flat and keeps its centre sample. Flat: all nine centres around it hit one
+    /// surface within `FLAT_CONTRAST` levels, no centre ray around it met something moving,
+    /// and under a moving camera the image is flat along its streak.
+    pub fn refinement(&self, x: usize, y: usize) -> Option<(f32, bool)> {
+        let (w, h) = self.frame.size;
+        let prim = self.centres[y * w + x].1;
+        let tone = self.tones[y * w + x];
+        let mut contrast = 0.0f32;
+        let mut other_surface = false;
+        let mut moving = false;
+        for near in around(x, y, (w, h)) {
+            for (t, (_, p)) in self.tones[near.clone()]
+                .iter()
+                .zip(&self.centres[near.clone()])
+            {
+                other_surface |= *p != prim;
+                contrast = contrast.max((*t - tone).abs().max_element());
+            }
+            if !self.sweeps.is_empty() {
+                moving |= self.sweeps[near].iter().any(|s| s.touched);
+            }
+        }
+        let streak = match self.sweeps.get(y * w + x).map(|s| s.streak) {
+            None => Streak::default(),
+            Some(None) => {
+                moving = true;
+                Streak::default()
+            }
+            Some(Some(ends)) => self.streak(x, y, ends),
+        };
+        other_surface |= streak.other_surface;
+        let flat = !moving && !other_surface && 255.0 * contrast.max(streak.bias) <= FLAT_CONTRAST;
+        (!flat).then_some((255.0 * contrast.max(streak.contrast), moving))
+    }
+
+    /// The centres along the streak from (x, y) to `ends` that the camera's motion draws:
+    /// the pixel's value is the mean of what the streak's two halves show, flat when every
+    /// pair of points that far along the two halves averages to the centre (a steady
+    /// gradient does), though the points themselves may differ more.
+    fn streak(&self, x: usize, y: usize, ends: [(f32, f32); 2]) -> Streak {
+        let (w, h) = self.frame.size;
+        let (prim, tone) = (self.centres[y * w + x].1, self.tones[y * w + x]);
+        let at = |(px, py): (i64, i64)| {
+            (px >= 0 && py >= 0 && px < w as i64 && py < h as i64)
+                .then(|| py as usize * w + px as usize)
+        };
+        let mut streak = Streak::default();
+        let mut seen = |i: usize| {
+            streak.other_surface |= self.centres[i].1 != prim;
+            let d = self.tones[i] - tone;
+            streak.contrast = streak.contrast.max(d.abs().max_element());
+            d
+        };
+        let mut bias = 0.0f32;
+        for [a, b] in Shutter::streak_pairs(x, y, ends) {
+            let (a, b) = (at(a).map(&mut seen), at(b).map(&mut seen));
+            let pair = match (a, b) {
+                (Some(a), Some(b)) => (a + b) * 0.5,
+                (Some(d), None) | (None, Some(d)) => d,
+                (None, None) => Vec3A::ZERO,
+            };
+            bias = bias.max(pair.abs().max_element());
+        }
+        Streak { bias, ..streak }
+    }
+
+    /// What the samples added to pixel (x, y) know of the lights: those that every shadow ray
+    /// of the centres around it saw fully, taken as visible where their camera rays hit. A
+    /// shadow edge inside the pixel that none of the nine centres' trees met is lost, as the
+    /// flat test loses a sliver between centres (BENCHMARKS.md, "Known-clear lights").
+    pub fn prior(&self, x: usize, y: usize) -> PixelPrior {
+        let (w, h) = self.frame.size;
+        let mut seen = 0;
+        for near in around(x, y, (w, h)) {
+            for nc in &self.not_clear[near] {
+                seen |= nc;
+            }
+        }
+        PixelPrior {
+            known_clear: !seen,
+            near: self.known_near(x, y),
+        }
+    }
+
+    /// In a frame with motion whose centres kept their shadow rays' findings for the shapes
+    /// that hold still: the range of distances of the hits of the centres around (x, y), and
+    /// under a moving camera the span of those centres in the image. A sample whose hit lies
+    /// outside them may see the lights past other shapes, so it takes none as known.
+    fn known_near(&self, x: usize, y: usize) -> Option<KnownNear> {
+        if !self.known_of_still {
+            return None;
+        }
+        let (w, h) = self.frame.size;
+        let mut depth = (f32::INFINITY, f32::NEG_INFINITY);
+        for near in around(x, y, (w, h)) {
+            for s in &self.sweeps[near] {
+                // NaN (no depth kept) leaves the range as it is.
+                depth = (depth.0.min(s.depth), depth.1.max(s.depth));
+            }
+        }
+        let view_moves = self.frame.shutter.is_some_and(|s| s.camera_moves());
+        let seen_from = view_moves.then(|| {
+            let first = |c: usize| c.saturating_sub(1) as f32 + 0.5;
+            let last = |c: usize, n: usize| (c + 1).min(n - 1) as f32 + 0.5;
+            let span = [first(x), first(y), last(x, w), last(y, h)];
+            (self.frame.camera.clone(), span)
+        });
+        Some(KnownNear { depth, seen_from })
+    }
+}
+
+/// What the pixels along a streak show ([`FirstPass::streak`]), in tone-mapped units.
+#[derive(Clone, Copy, Debug, Default)]
+struct Streak {
+    /// How far the worst pair's mean lies from the centre.
+    bias: f32,
+    /// How far the farthest pixel lies from the centre.
+    contrast: f32,
+    /// Whether some pixel shows another surface.
+    other_surface: bool,
+}
+
+/// The 3×3 neighbourhood of pixel (x, y) in a `w`×`h` image, clipped to it: per row, the
+/// range of its pixels' indices (row-major).
+pub(super) fn around(
+    x: usize,
+    y: usize,
+    (w, h): (usize, usize),
+) -> impl Iterator<Item = std::ops::Range<usize>> {
+    (y.saturating_sub(1)..(y + 2).min(h))
+        .map(move |ny| ny * w + x.saturating_sub(1)..ny * w + (x + 2).min(w))
+}

@@ -1,0 +1,302 @@
+//! The geometry contract: every strategy that answers a ray (the 4-wide hierarchy, the flat
+//! leaf, packed spheres, packets, instanced composites, moving shapes, direction cells and
+//! image tiles) gives brute force's answer over real primitives, to the bit: random scenes of
+//! spheres, boxes, triangles and the other kinds (some transformed, so kept in object space);
+//! the closest hit's distance, primitive and surface, and any-hit answers.
+//!
+//! - `hierarchy`: the hierarchy alone, over primitives.
+//! - `render_scene`: the compiled scene's queries, instanced composites against their
+//!   flattened trees, packets against single rays.
+//! - `lookups`: camera and shadow rays through the eye's and the lights' direction cells and
+//!   image tiles, in still and moving frames.
+
+mod hierarchy;
+mod lookups;
+mod render_scene;
+
+use anim_core::math::{Ray, Transform};
+use anim_core::render::camera::PinholeCamera;
+use anim_core::render::compile::{Occlusion, RayHint, RenderScene};
+use anim_core::render::geometry::{Dropped, Primitive, Scratch, SurfaceHit};
+use anim_core::render::shading::PointLight;
+use anim_core::render::view::Viewpoint;
+use anim_core::scene::{Camera, Instance, Material, Scene};
+use anim_core::shape::Geometry;
+use glam::{DVec3, Vec3, Vec3A};
+
+/// A compiled scene with a scratch of its own, asked what the renderer asks it.
+struct Compiled {
+    scene: RenderScene,
+    scratch: Scratch,
+}
+
+impl Compiled {
+    fn new(scene: &Scene, viewpoint: Option<&Viewpoint>) -> (Compiled, Vec<Dropped>) {
+        let (scene, dropped) = RenderScene::compile(scene, viewpoint);
+        let scratch = Scratch::default();
+        (Compiled { scene, scratch }, dropped)
+    }
+
+    fn len(&self) -> usize {
+        self.scene.geometry.len()
+    }
+
+    fn material_of(&self, id: u32) -> u32 {
+        self.scene.geometry.material_of(id)
+    }
+
+    /// The closest hit as a reflected ray asks it: through the hierarchy.
+    fn closest(&self, ray: &Ray, t_max: f32) -> Option<(u32, SurfaceHit)> {
+        self.scene
+            .intersect(ray, t_max, RayHint::Secondary, &self.scratch)
+    }
+
+    /// The closest hit as a camera ray asks it: through the eye's lookup where it answers.
+    fn closest_seen(&self, ray: &Ray) -> Option<(u32, SurfaceHit)> {
+        self.scene
+            .intersect(ray, f32::INFINITY, RayHint::Camera, &self.scratch)
+    }
+
+    fn closest_seen_packet<const N: usize>(
+        &self,
+        rays: &[Ray; N],
+    ) -> [Option<(u32, SurfaceHit)>; N] {
+        self.scene.intersect_camera_packet(rays, &self.scratch)
+    }
+
+    fn closest_packet<const N: usize>(
+        &self,
+        rays: &[Ray; N],
+        t_max: f32,
+    ) -> [Option<(u32, SurfaceHit)>; N] {
+        self.scene
+            .geometry
+            .closest_packet(rays, t_max, &self.scratch)
+    }
+
+    fn shadow(&self, ray: &Ray, t_max: f32, light: usize) -> Occlusion {
+        self.scene
+            .occlusion(ray, t_max, RayHint::Shadow(light), &self.scratch)
+    }
+
+    fn occluder(&self, ray: &Ray, t_max: f32) -> Option<u32> {
+        self.scene.geometry.occluder(ray, t_max, &self.scratch)
+    }
+
+    fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        self.occluder(ray, t_max).is_some()
+    }
+
+    fn hit(&self, id: u32, ray: &Ray, t_max: f32) -> Option<f32> {
+        self.scene.geometry.hit(id, ray, t_max, &self.scratch)
+    }
+
+    fn intersect(&self, id: u32, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
+        self.scene.geometry.intersect(id, ray, t_max, &self.scratch)
+    }
+
+    fn any_candidate(&self, ray: &Ray, t_max: f32, stop: impl FnMut(u32) -> bool) -> bool {
+        self.scene.geometry.any_candidate(ray, t_max, stop)
+    }
+
+    fn lights(&self) -> &[PointLight] {
+        &self.scene.shading.lights
+    }
+}
+
+/// A view from `camera` of a `width`×`height` image, as a render traces it (with more camera
+/// rays than any scene has shapes, so that every lookup the plan allows is built).
+fn viewpoint(camera: &Camera, (width, height): (u32, u32), motion: bool) -> Viewpoint {
+    let rays = PinholeCamera::new(camera, width, height).unwrap();
+    Viewpoint {
+        view: rays.view(),
+        size: (width, height),
+        camera_rays: u64::MAX,
+        motion,
+    }
+}
+
+/// A view from `eye` (looking down −z; cells around the eye do not depend on where it looks).
+fn viewpoint_at(eye: Vec3A, motion: bool) -> Viewpoint {
+    let mut camera = Camera::default_with_fov("eye", 60.0);
+    camera.eye = eye.as_dvec3();
+    viewpoint(&camera, (64, 48), motion)
+}
+
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn vec(&mut self, scale: f64) -> DVec3 {
+        DVec3::new(self.next(), self.next(), self.next()) * scale
+    }
+}
+
+fn random_ray(rng: &mut Rng, i: usize) -> Ray {
+    let o = rng.vec(80.0) - DVec3::splat(15.0);
+    let mut dir = (rng.vec(50.0) - o).normalize();
+    if i.is_multiple_of(4) {
+        // Axis-parallel: direction components of exactly zero.
+        dir = DVec3::ZERO;
+        dir[i / 4 % 3] = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+    }
+    Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(dir.as_vec3()))
+}
+
+/// Every third ray is bounded, so that the `t_max` paths are exercised too.
+fn t_limit_of(i: usize) -> f32 {
+    if i.is_multiple_of(3) {
+        40.0
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// The nearest hit by testing every primitive in order (the first of equal distances wins).
+fn brute_closest(prims: &[Primitive], ray: &Ray, t_limit: f32) -> Option<(usize, f32)> {
+    let mut best: Option<(usize, f32)> = None;
+    for (k, p) in prims.iter().enumerate() {
+        let t_max = best.map_or(t_limit, |(_, t)| t);
+        if let Some(h) = p.hit(ray, t_max) {
+            best = Some((k, h.t));
+        }
+    }
+    best
+}
+
+/// Mostly world-space spheres (so leaves of four spheres, and leaves mixing spheres with other
+/// kinds), with boxes, triangles, rotated and stretched shapes, an exact duplicate sphere (a
+/// tie) and a plane. Instance `i` has material `i`, which names it after renumbering.
+/// Each instance has its own transform slot, with the same index.
+fn mixed_instances(rng: &mut Rng, n: usize) -> (Vec<Instance>, Vec<Transform>) {
+    let mut transforms = Vec::new();
+    let mut push = |out: &mut Vec<Instance>, geometry: Geometry, transform: Transform| {
+        let material = out.len();
+        let mut instance = Instance::new(geometry, material);
+        instance.transform = transforms.len() as u32;
+        transforms.push(transform);
+        out.push(instance);
+    };
+    let mut out = Vec::new();
+    for i in 0..n {
+        let c = rng.vec(50.0);
+        let spin = |rng: &mut Rng| {
+            let turn = Transform::rotate(10.0 + rng.next() * 70.0, DVec3::Y).unwrap();
+            Transform::translate(c).then_after(&turn.then_after(&Transform::translate(-c)))
+        };
+        match i % 10 {
+            0 => push(
+                &mut out,
+                Geometry::Triangle {
+                    vertices: [c, c + rng.vec(4.0), c + rng.vec(4.0)],
+                },
+                Transform::IDENTITY,
+            ),
+            1 => push(
+                &mut out,
+                Geometry::Box {
+                    p1: c,
+                    p2: c + rng.vec(3.0) + DVec3::splat(0.05),
+                },
+                spin(rng),
+            ),
+            2 => {
+                let stretch = Transform::scale(DVec3::new(2.0, 0.5, 1.0)).unwrap();
+                push(
+                    &mut out,
+                    Geometry::Sphere {
+                        center: DVec3::ZERO,
+                        radius: 0.5 + rng.next(),
+                    },
+                    Transform::translate(c).then_after(&stretch),
+                )
+            }
+            _ => push(
+                &mut out,
+                Geometry::Sphere {
+                    center: c,
+                    radius: 0.2 + rng.next() * 2.0,
+                },
+                Transform::IDENTITY,
+            ),
+        }
+    }
+    let twin = out[3].geometry.clone();
+    push(&mut out, twin, Transform::IDENTITY);
+    push(
+        &mut out,
+        Geometry::Plane {
+            point: DVec3::new(0.0, -5.0, 0.0),
+            normal: DVec3::new(0.1, 1.0, 0.05),
+        },
+        Transform::IDENTITY,
+    );
+    (out, transforms)
+}
+
+/// World-space axis-aligned boxes (tested by distance alone, the surface built for the
+/// winner): small ones, an exact duplicate (a tie), and rooms enclosing every ray origin,
+/// so that rays start inside boxes and leave through them.
+fn world_boxes(rng: &mut Rng, n: usize) -> (Vec<Instance>, Vec<Transform>) {
+    let mut geometry: Vec<Geometry> = (0..n)
+        .map(|_| {
+            let c = rng.vec(50.0);
+            Geometry::Box {
+                p1: c,
+                p2: c + rng.vec(6.0),
+            }
+        })
+        .collect();
+    geometry.push(geometry[1].clone());
+    for half in [300.0, 400.0] {
+        geometry.push(Geometry::Box {
+            p1: DVec3::splat(-half),
+            p2: DVec3::new(half, half, half * 0.9),
+        });
+    }
+    let instances = geometry
+        .into_iter()
+        .enumerate()
+        .map(|(k, g)| Instance::new(g, k))
+        .collect();
+    (instances, vec![Transform::IDENTITY])
+}
+
+/// With `spheres_only`, the world-space spheres alone, renumbered.
+fn instances_only(
+    mut instances: Vec<Instance>,
+    transforms: &[Transform],
+    spheres_only: bool,
+) -> Vec<Instance> {
+    if spheres_only {
+        instances.retain(|i| {
+            matches!(i.geometry, Geometry::Sphere { .. })
+                && transforms[i.transform as usize] == Transform::IDENTITY
+        });
+        for (k, i) in instances.iter_mut().enumerate() {
+            i.material = k;
+        }
+    }
+    instances
+}
+
+/// The render scene of a file's first job.
+fn loaded_scene(text: &str) -> Scene {
+    let loaded = anim_core::scene::load_str(
+        text,
+        std::path::Path::new("scene.sdf"),
+        // A small budget: the composites are then worth instancing.
+        &anim_core::sdf::LoadOptions {
+            max_memory: 1 << 20,
+            ..anim_core::sdf::LoadOptions::default()
+        },
+    )
+    .unwrap_or_else(|d| panic!("{d:?}"));
+    loaded.jobs[0].scene.clone()
+}
