@@ -22,7 +22,7 @@ out=${OUT:-$root/target/bench-instructions}
 mkdir -p "$out/scenes"
 command -v valgrind >/dev/null || { echo "needs valgrind (apt-get install valgrind)" >&2; exit 1; }
 
-python3 "$root/scripts/gen-scenes.py" "$out/scenes"
+python3 "$root/scripts/bench/gen-scenes.py" "$out/scenes"
 # Frame 72 of the motion-blur animation: every kind of motion is in the shutter there.
 if [ ! -f "$out/scenes/blur/frame_0072.sdf" ]; then
   sed "s|scene: File(\"blur.sdf\")|scene: File(\"$root/animations/blur.sdf\")|" \

@@ -1,15 +1,30 @@
 #!/usr/bin/env bash
-# Instancing (BENCHMARKS.md §13): whole-process CPU seconds and peak RSS of `anim check` and
-# `anim render` on three generated scenes, for each binary given, in turns (twice):
+# Instancing (BENCHMARKS.md, "Instancing"): whole-process CPU seconds (user + system) and peak
+# RSS, both from /usr/bin/time, of `anim check` and `anim render` on three generated scenes,
+# for each binary given, in turns (ROUNDS rounds, default 2):
 #   chain20: a chain of composites 250 deep over one sphere that doubles at 20 levels
 #            (2^20 spheres flattened), 64×48 at 1 spp;
 #   chain16: the same with 16 doublings, 120 deep (65 536 spheres), 160×120, adaptive;
 #            run again with `--max-memory 1G`, which makes it worth instancing;
 #   blob:    1000 uses of a composite of 1000 spheres (10^6 flattened), 320×240, adaptive.
-# Images of the same scene are compared byte for byte between binaries.
+# Images of the same scene are compared byte for byte between binaries (md5 at the end).
 #
-# Usage: scripts/bench-instancing.sh BINARY...
+#   scripts/bench/instancing.sh BINARY...     # e.g. an old build, then a new one
+#   ANIM=/path/to/anim scripts/bench/instancing.sh
+#
+# Environment: ANIM (the binary when none is given as an argument; default: `cargo build
+# --release`, then target/release/anim), ROUNDS (default 2). Scenes and images live in a
+# temporary folder.
 set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+if [ $# -eq 0 ]; then
+    if [ -n "${ANIM:-}" ]; then
+        set -- "$ANIM"
+    else
+        cargo build --release --quiet --manifest-path "$root/Cargo.toml"
+        set -- "$root/target/release/anim"
+    fi
+fi
 
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
@@ -71,15 +86,18 @@ run() { # label binary args...
     local rc=0
     (cd "$dir" && /usr/bin/time -o "$dir/time" -f '%U %S %M' "$bin" "$@" >/dev/null 2>&1) || rc=$?
     read -r user sys rss < <(tail -n 1 "$dir/time")
-    printf '%-44s %-28s exit %d  CPU %6.2f s  RSS %8d KB\n' "$label" "$(basename "$bin")" "$rc" \
+    printf '%-44s %-28s exit %d  CPU %6.2f s  RSS %8d KB\n' "$label" "$tag" "$rc" \
         "$(awk -v u="$user" -v s="$sys" 'BEGIN { print u + s }')" "$rss"
 }
 
-for round in 1 2; do
+for ((round = 1; round <= ${ROUNDS:-2}; round++)); do
     echo "round $round"
+    i=0
     for bin in "$@"; do
         bin=$(realpath "$bin")
-        tag=$(basename "$bin")
+        # The binary's place in the list, so that two binaries named alike keep their images apart.
+        i=$((i + 1))
+        tag=$i-$(basename "$bin")
         run "check chain20" "$bin" check -q chain20.sdf
         run "render chain20 --spp 1" "$bin" render -q --spp 1 chain20.sdf
         run "render chain16" "$bin" render -q chain16.sdf

@@ -1,24 +1,39 @@
 #!/usr/bin/env bash
-# Measures adaptive anti-aliasing against uniform sampling and POV-Ray's adaptive method 2:
-# CPU seconds (user + sys, whole process, /usr/bin/time) and RMSE in 8-bit levels against
-# each scene's own 256-spp uniform render, all in one run on the same machine.
+# Time against error (BENCHMARKS.md, "Time against error"): adaptive anti-aliasing against
+# uniform sampling and POV-Ray's adaptive method 2, CPU seconds (user + system, whole
+# process, /usr/bin/time; the median of TURNS turns) and RMSE in 8-bit levels against each
+# scene's own 256-spp uniform render, all in one run on the same machine. POV-Ray's RMSE is
+# not given (its reflection and refraction model differs, so its image is another one); only
+# its time, and one third of it, the target for the default.
 #
-#   scripts/adaptive-measure.sh [extra anim flags for the adaptive run, e.g. --error 0.4]
+#   scripts/bench/adaptive.sh [extra anim flags for the adaptive run, e.g. --error 0.4]
+#   REUSE_REF=1 TURNS=3 LADDER="--spp 1" ANIM=/path/to/anim scripts/bench/adaptive.sh
 #
-# Environment: ANIM (binary, default target/release/anim), TOOLS (the POV-Ray converters,
-# default ../shared/tools beside the checkout), OUT (work directory, default /tmp/adaptive-measure),
+# Environment: ANIM (binary; default: `cargo build --release`, then target/release/anim),
+# TOOLS (the POV-Ray converters and imgio.py, default SHARED/tools, SHARED defaulting to
+# ../shared beside the checkout), OUT (work directory, default /tmp/adaptive-measure),
 # REUSE_REF=1 to keep reference renders from an earlier run, SIZE (default "640 360"),
 # QUICK=1 for the adaptive run alone, SCENES (default: the mirror-glass bench, its moved
-# variant and the showcase), TURNS (default 3: every run, the default, the LADDER runs and
-# uniform 4 and 16 spp, alternates with the others and with POV-Ray this many times; the
-# median CPU time of each is printed), LADDER (';'-separated
-# anim flag sets measured in the same turns, to trace the time/RMSE curve around the default;
-# default "--error 2.5;--error 3;--error 4;--error 64;--spp 1"; empty for none).
+# variant and the showcase; relative paths are from the repository's root), TURNS (default 3:
+# every run, the default, the LADDER runs and uniform 4 and 16 spp, alternates with the others
+# and with POV-Ray this many times; the median CPU time of each is printed), LADDER
+# (';'-separated anim flag sets measured in the same turns, to trace the time/RMSE curve
+# around the default; default "--error 2.5;--error 3;--error 4;--error 64;--spp 1"; empty for
+# none).
 set -euo pipefail
-cd "$(dirname "$0")/.."
-ANIM=${ANIM:-target/release/anim}
-TOOLS=${TOOLS:-$(pwd)/../shared/tools}
+root=$(cd "$(dirname "$0")/../.." && pwd)
+if [ -n "${ANIM:-}" ]; then
+  ANIM=$(realpath "$ANIM")
+else
+  cargo build --release --quiet --manifest-path "$root/Cargo.toml"
+  ANIM=$root/target/release/anim
+fi
+TOOLS=${TOOLS:-${SHARED:-$root/../shared}/tools}
+TOOLS=$(realpath -m "$TOOLS")
+[ -f "$TOOLS/imgio.py" ] || { echo "needs $TOOLS/imgio.py (set SHARED or TOOLS to the comparison tools)" >&2; exit 1; }
 OUT=${OUT:-/tmp/adaptive-measure}
+OUT=$(realpath -m "$OUT")
+cd "$root"
 TURNS=${TURNS:-3}
 read -r W H <<<"${SIZE:-640 360}"
 IFS=';' read -r -a LADDER <<<"${LADDER---error 2.5;--error 3;--error 4;--error 64;--spp 1}"

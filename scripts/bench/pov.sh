@@ -1,18 +1,24 @@
 #!/usr/bin/env bash
-# Speed against POV-Ray 3.7: anim and `povray` render the same scenes in turns (anim, POV,
-# anim, POV, ... RUNS times each, default 3), and a table gives whole-process CPU seconds
-# (user + system from /usr/bin/time, the median of the runs), their ratio, anim's rays per
-# CPU-second (from the ray counts its render summary prints) and anim's peak RSS.
+# Speed against POV-Ray 3.7 (BENCHMARKS.md, "Speed against POV-Ray"): anim and `povray`
+# render the same scenes in turns (anim, POV, anim, POV, ... RUNS times each, default 3), and
+# a table gives whole-process CPU seconds (user + system from /usr/bin/time, the median of the
+# runs), their ratio, anim's rays per CPU-second (from the ray counts its render summary
+# prints) and anim's peak RSS (/usr/bin/time's %M).
 #
-#   scripts/bench-pov.sh                 # RUNS=3; tools from ../shared beside the repository
-#   RUNS=5 SHARED=/path/to/shared scripts/bench-pov.sh
-#   ANIM=/path/to/other/anim scripts/bench-pov.sh   # another build of anim (not rebuilt)
+#   scripts/bench/pov.sh                 # RUNS=3; tools from ../shared beside the repository
+#   RUNS=5 SHARED=/path/to/shared scripts/bench/pov.sh
+#   ANIM=/path/to/other/anim scripts/bench/pov.sh   # another build of anim (not rebuilt)
+#
+# Environment: ANIM (binary; default: `cargo build --release`, then target/release/anim), RUNS
+# (default 3), SHARED (the folder holding tools/sdf2pov.py, default ../shared beside the
+# repository; without it, or without povray, anim alone), WORK (scenes, images and logs,
+# default target/pov-bench).
 #
 # Scenes: the assignment example at 1920×1080, 1 spp; 10k spheres in a deep grid at 1280×720,
 # 1 spp; 1k and 100k random spheres at 640×360, 1 spp; the mirror and glass room at 1280×720,
 # 9 spp; 10⁶ random spheres (anim only: POV-Ray's parser alone takes minutes there). The
-# generated ones come from scripts/gen-scenes.py (fixed seeds) into $WORK (default
-# target/pov-bench), where images and logs stay for a closer look.
+# generated ones come from scripts/bench/gen-scenes.py (fixed seeds) into $WORK, where images
+# and logs stay for a closer look.
 #
 # POV-Ray gets the scene from SHARED/tools/sdf2pov.py (same geometry, camera, lights and
 # Phong terms), two threads (+WT2, anim uses one per core on the 2-core machine) and no
@@ -23,7 +29,7 @@
 # pixels exactly equal to all their neighbours, which it leaves at one ray). Adaptive method 2
 # would spend a different number of rays per pixel and so measure a different thing.
 set -euo pipefail
-root=$(cd "$(dirname "$0")/.." && pwd)
+root=$(cd "$(dirname "$0")/../.." && pwd)
 runs=${RUNS:-3}
 shared=${SHARED:-$root/../shared}
 work=${WORK:-$root/target/pov-bench}
@@ -44,7 +50,7 @@ else
   cargo build --release --quiet --manifest-path "$root/Cargo.toml"
   anim=$root/target/release/anim
 fi
-python3 "$root/scripts/gen-scenes.py" "$work/scenes"
+python3 "$root/scripts/bench/gen-scenes.py" "$work/scenes"
 
 # name file width height spp pov(yes/no)
 scenes=(

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# What motion blur costs, and how close it is to brute force (BENCHMARKS.md §14).
+# What motion blur costs, and how close it is to brute force (BENCHMARKS.md, "Motion blur").
 #
-#   scripts/blur-bench.sh [FRAME ...]        # default: frames 10 and 72 of animations/blur.ron
+#   scripts/bench/blur.sh [FRAME ...]        # default: frames 10 and 72 of animations/blur.ron
+#   ROUNDS=1 ANIM=/path/to/anim scripts/bench/blur.sh 10
 #
 # For each frame of animations/blur.ron (640×360, default adaptive settings), in turns
 # (A B C A B C ..., ROUNDS rounds, default 3), the whole-process CPU seconds (user + system,
@@ -16,11 +17,12 @@
 # and the RMSE, in 8-bit levels, of the blurred frame against the mean of the 16 instants'
 # radiance (`--hdr`), both tone-mapped with the renderer's rule round(255·c/(c+1)).
 #
-# Environment: ANIM (binary; default: build target/release/anim), ROUNDS, OUT (work folder,
-# default a temporary one), ANIM_ARGS (extra render options for all three, e.g. --threads 1).
+# Environment: ANIM (binary; default: `cargo build --release`, then target/release/anim),
+# ROUNDS (default 3), OUT (work folder, kept; default a temporary one, also kept), ANIM_ARGS
+# (extra render options for all three, e.g. --threads 1 or --spp 16).
 set -euo pipefail
 
-root=$(cd "$(dirname "$0")/.." && pwd)
+root=$(cd "$(dirname "$0")/../.." && pwd)
 spec=$root/animations/blur.ron
 rounds=${ROUNDS:-3}
 frames=("$@")

@@ -1,26 +1,43 @@
 #!/usr/bin/env bash
-# Scale: flat files of 10^3..10^6 random spheres, loaded (`anim check`) and rendered
-# (`anim render --spp 1`, 640×360), whole process. Prints CPU seconds, peak RSS, bytes of
-# peak RSS per sphere and lines read per second (by `anim check`, whose time is the reader
-# and the scene builder).
+# Scale (BENCHMARKS.md, "Scale"): flat files of 10^3..10^6 random spheres (written by this
+# script, seed 8), loaded (`anim check`) and rendered (`anim render --spp 1`, 640×360), whole
+# process, /usr/bin/time. Prints CPU seconds (user + system), peak RSS (%M), bytes of peak RSS
+# per sphere and lines read per CPU-second (by `anim check`, whose time is the reader, the
+# scene builder and the blank-image probe).
 #
-# Usage: scripts/bench-scale.sh [ANIM_BINARY] [COUNTS...]
-# Default binary: target/release/anim; default counts: 1000 10000 100000 1000000.
-# With READER=1, first the reader alone (the source tree's `anim::sdf::parse_source`, no scene
-# building) and then the whole loader (`anim::scene::load_file`: reading the file, parsing and
-# building the scene) on a million-sphere file, in lines per CPU-second: two ignored tests of
-# tests/scale.rs.
+#   scripts/bench/scale.sh [ANIM_BINARY] [COUNTS...]
+#   ANIM=/path/to/anim scripts/bench/scale.sh 1000 100000
+#
+# Default binary: ANIM, else `cargo build --release`, then target/release/anim; default
+# counts: 1000 10000 100000 1000000. A first argument that is a number is a count.
+# Environment: ANIM, READER. With READER=1, first the reader alone (the source tree's
+# `parse_source`, no scene building) and then the whole loader (`load_file`: reading the file,
+# parsing and building the scene) on a million-sphere file, in lines per CPU-second of the
+# reading thread: two ignored tests of tests/scale.rs, run with `cargo test --release` (so
+# READER=1 always builds from the source tree, whatever ANIM says).
 set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
 
-bin=${1:-target/release/anim}
-shift || true
+bin=
+if [ $# -gt 0 ] && ! [[ $1 =~ ^[0-9]+$ ]]; then
+    bin=$1
+    shift
+fi
 counts=("$@")
 if [ ${#counts[@]} -eq 0 ]; then
     counts=(1000 10000 100000 1000000)
 fi
+if [ -z "$bin" ]; then
+    if [ -n "${ANIM:-}" ]; then
+        bin=$ANIM
+    else
+        cargo build --release --quiet --manifest-path "$root/Cargo.toml"
+        bin=$root/target/release/anim
+    fi
+fi
 if [ "${READER:-0}" = 1 ]; then
-    cargo test --release --test scale -- --ignored --nocapture --test-threads 1 lines_a_second 2>&1 |
-        grep -E "^(reader|loader):|panicked|FAILED" || true
+    cargo test --release --manifest-path "$root/Cargo.toml" --test scale -- --ignored --nocapture \
+        --test-threads 1 lines_a_second 2>&1 | grep -E "^(reader|loader):|panicked|FAILED" || true
 fi
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Writes the generated scenes of scripts/bench-pov.sh into DIR (deterministic: fixed seeds).
+"""Writes the generated scenes of scripts/bench/pov.sh and scripts/bench/instructions.sh into
+DIR (deterministic: fixed seeds). Used by those two scripts; run it alone for the same scenes.
 
-    python3 scripts/gen-scenes.py DIR
+    python3 scripts/bench/gen-scenes.py DIR
 
 - grid10k.sdf: 10,000 spheres in a deep grid (20 x 10 x 50, receding from the camera), 1280x720;
 - random1k.sdf, random100k.sdf, random1m.sdf: 10^3, 10^5 and 10^6 spheres at random in the
@@ -11,6 +12,7 @@
 One in five spheres is a partial mirror, so reflected rays cross the hierarchy too. Every file
 ends with a render line without a sample count: the script passes --spp.
 """
+import os
 import random
 import sys
 
@@ -24,7 +26,7 @@ ambient 0.1 0.1 0.1
 
 def grid(path):
     with open(path, "w") as f:
-        f.write("# 10,000 spheres in a 20 x 10 x 50 grid receding along -z (scripts/gen-scenes.py)\n")
+        f.write("# 10,000 spheres in a 20 x 10 x 50 grid receding along -z (scripts/bench/gen-scenes.py)\n")
         f.write(HEAD)
         n = 0
         for x in range(20):
@@ -43,7 +45,7 @@ def scattered(path, count):
     k = (100_000 / count) ** (1.0 / 3.0)
     name = path.rsplit("/", 1)[-1].replace(".sdf", "")
     with open(path, "w") as f:
-        f.write("# %d spheres at random, seed 1 (scripts/gen-scenes.py)\n" % count)
+        f.write("# %d spheres at random, seed 1 (scripts/bench/gen-scenes.py)\n" % count)
         f.write(HEAD)
         for n in range(count):
             x, y, z = rng.uniform(-60, 60), rng.uniform(-35, 35), rng.uniform(-160, -40)
@@ -57,6 +59,7 @@ def main():
     if len(sys.argv) != 2:
         sys.exit("usage: gen-scenes.py DIR")
     out = sys.argv[1].rstrip("/")
+    os.makedirs(out, exist_ok=True)
     grid(out + "/grid10k.sdf")
     scattered(out + "/random1k.sdf", 1_000)
     scattered(out + "/random100k.sdf", 100_000)
