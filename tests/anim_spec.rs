@@ -416,7 +416,7 @@ fn frame(text: &str, i: usize) -> RenderJob {
         .frame_text(i)
         .expect("frame");
     let mut loaded =
-        anim_core::scene::load_str(&frame_text, Path::new("frame.sdf"), &LoadOptions::default())
+        anim_core::load::load_str(&frame_text, Path::new("frame.sdf"), &LoadOptions::default())
             .unwrap_or_else(|e| panic!("{frame_text}\n{e:?}"));
     assert_eq!(loaded.jobs.len(), 1);
     loaded.jobs.remove(0)
@@ -621,7 +621,7 @@ fn frames_keep_the_materials_of_a_base_scene_in_another_layout() {
             material_fields: layout.clone(),
             ..LoadOptions::default()
         };
-        let loaded = anim_core::scene::load_str(&text, &frame, &opts)
+        let loaded = anim_core::load::load_str(&text, &frame, &opts)
             .unwrap_or_else(|e| panic!("{layout:?}: {e:?}\n{text}"));
         let red = &loaded.jobs[0].scene.materials[0];
         assert_eq!(

@@ -4,7 +4,7 @@
 mod common;
 
 use anim_core::diag::Diagnostic;
-use anim_core::scene::load_file;
+use anim_core::load::load_file;
 use anim_core::sdf::LoadOptions;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
@@ -84,12 +84,12 @@ fn canonical_text_of_corpus_files_loads_to_the_same_jobs() {
             continue;
         };
         let text = String::from_utf8_lossy(&bytes);
-        let Ok(original) = anim_core::scene::load_str(&text, file, &opts) else {
+        let Ok(original) = anim_core::load::load_str(&text, file, &opts) else {
             continue;
         };
         let (statements, _) = anim_core::sdf::parse(&text, file, &opts);
         let canonical: String = statements.iter().map(|s| format!("{s}\n")).collect();
-        let again = anim_core::scene::load_str(&canonical, file, &opts).unwrap_or_else(|ds| {
+        let again = anim_core::load::load_str(&canonical, file, &opts).unwrap_or_else(|ds| {
             panic!(
                 "{}: canonical text rejected:\n{}\n{canonical}",
                 file.display(),
@@ -143,7 +143,7 @@ fn canonical_text_of_corpus_files_loads_to_the_same_jobs() {
 /// change in these numbers is a change in what the reader accepts: update them with §8.
 #[test]
 fn corpus_summary_counts() {
-    use anim_core::scene::probe::{classify, Classification};
+    use anim_core::load::probe::{classify, Classification};
     let Some(shared) = common::shared_dir("corpus_summary_counts") else {
         return;
     };

@@ -3,7 +3,7 @@
 //! library; a handful of error rows also run through the real `anim render` binary.
 
 use anim_core::diag::{Diagnostic, Severity};
-use anim_core::scene::load_str;
+use anim_core::load::load_str;
 use anim_core::sdf::LoadOptions;
 use assert_cmd::Command;
 use std::path::Path;

@@ -4,8 +4,8 @@
 
 mod common;
 
+use anim_core::load::load_file;
 use anim_core::render::{render_job, RenderSettings};
-use anim_core::scene::load_file;
 use anim_core::sdf::LoadOptions;
 use std::path::{Path, PathBuf};
 

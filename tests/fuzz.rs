@@ -13,7 +13,7 @@
 //! `FUZZ_EXECS` (default 100 000), `FUZZ_SEED` (1), `FUZZ_CORPUS` (`../shared/corpus`),
 //! `FUZZ_TIMEOUT_MS` (2000), `FUZZ_OUT` (`target/fuzz-findings`).
 
-use anim_core::scene::load_str;
+use anim_core::load::load_str;
 use anim_core::sdf::{LoadOptions, MaterialField, TransformOrder};
 use anim_pipeline::keyframe::generate::BaseScene;
 use anim_pipeline::keyframe::spec::{self, Source};

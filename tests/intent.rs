@@ -1,10 +1,10 @@
 //! Author intent: material layouts inferred per file, forms other renderers accepted, and no
 //! silent blank image. The corpus rows drive the real binary; the summary table classifies
-//! every public corpus file through the library (`scene::probe::classify`).
+//! every public corpus file through the library (`load::probe::classify`).
 
 mod common;
 
-use anim_core::scene::probe::{classify, Classification};
+use anim_core::load::probe::{classify, Classification};
 use anim_core::sdf::LoadOptions;
 use common::{anim, shared_dir};
 use std::path::{Path, PathBuf};

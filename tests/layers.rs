@@ -11,7 +11,8 @@
 //! anim (the command):  cli → app
 //! anim-pipeline:       {frames, keyframe}
 //! anim-bench:          stress → report → {pov, rehit} → {plot, metrics}
-//! anim-core:           render → scene → sdf → shape → accel → math → limits → {diag, util}
+//! anim-core:           load → render → scene → sdf → shape → accel → math → limits →
+//!                      {diag, util}
 //! ```
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -33,6 +34,7 @@ const CRATES: &[(&str, &[&[&str]])] = &[
     (
         "crates/anim-core/src",
         &[
+            &["load"],
             &["render"],
             &["scene"],
             &["sdf"],
@@ -182,11 +184,13 @@ impl Crate {
             .find(|p| self.files.contains_key(p))
     }
 
-    /// Module files a file refers to through `crate::…` and `super::…` paths.
+    /// Module files a file refers to through `crate::…` and `super::…` paths, outside its
+    /// tests (which may drive it through higher layers, as the files named `tests` may).
     fn references(&self, module: &[String]) -> BTreeSet<Vec<String>> {
         let text = std::fs::read_to_string(&self.files[module]).unwrap();
+        let code = text.split("#[cfg(test)]\nmod tests {").next().unwrap_or("");
         let mut refs = BTreeSet::new();
-        for line in code_lines(&text) {
+        for line in code_lines(code) {
             for path in paths_after(line, "crate::") {
                 let path: Vec<String> = path.iter().map(|s| s.to_string()).collect();
                 refs.extend(self.resolve(&path));

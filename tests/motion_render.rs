@@ -2,8 +2,9 @@
 //! the fraction of the exposure it covers each pixel (derived here), determinism across
 //! thread counts, and `motion` lines that move nothing leaving the frame as it was.
 
+use anim_core::load::load_str;
 use anim_core::render::{render_job, RenderSettings};
-use anim_core::scene::{load_str, RenderJob};
+use anim_core::scene::RenderJob;
 use anim_core::sdf::LoadOptions;
 use std::path::Path;
 

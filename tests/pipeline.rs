@@ -478,7 +478,7 @@ fn committed_animations_generate_frames_that_load() {
         assert!(report.warnings.is_empty(), "{spec}: {:?}", report.warnings);
         for i in [0, frames / 2, frames - 1] {
             let path = out.path().join(format!("frame_{i:04}.sdf"));
-            let loaded = anim_core::scene::load_file(&path, &Default::default())
+            let loaded = anim_core::load::load_file(&path, &Default::default())
                 .unwrap_or_else(|e| panic!("{}: {e:?}", path.display()));
             assert_eq!(loaded.jobs.len(), 1);
             assert_eq!(

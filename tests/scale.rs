@@ -120,7 +120,7 @@ fn random_spheres(n: usize) -> String {
 }
 
 /// The whole front end of `anim render` before the hierarchy is built: reading the file
-/// from disk, tokenizing, parsing and building the scene (`anim_core::scene::load_file`, with the
+/// from disk, tokenizing, parsing and building the scene (`anim_core::load::load_file`, with the
 /// command line's default options), on a flat file of a million random spheres, in lines per
 /// CPU-second of the loading thread; it fails below 1.5 M lines/s (BENCHMARKS.md §10: about
 /// 2 M measured, 1 M before the reader took flat lines directly). A measurement, run by
@@ -143,7 +143,7 @@ fn the_loader_loads_one_and_a_half_million_lines_a_second() {
     let mut best = f64::INFINITY;
     for _ in 0..5 {
         let start = cpu_time::ThreadTime::now();
-        let loaded = anim_core::scene::load_file(&path, &opts).expect("loads");
+        let loaded = anim_core::load::load_file(&path, &opts).expect("loads");
         let seconds = start.elapsed().as_secs_f64();
         assert_eq!(loaded.jobs[0].scene.instances.len(), n);
         drop(loaded);

@@ -1,7 +1,7 @@
 //! `anim check FILE|DIR...`: load scene files without rendering and report every problem.
 
 use anim_core::diag::Diagnostic;
-use anim_core::scene::{load_file, probe};
+use anim_core::load::{load_file, probe};
 use anim_core::sdf::LoadOptions;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

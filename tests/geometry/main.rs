@@ -288,7 +288,7 @@ fn instances_only(
 
 /// The render scene of a file's first job.
 fn loaded_scene(text: &str) -> Scene {
-    let loaded = anim_core::scene::load_str(
+    let loaded = anim_core::load::load_str(
         text,
         std::path::Path::new("scene.sdf"),
         // A small budget: the composites are then worth instancing.

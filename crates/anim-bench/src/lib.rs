@@ -19,7 +19,6 @@ pub mod stress;
 pub use report::{markdown, write_outputs};
 
 use anim_core::render::{self, film, RayCounts, RenderSettings};
-use anim_core::scene;
 use anim_core::scene::RenderJob;
 use anim_core::sdf::LoadOptions;
 use cpu_time::ProcessTime;
@@ -259,7 +258,7 @@ pub fn load_scenes(dir: &Path, only: &[String]) -> Result<Vec<BenchScene>, Strin
         }
         let bytes =
             std::fs::read(&file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
-        let loaded = scene::load_str(
+        let loaded = anim_core::load::load_str(
             &String::from_utf8_lossy(&bytes),
             &file,
             &LoadOptions::default(),

@@ -204,7 +204,7 @@ pub fn count(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use anim_core::scene::load_str;
+    use anim_core::load::load_str;
     use anim_core::sdf::LoadOptions;
     use std::path::Path;
 

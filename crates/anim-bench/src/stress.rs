@@ -125,7 +125,7 @@ const ANISOTROPIC_SDF: &str = include_str!("anisotropic.sdf");
 
 fn anisotropic_scene() -> Result<BenchScene, String> {
     let file = PathBuf::from("anisotropic.sdf (built in)");
-    let job = anim_core::scene::load_str(
+    let job = anim_core::load::load_str(
         ANISOTROPIC_SDF,
         &file,
         &anim_core::sdf::LoadOptions::default(),
@@ -285,7 +285,7 @@ pub fn write_outputs(report: &StressReport, dir: &Path) -> Result<Vec<PathBuf>, 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use anim_core::scene::load_str;
+    use anim_core::load::load_str;
     use anim_core::sdf::LoadOptions;
 
     #[test]

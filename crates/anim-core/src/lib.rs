@@ -1,12 +1,15 @@
 //! The renderer library of anim: SDF scene text becomes an image.
 //!
 //! Data flow: SDF text → [`sdf`] statements (with source locations) → [`scene`] description
-//! → [`render::compile`] flat render scene with a BVH ([`accel`]) → [`render`] image.
+//! → [`render::compile`] compiled scene (geometry and its hierarchy from [`accel`], view,
+//! shading) → [`render`] image. [`load`] reads a file as its author meant it, looking
+//! through its cameras with the renderer where the transform order is in doubt.
 #![forbid(unsafe_code)]
 
 pub mod accel;
 pub mod diag;
 pub mod limits;
+pub mod load;
 pub mod math;
 pub mod render;
 pub mod scene;

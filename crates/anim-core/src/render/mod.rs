@@ -34,10 +34,11 @@ use crate::math::Transform;
 use crate::scene::{Camera, RenderJob, Scene};
 use camera::{CameraError, PinholeCamera};
 use compile::RenderScene;
-use geometry::Dropped;
+use geometry::{Dropped, Geometry};
 use glam::DVec3;
 use integrator::Integrator;
 use motion::Shutter;
+use std::sync::Arc;
 use view::Viewpoint;
 
 /// How many rays of each kind a render traced.
@@ -81,27 +82,68 @@ pub struct Rendered {
     pub dropped: Vec<Dropped>,
 }
 
-/// The job's scene and camera moved (in f64) so that the eye sits at the origin, or `None`
-/// when it already does. Rendering works in f32, which keeps about 7 digits relative to a
-/// coordinate's magnitude: a scene far from the world origin would lose its detail near the
-/// camera, where the picture needs it most. Moved together, the picture is the same.
-fn camera_relative(job: &RenderJob) -> Option<(Scene, Camera)> {
-    let eye = job.camera.eye;
-    if eye == DVec3::ZERO {
-        return None;
+/// A job made ready to render: its scene and camera moved (in f64) so that the eye sits at
+/// the origin, and its geometry built. The blank-image probe looks at it and the render uses
+/// it as it is, so the geometry is built once for both.
+///
+/// Rendering works in f32, which keeps about 7 digits relative to a coordinate's magnitude:
+/// a scene far from the world origin would lose its detail near the camera, where the
+/// picture needs it most. Moved together with the camera, the picture is the same.
+pub struct Prepared<'j> {
+    job: &'j RenderJob,
+    /// The scene and camera moved, or `None` when the eye is at the origin already.
+    rebased: Option<(Scene, Camera)>,
+    pub geometry: Arc<Geometry>,
+    /// Shapes that became degenerate once transformed (in f32) and were left out.
+    pub dropped: Vec<Dropped>,
+}
+
+impl<'j> Prepared<'j> {
+    /// Moves `job` camera-relative and builds its geometry.
+    pub fn new(job: &'j RenderJob) -> Prepared<'j> {
+        let rebased = (job.camera.eye != DVec3::ZERO).then(|| {
+            let eye = job.camera.eye;
+            // The instances are shared, not copied: only the table of transforms is.
+            let mut scene = job.scene.clone();
+            scene.transform_all(&Transform::translate(-eye));
+            for light in &mut scene.lights {
+                light.position -= eye;
+            }
+            let camera = Camera {
+                eye: DVec3::ZERO,
+                ..job.camera.clone()
+            };
+            (scene, camera)
+        });
+        let scene = rebased.as_ref().map_or(&job.scene, |(s, _)| s);
+        let (geometry, dropped) = Geometry::build(scene);
+        Prepared {
+            job,
+            rebased,
+            geometry: Arc::new(geometry),
+            dropped,
+        }
     }
-    let to_camera = Transform::translate(-eye);
-    // The instances are shared, not copied: only the table of transforms is.
-    let mut scene = job.scene.clone();
-    scene.transform_all(&to_camera);
-    for light in &mut scene.lights {
-        light.position -= eye;
+
+    /// The job.
+    pub fn job(&self) -> &'j RenderJob {
+        self.job
     }
-    let camera = Camera {
-        eye: DVec3::ZERO,
-        ..job.camera.clone()
-    };
-    Some((scene, camera))
+
+    /// The scene, camera-relative.
+    pub fn scene(&self) -> &Scene {
+        self.rebased.as_ref().map_or(&self.job.scene, |(s, _)| s)
+    }
+
+    /// The camera, at the origin.
+    pub fn camera(&self) -> &Camera {
+        self.rebased.as_ref().map_or(&self.job.camera, |(_, c)| c)
+    }
+
+    /// The compiled scene, as seen from `viewpoint` (`None`: without a camera).
+    pub fn compile(&self, viewpoint: Option<&Viewpoint>) -> RenderScene {
+        RenderScene::with_geometry(self.geometry.clone(), self.scene(), viewpoint)
+    }
 }
 
 /// Renders one job to an HDR image. `on_pixels(n)` is called as each band of `n` pixels
@@ -111,11 +153,18 @@ pub fn render_job(
     settings: &RenderSettings,
     on_pixels: &(dyn Fn(u64) + Sync),
 ) -> Result<Rendered, CameraError> {
+    render_prepared(&Prepared::new(job), settings, on_pixels)
+}
+
+/// [`render_job`] of a job made ready already.
+pub fn render_prepared(
+    prepared: &Prepared,
+    settings: &RenderSettings,
+    on_pixels: &(dyn Fn(u64) + Sync),
+) -> Result<Rendered, CameraError> {
+    let job = prepared.job();
     let (width, height, _) = settings.resolve(job);
-    let rebased = camera_relative(job);
-    let (scene, camera) = rebased
-        .as_ref()
-        .map_or((&job.scene, &job.camera), |(s, c)| (s, c));
+    let (scene, camera) = (prepared.scene(), prepared.camera());
     let shutter = scene
         .motion
         .as_ref()
@@ -128,7 +177,7 @@ pub fn render_job(
         camera_rays: u64::from(width) * u64::from(height) * u64::from(sampling.least_spp()),
         motion: shutter.is_some(),
     };
-    let (scene, dropped) = RenderScene::compile(scene, Some(&viewpoint));
+    let scene = prepared.compile(Some(&viewpoint));
     let integrator = Integrator {
         scene: &scene,
         max_depth: settings.max_depth,
@@ -148,7 +197,7 @@ pub fn render_job(
         },
         mean_spp: counts.primary as f64 / (width as f64 * height as f64),
         rays: counts,
-        dropped,
+        dropped: prepared.dropped.clone(),
     })
 }
 

@@ -5,17 +5,11 @@
 
 mod build;
 mod instancing;
-mod load;
 pub mod motion;
-pub mod probe;
-#[cfg(test)]
-mod scale_tests;
-#[cfg(test)]
-mod tests;
 
 pub use crate::shape::Geometry;
+pub use build::build_jobs;
 pub use instancing::{Instanced, Placed, Prototype, Use};
-pub use load::{build, load_file, load_str, read_input, Loaded};
 
 use crate::diag::Loc;
 use crate::math::Transform;

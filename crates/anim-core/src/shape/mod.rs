@@ -124,6 +124,12 @@ impl Shape {
         }
     }
 
+    /// Whether the shape encloses a solid, which a camera can be inside: planes, triangles
+    /// and meshes are surfaces.
+    pub fn is_closed(&self) -> bool {
+        !matches!(self, Shape::Plane(_) | Shape::Triangle(_) | Shape::Mesh(_))
+    }
+
     pub fn bounds(&self) -> Aabb {
         match self {
             Shape::Sphere(s) => s.bounds(),

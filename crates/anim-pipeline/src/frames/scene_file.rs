@@ -3,9 +3,10 @@
 
 use anim_core::diag::{Diagnostic, Severity};
 use anim_core::limits;
+use anim_core::load::probe;
 use anim_core::render::camera::CameraError;
 use anim_core::render::film::{self, ImageBytes, ImageFormat};
-use anim_core::render::{render_job, RayCounts, RenderSettings, Rendered};
+use anim_core::render::{render_prepared, Prepared, RayCounts, RenderSettings, Rendered};
 use anim_core::scene::RenderJob;
 use anim_core::sdf::LoadOptions;
 use std::path::{Component, Path, PathBuf};
@@ -124,14 +125,12 @@ pub fn render_scene_file(
     settings: &RenderSettings,
     progress: &dyn ImageProgress,
 ) -> Result<FileOutcome, Vec<Diagnostic>> {
-    let loaded = anim_core::scene::load_file(path, load)?;
+    let loaded = anim_core::load::load_file(path, load)?;
     let mut warnings = loaded.diagnostics;
     // A file that loads but would render one flat colour says why, instead of handing back a
-    // blank image in silence.
-    warnings.extend(anim_core::scene::probe::blank_image_warnings(
-        &loaded.jobs,
-        path,
-    ));
+    // blank image in silence: those warnings go here, after the file's own, though each is
+    // found when its image is about to be rendered (with the geometry the render uses).
+    let blank_at = warnings.len();
     // Resolve every output before rendering anything, so a bad name fails fast.
     let mut targets = Vec::with_capacity(loaded.jobs.len());
     let mut errors = Vec::new();
@@ -195,6 +194,8 @@ pub fn render_scene_file(
         }
     }
     if !errors.is_empty() {
+        let blanks = probe::blank_image_warnings(&loaded.jobs, path);
+        warnings.splice(blank_at..blank_at, blanks);
         warnings.extend(errors);
         return Err(warnings);
     }
@@ -208,15 +209,17 @@ pub fn render_scene_file(
             })
             .sum(),
     );
+    let mut blanks = Vec::new();
     let result = render_jobs(
         path,
         &loaded.jobs,
         targets,
         settings,
         progress,
-        &mut warnings,
+        (&mut blanks, &mut warnings),
     );
     progress.end();
+    warnings.splice(blank_at..blank_at, blanks);
     match result {
         Ok((outputs, rays)) => Ok(FileOutcome {
             outputs,
@@ -232,14 +235,15 @@ fn gib(bytes: u64) -> String {
     format!("{:.1} GiB", bytes as f64 / (1u64 << 30) as f64)
 }
 
-/// Renders and writes each job; problems go to `diagnostics`, and an error stops the file.
+/// Renders and writes each job; the warnings that an image would be blank go to `blanks`,
+/// other problems to `diagnostics`, and an error stops the file.
 fn render_jobs(
     path: &Path,
     jobs: &[RenderJob],
     targets: Vec<(PathBuf, ImageFormat)>,
     settings: &RenderSettings,
     progress: &dyn ImageProgress,
-    diagnostics: &mut Vec<Diagnostic>,
+    (blanks, diagnostics): (&mut Vec<Diagnostic>, &mut Vec<Diagnostic>),
 ) -> Result<(Vec<Output>, RayCounts), ()> {
     let mut outputs = Vec::with_capacity(jobs.len());
     let mut rays = RayCounts::default();
@@ -249,12 +253,16 @@ fn render_jobs(
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default(),
         );
+        let prepared = Prepared::new(job);
+        if let Some(blank) = probe::blank_image_of(&prepared) {
+            blanks.push(probe::blank_warning(job, &blank, path));
+        }
         let Rendered {
             image,
             rays: counts,
             dropped,
             ..
-        } = match render_job(job, settings, &|n| progress.advance(n)) {
+        } = match render_prepared(&prepared, settings, &|n| progress.advance(n)) {
             Ok(r) => r,
             Err(e) => {
                 let what = match e {

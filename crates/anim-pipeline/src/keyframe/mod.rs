@@ -197,7 +197,7 @@ fn load_base(
     let (statements, mut diags, path) = match scene {
         SceneSource::File(rel) => {
             let path = spec_dir.join(rel);
-            let bytes = anim_core::scene::read_input(&path, opts.max_input, "the base scene")
+            let bytes = anim_core::load::read_input(&path, opts.max_input, "the base scene")
                 .map_err(|e| {
                     // The reader's own words, naming the file.
                     let why = e.first().map_or(String::new(), |d| d.message.clone());
@@ -219,7 +219,7 @@ fn load_base(
     // Building the scene finds what parsing alone cannot (an unknown material, a composite
     // child defined nowhere), located in the base scene rather than in a generated frame.
     if !diags.iter().any(Diagnostic::is_error) {
-        if let Err(built) = anim_core::scene::build(&statements, &path, &opts) {
+        if let Err(built) = anim_core::load::build(&statements, &path, &opts) {
             diags.extend(built.into_iter().filter(Diagnostic::is_error));
         }
     }
@@ -314,7 +314,7 @@ fn checked_frame_text(
 ) -> Result<String, Vec<Diagnostic>> {
     let text = generator.frame_text(i)?;
     let path: Arc<Path> = Arc::from(dir.join(anim.output.sdf(i, anim.digits())).as_path());
-    if let Err(diags) = anim_core::scene::load_str(&text, &path, &LoadOptions::default()) {
+    if let Err(diags) = anim_core::load::load_str(&text, &path, &LoadOptions::default()) {
         // A frame that does not load is a bug or a combination the spec checks missed;
         // show the loader's own words with the frame text they are about.
         let mut out = vec![Diagnostic::file_error(

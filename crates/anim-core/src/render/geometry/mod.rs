@@ -316,6 +316,23 @@ impl Geometry {
         }
     }
 
+    /// Whether primitive `i` encloses a solid (`Shape::is_closed`), which a camera can be
+    /// inside.
+    pub fn is_closed(&self, i: PrimId) -> bool {
+        match self.kind.get(i as usize).map(|k| k.kind()) {
+            Some(Kind::Sphere) => true,
+            Some(Kind::Shape(k)) => self.objects[k as usize].shape.is_closed(),
+            Some(Kind::Moving(k)) => self.moving.as_ref().is_some_and(|m| m.is_closed(k)),
+            Some(Kind::Instance(_)) | None => false,
+        }
+    }
+
+    /// The depth-first number of primitive `i` in the flattened composite tree: the index
+    /// of its instance in the scene description when the scene has no instanced composites.
+    pub fn source(&self, i: PrimId) -> Option<u32> {
+        self.key.get(i as usize).copied()
+    }
+
     /// The object-space shape of primitive `i`, or `None` for a packed world-space sphere
     /// (for tools that report by kind of shape).
     pub fn object_shape(&self, i: PrimId) -> Option<&Shape> {

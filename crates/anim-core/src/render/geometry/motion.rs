@@ -463,6 +463,11 @@ impl Moving {
         self.instances.get(*self.entries.get(k as usize)? as usize)
     }
 
+    /// Whether entry `k`'s shape encloses a solid (`Shape::is_closed`).
+    pub fn is_closed(&self, k: u32) -> bool {
+        self.own(k).is_some_and(|(_, p)| p.shape.is_closed())
+    }
+
     /// Entry `k`'s instance and its shape in its own space (where its motion places it from).
     fn own(&self, k: u32) -> Option<(&Instance, Primitive)> {
         let inst = self.instance(k)?;
@@ -721,7 +726,7 @@ mod tests {
             motion ball 0 translate -10 -0.5 0\nmotion ball 0.5\nmotion ball 1 translate 10 0.5 1\n\
             motion post 0 rotate -20 1 0 0\nmotion post 0.5\nmotion post 1 rotate 40 1 0 0\n\
             render eye m.ppm 8 8\n";
-        let loaded = crate::scene::load_str(
+        let loaded = crate::load::load_str(
             text,
             std::path::Path::new("m.sdf"),
             &crate::sdf::LoadOptions::default(),

@@ -350,8 +350,9 @@ impl Building {
 
 #[cfg(test)]
 mod tests {
+    use crate::load::load_str;
     use crate::math::Transform;
-    use crate::scene::{load_str, Scene};
+    use crate::scene::Scene;
     use crate::sdf::LoadOptions;
     use glam::DVec3;
     use std::fmt::Write;

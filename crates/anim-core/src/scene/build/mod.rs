@@ -31,7 +31,7 @@ const SUGGESTION_BUDGET: usize = 1_000_000;
 /// the values of every statement; without it (statements made by a program) those checks are
 /// made here. `shapes` are the file's primitive shapes the reader kept apart (see
 /// `sdf::parse_source`), if any: they are built into instances directly.
-pub(super) fn build_jobs(
+pub fn build_jobs(
     statements: &[Statement],
     shapes: FlatShapes,
     path: &Path,

@@ -20,7 +20,7 @@ impl Source {
     /// Reads a spec file: refused unread when larger than `limit` bytes (a device or pipe
     /// after `limit + 1` bytes), when it holds NUL bytes, or when it is not UTF-8.
     pub fn read(path: &Path, limit: u64) -> Result<Source, Vec<Diagnostic>> {
-        let bytes = anim_core::scene::read_input(path, limit, "the spec")?;
+        let bytes = anim_core::load::read_input(path, limit, "the spec")?;
         let text = String::from_utf8(bytes)
             .map_err(|_| vec![Diagnostic::file_error(path, "the spec is not UTF-8 text")])?;
         Ok(Source::new(path, text))

@@ -1,10 +1,17 @@
-//! Loading a scene file: the reader's statements built into render jobs.
+//! Loading a scene file as its author meant it: the reader's statements built into render
+//! jobs, read in the other transform order when only that order shows something (a look
+//! through each camera with the renderer's own camera and queries: [`probe`]), with every
+//! diagnostic capped and quoted.
 
-use super::build::build_jobs;
-use super::probe;
-use super::RenderJob;
+pub mod probe;
+#[cfg(test)]
+mod scale_tests;
+#[cfg(test)]
+mod tests;
+
 use crate::diag::{Diagnostic, Severity};
 use crate::limits::MAX_DIAGNOSTICS;
+use crate::scene::{build_jobs, RenderJob};
 use crate::sdf::ast::{Statement, StatementKind};
 use crate::sdf::{self, finish_diagnostics, LoadOptions, TransformOrder};
 use std::borrow::Cow;
@@ -119,7 +126,7 @@ pub fn load_str(text: &str, path: &Path, opts: &LoadOptions) -> Result<Loaded, V
 /// [`load_str`] with the shapes of a flat file read as statements: what the compact form of
 /// `sdf::ast::FlatShapes` must give the same result as.
 #[cfg(test)]
-pub(super) fn load_str_whole(
+pub(crate) fn load_str_whole(
     text: &str,
     path: &Path,
     opts: &LoadOptions,

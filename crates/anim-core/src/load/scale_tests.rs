@@ -93,7 +93,7 @@ fn same_both_ways(text: &str, opts: &LoadOptions, flat: bool) -> Result<Loaded, 
     let parsed = crate::sdf::parse_source(text, path, opts);
     assert_eq!(!parsed.shapes.is_empty(), flat, "{text}");
     let compact = load_str(text, path, opts);
-    let whole = super::load::load_str_whole(text, path, opts);
+    let whole = super::load_str_whole(text, path, opts);
     match (&compact, &whole) {
         (Ok(a), Ok(b)) => {
             assert_eq!(a.jobs, b.jobs, "{text}");

@@ -1,8 +1,8 @@
-//! Behaviour of the reader as a whole: variants, transform composition, the composite tree,
-//! render semantics and the canonical text round trip.
+//! The reader as a whole: variants, transform order, composites, renders, canonical text.
 
 use super::*;
 use crate::diag::{Diagnostic, Severity};
+use crate::scene::*;
 use crate::sdf::{ast, parse, LoadOptions, MaterialField, MaterialLayout, TransformOrder};
 use glam::{DVec3, Vec3};
 use std::path::Path;
