@@ -131,7 +131,7 @@ impl RenderScene {
     /// What a shadow ray (`hint` names its light) meets before `t_max`, looking past
     /// transparent primitives for an opaque one (which one, of several, is left to the
     /// strategy that answers).
-    #[inline]
+    #[inline(always)]
     pub fn occlusion(&self, ray: &Ray, t_max: f32, hint: RayHint, scratch: &Scratch) -> Occlusion {
         let candidates = match hint {
             RayHint::Shadow(light) => self.view.shadow(ray, t_max, light),

@@ -40,7 +40,7 @@ pub fn tone3(c: Vec3A) -> Vec3A {
 #[inline]
 pub fn tone_map_u8(c: f32) -> u8 {
     // Black (and NaN) without the rounding: much of many images is black background.
-    if c.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+    if c.is_nan() || c <= 0.0 {
         return 0;
     }
     round_level(255.0 * tone(c))

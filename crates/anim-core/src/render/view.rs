@@ -95,7 +95,7 @@ impl View {
 
     /// The candidates of a camera ray (from the eye; a ray from elsewhere, or one the eye's
     /// lookup does not answer, gets every primitive).
-    #[inline]
+    #[inline(always)]
     pub fn camera(&self, ray: &Ray) -> Candidates<'_> {
         let listed = match &self.eye {
             Some(Candidacy::Cells(cells)) => cells
@@ -123,7 +123,7 @@ impl View {
     }
 
     /// The candidates of a shadow ray towards light `light` that ends there after `t_max`.
-    #[inline]
+    #[inline(always)]
     pub fn shadow(&self, ray: &Ray, t_max: f32, light: usize) -> Candidates<'_> {
         let listed = match self.lights.get(light) {
             Some(Some(Candidacy::Cells(cells))) => cells

@@ -193,9 +193,22 @@ impl Geometry {
             todo &= todo - 1;
             let i = id(k);
             let (t, hit) = if c.others_near & (1 << k) != 0 {
-                match self.closest_other(i, ray, &mut t_max, (best, won), scratch) {
-                    Some(found) => found,
-                    None => continue,
+                match self.kind_of(i) {
+                    Kind::Moving(m) => {
+                        self.closest_moving(m, i, ray, &mut t_max, best, scratch);
+                        continue;
+                    }
+                    Kind::Instance(u) => {
+                        if let Some(inst) = &self.instances {
+                            inst.closest(u, ray, &mut t_max, best, won);
+                        }
+                        continue;
+                    }
+                    Kind::Shape(o) => match self.objects[o as usize].hit(ray, t_max.next_up()) {
+                        Some(h) => (h.t, Some(h)),
+                        None => continue,
+                    },
+                    Kind::Sphere => continue,
                 }
             } else if c.spheres & (1 << k) != 0 {
                 (sphere_t[k], None)
@@ -215,45 +228,29 @@ impl Geometry {
         t_max
     }
 
-    /// Primitive `i` of a kind whose bounds do not give its hit: a shape's hit (to be judged
-    /// by the caller), or `None` when there is none or when the primitive settled the closest
-    /// hit itself (a moving shape, or a use of a composite, which updates `t_max` and `best`).
+    /// Moving entry `m` (primitive `i`) placed at the ray's time, kept in `best` if it is hit
+    /// closer than `t_max` (or as close, and earlier in the tree).
     #[inline(always)]
-    fn closest_other(
+    fn closest_moving(
         &self,
+        m: u32,
         i: usize,
         ray: &Ray,
         t_max: &mut f32,
-        (best, won): (&mut Option<Best>, &mut Option<Primitive>),
+        best: &mut Option<Best>,
         scratch: &Scratch,
-    ) -> Option<(f32, Option<ShapeHit>)> {
-        match self.kind_of(i) {
-            Kind::Moving(k) => {
-                let h = self
-                    .moving_with(k, ray, scratch, |p| p.hit(ray, t_max.next_up()))
-                    .flatten();
-                if let Some(h) = h.filter(|h| Best::loses_to(best, *t_max, h.t, self.key[i])) {
-                    *t_max = h.t;
-                    *best = Some(Best {
-                        id: i as u32,
-                        t: *t_max,
-                        key: self.key[i],
-                        hit: Some(h),
-                    });
-                }
-                None
-            }
-            Kind::Instance(u) => {
-                if let Some(inst) = &self.instances {
-                    inst.closest(u, ray, t_max, best, won);
-                }
-                None
-            }
-            Kind::Shape(o) => {
-                let h = self.objects[o as usize].hit(ray, t_max.next_up())?;
-                Some((h.t, Some(h)))
-            }
-            Kind::Sphere => None,
+    ) {
+        let h = self
+            .moving_with(m, ray, scratch, |p| p.hit(ray, t_max.next_up()))
+            .flatten();
+        if let Some(h) = h.filter(|h| Best::loses_to(best, *t_max, h.t, self.key[i])) {
+            *t_max = h.t;
+            *best = Some(Best {
+                id: i as u32,
+                t: *t_max,
+                key: self.key[i],
+                hit: Some(h),
+            });
         }
     }
 

@@ -21,7 +21,7 @@ impl Geometry {
         stop: impl FnMut(u32) -> bool,
     ) {
         match candidates {
-            Candidates::All => self.any_hit(ray, t_max, scratch, stop),
+            Candidates::All => self.any_of_all(ray, t_max, scratch, stop),
             Candidates::Listed { ids, near: None } => {
                 self.any_listed::<false>(ray, t_max, (ids, &[]), scratch, stop)
             }
@@ -41,6 +41,14 @@ impl Geometry {
             true
         });
         found
+    }
+
+    /// [`Geometry::any`] among every primitive, in the hierarchy's near-first order. Not
+    /// inlined, as the queries over lists are not: the dispatch that picks one of them stays
+    /// small enough to be inlined where rays are traced.
+    #[inline(never)]
+    fn any_of_all(&self, ray: &Ray, t_max: f32, scratch: &Scratch, stop: impl FnMut(u32) -> bool) {
+        self.any_hit(ray, t_max, scratch, stop)
     }
 
     /// [`Geometry::any`] among every primitive, in the hierarchy's near-first order.
