@@ -63,37 +63,8 @@ impl Cone {
         let a = d.x * d.x + d.y * d.y - k2 * d.z * d.z;
         let b = 2.0 * (o.x * d.x + o.y * d.y - k2 * o.z * d.z);
         let c = o.x * o.x + o.y * o.y - k2 * o.z * o.z;
-        let roots: [Option<f64>; 2] = if a != 0.0 {
-            // Also right for |a| tiny (nearly parallel to a generator): the stable form yields
-            // the linear root as c/q and the other one far away, on the other nappe or beyond
-            // the base.
-            match quadratic_roots(a, b, c) {
-                Some((t0, t1)) => [Some(t0), Some(t1)],
-                None => [None, None],
-            }
-        } else if b != 0.0 {
-            // Exactly parallel to a generator: the line meets the cone once.
-            [Some(-c / b), None]
-        } else {
-            // A generator itself (or parallel through the apex): no isolated crossing; the
-            // base cap below still catches it.
-            [None, None]
-        };
-        // How far below the apex (z < 0, the mirrored nappe) a root may be taken as the apex.
-        // A ray steeper than the generators (a < 0) that passes near the apex goes from one
-        // nappe's inside to the other's: it crosses our surface at the apex, by leaving the
-        // mirrored nappe at z = −ε and entering ours at z = +ε. Those two roots merge as ε → 0
-        // and are then known only to √noise/|a| in t: the entry root (or the merged double
-        // root) can land at z < 0, and dropping it would let the ray slip in or out through
-        // the apex unseen (pinned in `tests::pinned_apex_*`). Within that bound the root is
-        // the apex itself, up to the same uncertainty. Otherwise only a sliver of tolerance,
-        // as the cylinder has at both ends; at the rim the side takes rays the cap test
-        // rounds away.
-        let below_apex = if a < 0.0 {
-            d.z.abs() * discriminant_noise(a, b, c).sqrt() / -a
-        } else {
-            0.0
-        } + 1e-12 * h;
+        let roots = side_roots(a, b, c);
+        let below_apex = below_apex_tolerance(a, b, c, d.z, h);
         for tl in roots.into_iter().flatten() {
             let z = o.z + tl * d.z;
             if (-below_apex..=h * (1.0 + 1e-12)).contains(&z) && nearest.offer(l.t_shift + tl) {
@@ -160,6 +131,49 @@ impl Cone {
         let normal = AxisFrame::crossing_normal(normal, face, d, inside);
         self.frame.shape_hit(t, local, normal)
     }
+}
+
+/// The side's crossings in local `t`: the roots of `a·t² + b·t + c = 0`, where `a` vanishes
+/// for rays parallel to a generator and the equation is linear.
+#[inline(always)]
+fn side_roots(a: f64, b: f64, c: f64) -> [Option<f64>; 2] {
+    if a != 0.0 {
+        // Also right for |a| tiny (nearly parallel to a generator): the stable form yields
+        // the linear root as c/q and the other one far away, on the other nappe or beyond
+        // the base.
+        match quadratic_roots(a, b, c) {
+            Some((t0, t1)) => [Some(t0), Some(t1)],
+            None => [None, None],
+        }
+    } else if b != 0.0 {
+        // Exactly parallel to a generator: the line meets the cone once.
+        [Some(-c / b), None]
+    } else {
+        // A generator itself (or parallel through the apex): no isolated crossing; the
+        // base cap still catches it.
+        [None, None]
+    }
+}
+
+/// How far below the apex (z < 0, the mirrored nappe) a root of the side's quadratic
+/// `a·t² + b·t + c` may be taken as the apex, for a local direction of height `dz` and a
+/// cone of height `h`.
+///
+/// A ray steeper than the generators (a < 0) that passes near the apex goes from one nappe's
+/// inside to the other's: it crosses our surface at the apex, by leaving the mirrored nappe
+/// at z = −ε and entering ours at z = +ε. Those two roots merge as ε → 0 and are then known
+/// only to √noise/|a| in t: the entry root (or the merged double root) can land at z < 0,
+/// and dropping it would let the ray slip in or out through the apex unseen (pinned in
+/// `tests::pinned_apex_*`). Within that bound the root is the apex itself, up to the same
+/// uncertainty. Otherwise only a sliver of tolerance, as the cylinder has at both ends; at
+/// the rim the side takes rays the cap test rounds away.
+#[inline(always)]
+fn below_apex_tolerance(a: f64, b: f64, c: f64, dz: f64, h: f64) -> f64 {
+    (if a < 0.0 {
+        dz.abs() * discriminant_noise(a, b, c).sqrt() / -a
+    } else {
+        0.0
+    }) + 1e-12 * h
 }
 
 impl Cone {
