@@ -251,32 +251,107 @@ fn find_split(items: &mut [BuildItem], extent: &Extent, stride: usize) -> Option
     let parent_area = extent.bounds.surface_area().max(f32::MIN_POSITIVE);
     // Skips flat axes, and NaN or infinite extents alike.
     let live = [0, 1, 2].map(|a| size[a].is_finite() && size[a] > 0.0);
-    let scale =
-        Vec3A::from_array([0, 1, 2].map(|a| if live[a] { BINS as f32 / size[a] } else { 0.0 }));
-    let bin_of = |c: Vec3A| {
-        let b = (c - centroid_bounds.min) * scale;
-        [bin(b.x), bin(b.y), bin(b.z)]
+    let binning = Binning {
+        min: centroid_bounds.min,
+        scale: Vec3A::from_array(
+            [0, 1, 2].map(|a| if live[a] { BINS as f32 / size[a] } else { 0.0 }),
+        ),
     };
-    let mut bin_bounds = [[Aabb::EMPTY; BINS]; 3];
-    let mut bin_counts = [[0usize; BINS]; 3];
-    let mut add = |it: &BuildItem| {
-        let b = bin_of(it.centroid);
-        for axis in 0..3 {
-            let bin = &mut bin_bounds[axis][b[axis]];
-            *bin = bin.union(it.bounds);
-            bin_counts[axis][b[axis]] += 1;
-        }
-    };
+    let mut bins = Bins::EMPTY;
     if live.contains(&true) {
+        bins.add(items, stride, &binning);
+    }
+    let mut best: Option<(f32, usize, usize)> = None;
+    for axis in (0..3).filter(|&a| live[a]) {
+        bins.offer_splits(axis, stride, parent_area, &mut best);
+    }
+    let (cost, axis, split) = match best {
+        Some(b) => b,
+        // All centroids coincide: split in halves if the leaf would be too big to store.
+        None if items.len() > u16::MAX as usize => {
+            let mid = items.len() / 2;
+            let (left, right) = items.split_at(mid);
+            return Some(Split {
+                axis: 0,
+                mid,
+                left: Extent::of(left),
+                right: Extent::of(right),
+            });
+        }
+        None => return None,
+    };
+    if cost >= leaf_cost && items.len() <= u16::MAX as usize {
+        return None;
+    }
+    Some(partition(items, &bins, &binning, axis, split, stride))
+}
+
+/// Where a node's centroids fall among its bins: `BINS` equal slices of the centroid bounds
+/// along each axis, and all in bin 0 along an axis whose scale is 0 (a flat one).
+struct Binning {
+    min: Vec3A,
+    scale: Vec3A,
+}
+
+impl Binning {
+    /// The bins of centroid `c` along the three axes.
+    #[inline(always)]
+    fn bins(&self, c: Vec3A) -> [usize; 3] {
+        let b = (c - self.min) * self.scale;
+        [bin(b.x), bin(b.y), bin(b.z)]
+    }
+
+    /// The bin of centroid `c` along `axis`: lane `axis` of `bins`.
+    #[inline(always)]
+    fn bin(&self, c: Vec3A, axis: usize) -> usize {
+        bin(((c - self.min) * self.scale)[axis])
+    }
+}
+
+/// A node's bins along each axis: the union of the boxes of the items binned in each, and
+/// how many they are.
+struct Bins {
+    bounds: [[Aabb; BINS]; 3],
+    counts: [[usize; BINS]; 3],
+}
+
+impl Bins {
+    const EMPTY: Bins = Bins {
+        bounds: [[Aabb::EMPTY; BINS]; 3],
+        counts: [[0; BINS]; 3],
+    };
+
+    /// Bins `items`, or with `stride` above 1 only one item of each run of `stride`
+    /// (`sample`).
+    #[inline(always)]
+    fn add(&mut self, items: &[BuildItem], stride: usize, binning: &Binning) {
+        let Bins { bounds, counts } = self;
+        let mut add = |it: &BuildItem| {
+            let b = binning.bins(it.centroid);
+            for axis in 0..3 {
+                let bin = &mut bounds[axis][b[axis]];
+                *bin = bin.union(it.bounds);
+                counts[axis][b[axis]] += 1;
+            }
+        };
         if stride == 1 {
             items.iter().for_each(&mut add);
         } else {
             sample(items.len(), stride).for_each(|i| add(&items[i]));
         }
     }
-    let mut best: Option<(f32, usize, usize)> = None;
-    for axis in (0..3).filter(|&a| live[a]) {
-        let (bin_bounds, bin_counts) = (&bin_bounds[axis], &bin_counts[axis]);
+
+    /// Offers the SAH cost of each split along `axis` (with the counts scaled back up by
+    /// `stride`) to `best`, which keeps the first of the cheapest as (cost, axis, split).
+    #[inline(always)]
+    fn offer_splits(
+        &self,
+        axis: usize,
+        stride: usize,
+        parent_area: f32,
+        best: &mut Option<(f32, usize, usize)>,
+    ) {
+        let (bin_bounds, bin_counts) = (&self.bounds[axis], &self.counts[axis]);
         // Sweep from the right to get the area and count of everything right of each split.
         let mut right_area = [0.0f32; BINS];
         let mut right_count = [0usize; BINS];
@@ -312,35 +387,31 @@ fn find_split(items: &mut [BuildItem], extent: &Extent, stride: usize) -> Option
                     * stride as f32
                     / parent_area;
             if best.is_none_or(|(c, _, _)| cost < c) {
-                best = Some((cost, axis, split));
+                *best = Some((cost, axis, split));
             }
         }
     }
-    let (cost, axis, split) = match best {
-        Some(b) => b,
-        // All centroids coincide: split in halves if the leaf would be too big to store.
-        None if items.len() > u16::MAX as usize => {
-            let mid = items.len() / 2;
-            let (left, right) = items.split_at(mid);
-            return Some(Split {
-                axis: 0,
-                mid,
-                left: Extent::of(left),
-                right: Extent::of(right),
-            });
-        }
-        None => return None,
-    };
-    if cost >= leaf_cost && items.len() <= u16::MAX as usize {
-        return None;
-    }
+}
+
+/// Moves the items whose centroids fall below bin `split` along `axis` to the front: the
+/// split, with each side's centroid bounds gathered on the way, and its bounds the union of
+/// its bins'.
+#[inline(always)]
+fn partition(
+    items: &mut [BuildItem],
+    bins: &Bins,
+    binning: &Binning,
+    axis: usize,
+    split: usize,
+    stride: usize,
+) -> Split {
     let side = |bins: &[Aabb]| bins.iter().fold(Aabb::EMPTY, |b, &o| b.union(o));
     let mut left = Extent {
-        bounds: side(&bin_bounds[axis][..split]),
+        bounds: side(&bins.bounds[axis][..split]),
         centroids: Aabb::EMPTY,
     };
     let mut right = Extent {
-        bounds: side(&bin_bounds[axis][split..]),
+        bounds: side(&bins.bounds[axis][split..]),
         centroids: Aabb::EMPTY,
     };
     // Chosen from a sample, a side's bins hold only the sampled items: its box grows to the
@@ -349,7 +420,7 @@ fn find_split(items: &mut [BuildItem], extent: &Extent, stride: usize) -> Option
     for i in 0..items.len() {
         let c = items[i].centroid;
         let b = items[i].bounds;
-        if bin(((c - centroid_bounds.min) * scale)[axis]) < split {
+        if binning.bin(c, axis) < split {
             left.centroids = left.centroids.union_point(c);
             if stride > 1 {
                 left.bounds = left.bounds.union(b);
@@ -363,12 +434,12 @@ fn find_split(items: &mut [BuildItem], extent: &Extent, stride: usize) -> Option
             }
         }
     }
-    Some(Split {
+    Split {
         axis,
         mid,
         left,
         right,
-    })
+    }
 }
 
 #[cfg(test)]
