@@ -236,62 +236,9 @@ fn scan_line(s: &mut Scan, line: &str, line_no: u64) -> Result<(), LineProblem> 
         return Ok(());
     };
     let end = line.len();
-    let number = |w: Option<(usize, &str)>, what: &str| -> Result<f32, LineProblem> {
-        match w {
-            None => Err((end, end, format!("expected {what}, found end of line"))),
-            Some((at, text)) => text.parse::<f32>().map_err(|_| {
-                (
-                    at,
-                    at + text.len(),
-                    format!("expected {what}, found '{text}'"),
-                )
-            }),
-        }
-    };
     match keyword {
         "v" => {
-            let mut xyz = [0.0f32; 3];
-            let mut spans = [(0usize, 0usize); 3];
-            // Written out, not formatted: this runs three times on each of a mesh's vertices.
-            let whats = [
-                "the vertex's x coordinate (a number)",
-                "the vertex's y coordinate (a number)",
-                "the vertex's z coordinate (a number)",
-            ];
-            for (i, what) in whats.into_iter().enumerate() {
-                let w = ws.next();
-                xyz[i] = number(w, what)?;
-                spans[i] = w.map_or((end, end), |(a, t)| (a, a + t.len()));
-            }
-            let rest: Vec<(usize, &str)> = ws.collect();
-            match rest.len() {
-                0 | 3 => {}
-                1 => {
-                    let w = number(Some(rest[0]), "the vertex's weight w (a number)")?;
-                    let (a, t) = rest[0];
-                    if w == 0.0 {
-                        return Err((a, a + t.len(), "vertex weight w is 0".to_string()));
-                    }
-                    for c in &mut xyz {
-                        *c /= w;
-                    }
-                }
-                n => {
-                    let (a, _) = rest[0];
-                    return Err((
-                        a,
-                        end,
-                        format!(
-                            "a vertex takes x y z and then a weight w or an r g b colour; \
-                             found {n} more words"
-                        ),
-                    ));
-                }
-            }
-            if let Some(i) = xyz.iter().position(|c| !c.is_finite()) {
-                let (a, b) = spans[i];
-                return Err((a, b, "vertex coordinate is not a finite number".to_string()));
-            }
+            vertex(ws, end)?;
             s.counts[0] += 1;
         }
         "vt" => {
@@ -299,7 +246,7 @@ fn scan_line(s: &mut Scan, line: &str, line_no: u64) -> Result<(), LineProblem> 
                 "the texture coordinate u (a number)",
                 "the texture coordinate v (a number)",
             ] {
-                number(ws.next(), what)?;
+                number(ws.next(), what, end)?;
             }
             s.counts[1] += 1;
         }
@@ -310,7 +257,7 @@ fn scan_line(s: &mut Scan, line: &str, line_no: u64) -> Result<(), LineProblem> 
                 "the normal's z component (a number)",
             ] {
                 let w = ws.next();
-                let v = number(w, what)?;
+                let v = number(w, what, end)?;
                 if !v.is_finite() {
                     let (a, t) = w.unwrap_or((end, ""));
                     return Err((a, a + t.len(), "normal is not a finite number".to_string()));
@@ -343,6 +290,74 @@ fn scan_line(s: &mut Scan, line: &str, line_no: u64) -> Result<(), LineProblem> 
             ));
         }
         _ => {}
+    }
+    Ok(())
+}
+
+/// The number of word `w` (`None` past the last word of a line `end` bytes long), or what
+/// the line should have had there.
+#[inline(always)]
+fn number(w: Option<(usize, &str)>, what: &str, end: usize) -> Result<f32, LineProblem> {
+    match w {
+        None => Err((end, end, format!("expected {what}, found end of line"))),
+        Some((at, text)) => text.parse::<f32>().map_err(|_| {
+            (
+                at,
+                at + text.len(),
+                format!("expected {what}, found '{text}'"),
+            )
+        }),
+    }
+}
+
+/// Checks the words `ws` after a `v` of a line `end` bytes long: x y z, then a weight w or an
+/// r g b colour, as `tobj` reads them.
+#[inline(always)]
+fn vertex<'a>(
+    mut ws: impl Iterator<Item = (usize, &'a str)>,
+    end: usize,
+) -> Result<(), LineProblem> {
+    let mut xyz = [0.0f32; 3];
+    let mut spans = [(0usize, 0usize); 3];
+    // Written out, not formatted: this runs three times on each of a mesh's vertices.
+    let whats = [
+        "the vertex's x coordinate (a number)",
+        "the vertex's y coordinate (a number)",
+        "the vertex's z coordinate (a number)",
+    ];
+    for (i, what) in whats.into_iter().enumerate() {
+        let w = ws.next();
+        xyz[i] = number(w, what, end)?;
+        spans[i] = w.map_or((end, end), |(a, t)| (a, a + t.len()));
+    }
+    let rest: Vec<(usize, &str)> = ws.collect();
+    match rest.len() {
+        0 | 3 => {}
+        1 => {
+            let w = number(Some(rest[0]), "the vertex's weight w (a number)", end)?;
+            let (a, t) = rest[0];
+            if w == 0.0 {
+                return Err((a, a + t.len(), "vertex weight w is 0".to_string()));
+            }
+            for c in &mut xyz {
+                *c /= w;
+            }
+        }
+        n => {
+            let (a, _) = rest[0];
+            return Err((
+                a,
+                end,
+                format!(
+                    "a vertex takes x y z and then a weight w or an r g b colour; \
+                     found {n} more words"
+                ),
+            ));
+        }
+    }
+    if let Some(i) = xyz.iter().position(|c| !c.is_finite()) {
+        let (a, b) = spans[i];
+        return Err((a, b, "vertex coordinate is not a finite number".to_string()));
     }
     Ok(())
 }
