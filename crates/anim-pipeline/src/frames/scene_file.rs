@@ -132,10 +132,60 @@ pub fn render_scene_file(
     // found when its image is about to be rendered (with the geometry the render uses).
     let blank_at = warnings.len();
     // Resolve every output before rendering anything, so a bad name fails fast.
-    let mut targets = Vec::with_capacity(loaded.jobs.len());
+    let targets = match resolve_targets(path, &loaded.jobs, settings, load.strict, &mut warnings) {
+        Ok(targets) => targets,
+        Err(errors) => {
+            let blanks = probe::blank_image_warnings(&loaded.jobs, path);
+            warnings.splice(blank_at..blank_at, blanks);
+            warnings.extend(errors);
+            return Err(warnings);
+        }
+    };
+    progress.begin(
+        loaded
+            .jobs
+            .iter()
+            .map(|j| {
+                let (w, h, _) = settings.resolve(j);
+                w as u64 * h as u64
+            })
+            .sum(),
+    );
+    let mut blanks = Vec::new();
+    let result = render_jobs(
+        path,
+        &loaded.jobs,
+        targets,
+        settings,
+        progress,
+        (&mut blanks, &mut warnings),
+    );
+    progress.end();
+    warnings.splice(blank_at..blank_at, blanks);
+    match result {
+        Ok((outputs, rays)) => Ok(FileOutcome {
+            outputs,
+            warnings,
+            rays,
+        }),
+        Err(()) => Err(warnings),
+    }
+}
+
+/// Where each of `jobs` writes its image, and in which format. A path confined to its folder
+/// warns in `warnings` (or is an error under `strict`); `Err` holds every error, in the order
+/// of the render lines.
+fn resolve_targets(
+    path: &Path,
+    jobs: &[RenderJob],
+    settings: &RenderSettings,
+    strict: bool,
+    warnings: &mut Vec<Diagnostic>,
+) -> Result<Vec<(PathBuf, ImageFormat)>, Vec<Diagnostic>> {
+    let mut targets = Vec::with_capacity(jobs.len());
     let mut errors = Vec::new();
-    for job in &loaded.jobs {
-        let (out, confined) = output_path(path, job, settings, load.strict);
+    for job in jobs {
+        let (out, confined) = output_path(path, job, settings, strict);
         if let Some(d) = confined {
             if d.is_error() {
                 errors.push(d);
@@ -193,40 +243,10 @@ pub fn render_scene_file(
             ),
         }
     }
-    if !errors.is_empty() {
-        let blanks = probe::blank_image_warnings(&loaded.jobs, path);
-        warnings.splice(blank_at..blank_at, blanks);
-        warnings.extend(errors);
-        return Err(warnings);
-    }
-    progress.begin(
-        loaded
-            .jobs
-            .iter()
-            .map(|j| {
-                let (w, h, _) = settings.resolve(j);
-                w as u64 * h as u64
-            })
-            .sum(),
-    );
-    let mut blanks = Vec::new();
-    let result = render_jobs(
-        path,
-        &loaded.jobs,
-        targets,
-        settings,
-        progress,
-        (&mut blanks, &mut warnings),
-    );
-    progress.end();
-    warnings.splice(blank_at..blank_at, blanks);
-    match result {
-        Ok((outputs, rays)) => Ok(FileOutcome {
-            outputs,
-            warnings,
-            rays,
-        }),
-        Err(()) => Err(warnings),
+    if errors.is_empty() {
+        Ok(targets)
+    } else {
+        Err(errors)
     }
 }
 
