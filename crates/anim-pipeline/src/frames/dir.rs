@@ -202,22 +202,7 @@ pub fn render_dir(
     // list in halves), so an interrupted run leaves a playable prefix behind.
     todo.iter().par_bridge().for_each(|(path, name, hash)| {
         let t0 = Instant::now();
-        let record = record_path(&out_dir, name);
-        // A stale record must not outlive an attempt to replace its images.
-        let _ = std::fs::remove_file(&record);
-        let outcome = match render_scene_file(path, load, settings, &NoProgress) {
-            Ok(file) => match write_record(&record, &out_dir, *hash, &file.outputs) {
-                Ok(()) => FrameOutcome::Rendered {
-                    rays: file.rays.total(),
-                    warnings: file.warnings,
-                },
-                Err(e) => FrameOutcome::Failed(vec![Diagnostic::file_error(
-                    &record,
-                    format!("rendered, but cannot record it: {e}"),
-                )]),
-            },
-            Err(diags) => FrameOutcome::Failed(diags),
-        };
+        let outcome = render_frame(path, name, *hash, &out_dir, settings, load);
         observer.finished(name, &outcome, t0.elapsed());
         if let Ok(mut r) = results.lock() {
             r.push((name.clone(), outcome));
@@ -225,30 +210,64 @@ pub fn render_dir(
     });
     observer.end();
 
-    let mut results = results.into_inner().unwrap_or_else(|e| e.into_inner());
-    results.sort_by(|a, b| natural_cmp(&a.0, &b.0));
-    let mut warnings: BTreeMap<String, (Diagnostic, usize)> = BTreeMap::new();
-    for (name, outcome) in results {
-        match outcome {
-            FrameOutcome::Rendered { rays, warnings: w } => {
-                summary.rays += rays;
-                summary.rendered.push(name);
-                for d in w {
-                    // Frames of one animation repeat the same warning: show it once, with
-                    // the first frame's location and a count.
-                    warnings
-                        .entry(d.message.clone())
-                        .and_modify(|e| e.1 += 1)
-                        .or_insert((d, 1));
-                }
-            }
-            FrameOutcome::Failed(diags) => summary.failed.push((name, diags)),
-        }
-    }
-    summary.failed.sort_by(|a, b| natural_cmp(&a.0, &b.0));
-    summary.warnings = warnings.into_values().collect();
+    summary.add_outcomes(results.into_inner().unwrap_or_else(|e| e.into_inner()));
     summary.wall = start.elapsed();
     Ok(summary)
+}
+
+/// Renders frame `path` (file `name`, of hash `hash`) and records it under `out_dir`.
+fn render_frame(
+    path: &Path,
+    name: &str,
+    hash: u64,
+    out_dir: &Path,
+    settings: &RenderSettings,
+    load: &LoadOptions,
+) -> FrameOutcome {
+    let record = record_path(out_dir, name);
+    // A stale record must not outlive an attempt to replace its images.
+    let _ = std::fs::remove_file(&record);
+    match render_scene_file(path, load, settings, &NoProgress) {
+        Ok(file) => match write_record(&record, out_dir, hash, &file.outputs) {
+            Ok(()) => FrameOutcome::Rendered {
+                rays: file.rays.total(),
+                warnings: file.warnings,
+            },
+            Err(e) => FrameOutcome::Failed(vec![Diagnostic::file_error(
+                &record,
+                format!("rendered, but cannot record it: {e}"),
+            )]),
+        },
+        Err(diags) => FrameOutcome::Failed(diags),
+    }
+}
+
+impl Summary {
+    /// Adds the outcomes of the frames rendered (finished in any order) in natural order, with
+    /// each distinct warning once.
+    fn add_outcomes(&mut self, mut results: Vec<(String, FrameOutcome)>) {
+        results.sort_by(|a, b| natural_cmp(&a.0, &b.0));
+        let mut warnings: BTreeMap<String, (Diagnostic, usize)> = BTreeMap::new();
+        for (name, outcome) in results {
+            match outcome {
+                FrameOutcome::Rendered { rays, warnings: w } => {
+                    self.rays += rays;
+                    self.rendered.push(name);
+                    for d in w {
+                        // Frames of one animation repeat the same warning: show it once, with
+                        // the first frame's location and a count.
+                        warnings
+                            .entry(d.message.clone())
+                            .and_modify(|e| e.1 += 1)
+                            .or_insert((d, 1));
+                    }
+                }
+                FrameOutcome::Failed(diags) => self.failed.push((name, diags)),
+            }
+        }
+        self.failed.sort_by(|a, b| natural_cmp(&a.0, &b.0));
+        self.warnings = warnings.into_values().collect();
+    }
 }
 
 fn file_name(path: &Path) -> String {
