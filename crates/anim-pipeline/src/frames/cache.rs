@@ -165,12 +165,31 @@ mod tests {
     use super::*;
     use anim_core::sdf::{MaterialField, MaterialLayout, TransformOrder};
 
-    /// Changing any one setting changes the key. The structs are taken apart field by field
-    /// without `..`, so a new setting does not compile here until it has a case of its own.
+    /// Changing any one setting changes the key.
     #[test]
     fn every_setting_is_part_of_the_key() {
         let base = RenderSettings::default();
         let load = LoadOptions::default();
+        let variants = render_variants(&base)
+            .into_iter()
+            .map(|s| (s, load.clone()))
+            .chain(load_variants(&load).into_iter().map(|l| (base.clone(), l)));
+        let key =
+            |s: &RenderSettings, l: &LoadOptions| frame_hash(b"x", &settings_fingerprint(s, l));
+        let unchanged = key(&base, &load);
+        for (s, l) in variants {
+            assert_ne!(key(&s, &l), unchanged, "{s:?} {l:?}");
+        }
+        assert_ne!(
+            key(&base, &load),
+            frame_hash(b"y", &settings_fingerprint(&base, &load))
+        );
+    }
+
+    /// `base` with each of its settings changed in turn. The struct is taken apart field by
+    /// field without `..`, so a new setting does not compile here until it has a case of its
+    /// own.
+    fn render_variants(base: &RenderSettings) -> Vec<RenderSettings> {
         let RenderSettings {
             spp,
             error,
@@ -184,6 +203,57 @@ mod tests {
             max_memory,
             hdr,
         } = base.clone();
+        vec![
+            RenderSettings {
+                spp: Some(spp.unwrap_or(1) + 1),
+                ..base.clone()
+            },
+            RenderSettings {
+                error: Some(error.unwrap_or(1.0) * 2.0),
+                ..base.clone()
+            },
+            RenderSettings {
+                max_spp: Some(max_spp.unwrap_or(1) + 1),
+                ..base.clone()
+            },
+            RenderSettings {
+                width: Some(width.unwrap_or(1) + 1),
+                ..base.clone()
+            },
+            RenderSettings {
+                height: Some(height.unwrap_or(1) + 1),
+                ..base.clone()
+            },
+            RenderSettings {
+                max_depth: max_depth + 1,
+                ..base.clone()
+            },
+            RenderSettings {
+                ppm_ascii: !ppm_ascii,
+                ..base.clone()
+            },
+            RenderSettings {
+                out_dir: Some(out_dir.unwrap_or_default().join("elsewhere")),
+                ..base.clone()
+            },
+            RenderSettings {
+                allow_any_output: !allow_any_output,
+                ..base.clone()
+            },
+            RenderSettings {
+                max_memory: max_memory / 2,
+                ..base.clone()
+            },
+            RenderSettings {
+                hdr: !hdr,
+                ..base.clone()
+            },
+        ]
+    }
+
+    /// `load` with each option the key covers changed in turn, taken apart as in
+    /// `render_variants`.
+    fn load_variants(load: &LoadOptions) -> Vec<LoadOptions> {
         let LoadOptions {
             strict,
             material_fields,
@@ -195,128 +265,29 @@ mod tests {
             // renders.
             max_memory: _,
         } = load.clone();
-        let variants: Vec<(RenderSettings, LoadOptions)> = vec![
-            (
-                RenderSettings {
-                    spp: Some(spp.unwrap_or(1) + 1),
-                    ..base.clone()
+        vec![
+            LoadOptions {
+                strict: !strict,
+                ..load.clone()
+            },
+            LoadOptions {
+                material_fields: match material_fields {
+                    MaterialLayout::Auto => MaterialLayout::Fields(vec![MaterialField::Ior]),
+                    MaterialLayout::Fields(_) => MaterialLayout::Auto,
                 },
-                load.clone(),
-            ),
-            (
-                RenderSettings {
-                    error: Some(error.unwrap_or(1.0) * 2.0),
-                    ..base.clone()
+                ..load.clone()
+            },
+            LoadOptions {
+                transform_order: match transform_order {
+                    TransformOrder::World => TransformOrder::Local,
+                    TransformOrder::Local => TransformOrder::World,
                 },
-                load.clone(),
-            ),
-            (
-                RenderSettings {
-                    max_spp: Some(max_spp.unwrap_or(1) + 1),
-                    ..base.clone()
-                },
-                load.clone(),
-            ),
-            (
-                RenderSettings {
-                    width: Some(width.unwrap_or(1) + 1),
-                    ..base.clone()
-                },
-                load.clone(),
-            ),
-            (
-                RenderSettings {
-                    height: Some(height.unwrap_or(1) + 1),
-                    ..base.clone()
-                },
-                load.clone(),
-            ),
-            (
-                RenderSettings {
-                    max_depth: max_depth + 1,
-                    ..base.clone()
-                },
-                load.clone(),
-            ),
-            (
-                RenderSettings {
-                    ppm_ascii: !ppm_ascii,
-                    ..base.clone()
-                },
-                load.clone(),
-            ),
-            (
-                RenderSettings {
-                    out_dir: Some(out_dir.unwrap_or_default().join("elsewhere")),
-                    ..base.clone()
-                },
-                load.clone(),
-            ),
-            (
-                RenderSettings {
-                    allow_any_output: !allow_any_output,
-                    ..base.clone()
-                },
-                load.clone(),
-            ),
-            (
-                RenderSettings {
-                    max_memory: max_memory / 2,
-                    ..base.clone()
-                },
-                load.clone(),
-            ),
-            (
-                RenderSettings {
-                    hdr: !hdr,
-                    ..base.clone()
-                },
-                load.clone(),
-            ),
-            (
-                base.clone(),
-                LoadOptions {
-                    strict: !strict,
-                    ..load.clone()
-                },
-            ),
-            (
-                base.clone(),
-                LoadOptions {
-                    material_fields: match material_fields {
-                        MaterialLayout::Auto => MaterialLayout::Fields(vec![MaterialField::Ior]),
-                        MaterialLayout::Fields(_) => MaterialLayout::Auto,
-                    },
-                    ..load.clone()
-                },
-            ),
-            (
-                base.clone(),
-                LoadOptions {
-                    transform_order: match transform_order {
-                        TransformOrder::World => TransformOrder::Local,
-                        TransformOrder::Local => TransformOrder::World,
-                    },
-                    ..load.clone()
-                },
-            ),
-            (
-                base.clone(),
-                LoadOptions {
-                    infer_transform_order: !infer_transform_order,
-                    ..load.clone()
-                },
-            ),
-        ];
-        let key =
-            |s: &RenderSettings, l: &LoadOptions| frame_hash(b"x", &settings_fingerprint(s, l));
-        let unchanged = key(&base, &load);
-        for (s, l) in &variants {
-            assert_ne!(key(s, l), unchanged, "{s:?} {l:?}");
-        }
-        assert_ne!(
-            key(&base, &load),
-            frame_hash(b"y", &settings_fingerprint(&base, &load))
-        );
+                ..load.clone()
+            },
+            LoadOptions {
+                infer_transform_order: !infer_transform_order,
+                ..load.clone()
+            },
+        ]
     }
 }
