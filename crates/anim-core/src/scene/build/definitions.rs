@@ -50,15 +50,46 @@ pub(super) struct Definitions<'s> {
     pub(super) background: Vec3,
 }
 
+/// Where each name was first defined (statement index and line), for a use that comes before
+/// its definition.
+#[derive(Default)]
+struct FirstDefinitions<'s> {
+    /// Shapes and composites: a child must be defined before the composite.
+    objects: HashMap<&'s str, (usize, u32)>,
+    /// A material used before its definition is warned of.
+    materials: HashMap<&'s str, (usize, u32)>,
+}
+
 impl Builder<'_> {
     // ----- definitions -------------------------------------------------------------------
 
     pub(super) fn definitions<'s>(&mut self, statements: &'s [Statement]) -> Definitions<'s> {
+        let (mut d, first) = self.read_definitions(statements);
+        // Shapes whose material is undefined, for one report per material.
+        let undefined: Vec<(&NameRef, &str)> = statements
+            .iter()
+            .filter_map(|stmt| match &stmt.kind {
+                StatementKind::Shape { name, material, .. }
+                    if !d.material_index.contains_key(material.name.as_str()) =>
+                {
+                    Some((material, name.as_str()))
+                }
+                _ => None,
+            })
+            .collect();
+        let fallback_of = self.undefined_materials(&mut d, &undefined);
+        self.resolve_names(&mut d, statements, &first, &fallback_of);
+        d
+    }
+
+    /// Every definition of `statements`, final versions, with shapes' materials and
+    /// composites' children not yet resolved, and where each name was first defined.
+    fn read_definitions<'s>(
+        &mut self,
+        statements: &'s [Statement],
+    ) -> (Definitions<'s>, FirstDefinitions<'s>) {
         let mut d = Definitions::default();
-        // Where each object name was first defined, for "a child must be defined before the
-        // composite": statement index and line.
-        let mut first_object_def: HashMap<&str, (usize, u32)> = HashMap::new();
-        let mut material_first_def: HashMap<&str, (usize, u32)> = HashMap::new();
+        let mut first = FirstDefinitions::default();
         let mut ambient_set: Option<Vec3> = None;
         let mut ambient_added = Vec3::ZERO;
         for (index, stmt) in statements.iter().enumerate() {
@@ -73,34 +104,20 @@ impl Builder<'_> {
             match &stmt.kind {
                 StatementKind::Material(m) => {
                     let material = self.material(m, stmt);
-                    material_first_def
+                    first
+                        .materials
                         .entry(m.name.as_str())
                         .or_insert((index, stmt.loc.line));
-                    if let Some(&i) = d.material_index.get(m.name.as_str()) {
-                        self.duplicate(stmt, &m.name, "material");
-                        d.materials[i] = material;
-                    } else {
-                        d.material_index.insert(&m.name, d.materials.len());
-                        d.materials.push(material);
-                    }
+                    let (items, names) = (&mut d.materials, &mut d.material_index);
+                    self.define_named(stmt, "material", &m.name, material, items, names);
                 }
                 StatementKind::Shape { name, geometry, .. } => {
-                    if let Geometry::Mesh(m) = geometry {
-                        self.load_mesh(m, stmt);
-                    }
-                    if let Some(reason) = degeneracy(geometry) {
-                        if !self.from_reader {
-                            self.warn(
-                                At::Name(stmt),
-                                format!("shape `{name}` {reason}; shape dropped"),
-                                None,
-                            );
-                        }
-                    }
-                    first_object_def
+                    self.check_shape(stmt, name, geometry);
+                    first
+                        .objects
                         .entry(name.as_str())
                         .or_insert((index, stmt.loc.line));
-                    // The material is resolved below, once every material is known.
+                    // The material is resolved later, once every material is known.
                     let object = Object {
                         name,
                         statement: stmt,
@@ -112,7 +129,8 @@ impl Builder<'_> {
                     self.define_object(&mut d, object);
                 }
                 StatementKind::Composite { name, .. } => {
-                    first_object_def
+                    first
+                        .objects
                         .entry(name.as_str())
                         .or_insert((index, stmt.loc.line));
                     let object = Object {
@@ -125,25 +143,15 @@ impl Builder<'_> {
                     self.define_object(&mut d, object);
                 }
                 StatementKind::Light(l) => {
-                    if let Some(&i) = d.light_index.get(l.name.as_str()) {
-                        self.duplicate(stmt, &l.name, "light");
-                        d.lights[i] = l;
-                    } else {
-                        d.light_index.insert(&l.name, d.lights.len());
-                        d.lights.push(l);
-                    }
+                    let (items, names) = (&mut d.lights, &mut d.light_index);
+                    self.define_named(stmt, "light", &l.name, l, items, names);
                 }
                 StatementKind::Camera(c) => {
                     if !self.from_reader && !self.camera_ok(c, stmt) {
                         continue;
                     }
-                    if let Some(&i) = d.camera_index.get(c.name.as_str()) {
-                        self.duplicate(stmt, &c.name, "camera");
-                        d.cameras[i] = c;
-                    } else {
-                        d.camera_index.insert(&c.name, d.cameras.len());
-                        d.cameras.push(c);
-                    }
+                    let (items, names) = (&mut d.cameras, &mut d.camera_index);
+                    self.define_named(stmt, "camera", &c.name, c, items, names);
                 }
                 StatementKind::Ambient(rgb) => ambient_set = Some(*rgb),
                 StatementKind::AmbientAdd(rgb) => ambient_added += *rgb,
@@ -154,22 +162,55 @@ impl Builder<'_> {
             }
         }
         d.ambient = ambient_set.unwrap_or(Vec3::ZERO) + ambient_added;
+        (d, first)
+    }
 
-        // Shapes whose material is undefined, for one report per material.
-        let undefined: Vec<(&NameRef, &str)> = statements
-            .iter()
-            .filter_map(|stmt| match &stmt.kind {
-                StatementKind::Shape { name, material, .. }
-                    if !d.material_index.contains_key(material.name.as_str()) =>
-                {
-                    Some((material, name.as_str()))
-                }
-                _ => None,
-            })
-            .collect();
-        let fallback_of = self.undefined_materials(&mut d, &undefined);
+    /// Loads a shape's mesh, and warns of a degenerate shape made by a program (the parser
+    /// warns of those it reads).
+    fn check_shape(&mut self, stmt: &Statement, name: &str, geometry: &Geometry) {
+        if let Geometry::Mesh(m) = geometry {
+            self.load_mesh(m, stmt);
+        }
+        if let Some(reason) = degeneracy(geometry) {
+            if !self.from_reader {
+                self.warn(
+                    At::Name(stmt),
+                    format!("shape `{name}` {reason}; shape dropped"),
+                    None,
+                );
+            }
+        }
+    }
 
-        // Shapes' materials and composites' children, now that every name is known.
+    /// Adds `item`, the `what` named `name`, to `items` and `index`; a later definition of the
+    /// name replaces the earlier one in place, with a warning.
+    fn define_named<'s, T>(
+        &mut self,
+        stmt: &Statement,
+        what: &str,
+        name: &'s str,
+        item: T,
+        items: &mut Vec<T>,
+        index: &mut HashMap<&'s str, usize>,
+    ) {
+        if let Some(&i) = index.get(name) {
+            self.duplicate(stmt, name, what);
+            items[i] = item;
+        } else {
+            index.insert(name, items.len());
+            items.push(item);
+        }
+    }
+
+    /// Shapes' materials and composites' children, now that every name is known; a shape
+    /// whose material is undefined takes `fallback_of` it.
+    fn resolve_names<'s>(
+        &mut self,
+        d: &mut Definitions<'s>,
+        statements: &'s [Statement],
+        first: &FirstDefinitions,
+        fallback_of: &HashMap<&str, usize>,
+    ) {
         for (index, stmt) in statements.iter().enumerate() {
             match &stmt.kind {
                 StatementKind::Shape {
@@ -178,13 +219,13 @@ impl Builder<'_> {
                     material,
                 } => {
                     let resolved = self
-                        .resolve_material(&d, &material_first_def, index, material)
+                        .resolve_material(d, &first.materials, index, material)
                         .or_else(|| fallback_of.get(material.name.as_str()).copied());
                     let Some(&i) = d.object_index.get(name.as_str()) else {
                         continue;
                     };
                     // Only the final definition of the name is drawn; earlier ones were
-                    // still checked above.
+                    // still checked when read.
                     if std::ptr::eq(d.objects[i].statement, stmt) {
                         d.objects[i].kind = ObjectKind::Shape {
                             geometry,
@@ -197,8 +238,7 @@ impl Builder<'_> {
                     }
                 }
                 StatementKind::Composite { name, children } => {
-                    let resolved =
-                        self.resolve_children(&d, &first_object_def, index, name, children);
+                    let resolved = self.resolve_children(d, &first.objects, index, name, children);
                     if let Some(&i) = d.object_index.get(name.as_str()) {
                         if std::ptr::eq(d.objects[i].statement, stmt) {
                             d.objects[i].kind = ObjectKind::Composite { children: resolved };
@@ -208,7 +248,6 @@ impl Builder<'_> {
                 _ => {}
             }
         }
-        d
     }
 
     pub(super) fn define_object<'s>(&mut self, d: &mut Definitions<'s>, object: Object<'s>) {
