@@ -4,6 +4,7 @@
 //! would give (`scene::scale_tests` compares the two); the shapes are turned into instances
 //! chunk by chunk, each chunk freed once done, so the file's shapes are never held twice.
 
+use super::definitions::Definitions;
 use super::jobs::{placed_geometry, Expansion, Flat, Largest};
 use super::{At, Builder};
 use crate::scene::{Instance, Names, RenderJob, NO_NAME};
@@ -21,37 +22,9 @@ impl Builder<'_> {
         statements: &[Statement],
         mut shapes: FlatShapes,
     ) -> Vec<RenderJob> {
-        // The uses of materials no statement defines, reported with the shapes using them as
-        // for shapes read as statements; made before the definitions, which borrow them.
-        let defined: FastSet<&str> = statements
-            .iter()
-            .filter_map(|s| match &s.kind {
-                StatementKind::Material(m) => Some(m.name.as_str()),
-                _ => None,
-            })
-            .collect();
-        let unknown_ids: Vec<bool> = (0..shapes.material_count())
-            .map(|id| !defined.contains(shapes.material_name(id)))
-            .collect();
-        let unknown: Vec<(NameRef, String)> = if unknown_ids.contains(&true) {
-            shapes
-                .iter()
-                .filter(|s| unknown_ids[shapes.material_of(s)])
-                .map(|s| (shapes.material_ref(s), shapes.name(s).to_string()))
-                .collect()
-        } else {
-            Vec::new()
-        };
-        // Where each material is first defined, placed after every shape that the reader saw
-        // before it (index 0 below): for "used before its definition".
-        let mut first_def: HashMap<&str, (usize, u32)> = HashMap::new();
-        for (index, stmt) in statements.iter().enumerate() {
-            if let StatementKind::Material(m) = &stmt.kind {
-                first_def
-                    .entry(m.name.as_str())
-                    .or_insert((index + 1, stmt.loc.line));
-            }
-        }
+        // Made before the definitions, which borrow them.
+        let unknown = unknown_material_uses(statements, &shapes);
+        let first_def = material_first_defs(statements);
         let mut d = self.definitions(statements);
         self.check_cycles(&d);
         let uses: Vec<(&NameRef, &str)> = unknown.iter().map(|(m, s)| (m, s.as_str())).collect();
@@ -66,56 +39,9 @@ impl Builder<'_> {
             })
             .collect();
 
-        // Later definitions of a name replace earlier ones; materials used before their
-        // definition are pointed out.
-        // By shape: `SUPERSEDED` once a later shape takes its name, `DRAWABLE` when its
-        // material resolves and it is not degenerate (found in the same walk over the shapes).
-        let mut state = vec![0u8; shapes.len()];
+        let state = self.flat_shape_states(&shapes, &resolved, &d, &first_def);
         let mut total = Expansion::default();
         let mut first_root: Option<usize> = None;
-        {
-            let mut latest = NameTable::new(shapes.len());
-            let mut hashes = Vec::new();
-            let mut k = 0;
-            for chunk in shapes.chunks() {
-                // The names of a chunk are hashed first: the table's slots, far apart in
-                // memory, are then looked up in a tight loop whose loads overlap.
-                hashes.clear();
-                hashes.extend(chunk.iter().map(|s| NameTable::hash(shapes.name(s))));
-                for (s, &hash) in chunk.iter().zip(&hashes) {
-                    let name = shapes.name(s);
-                    if resolved[shapes.material_of(s)].is_some()
-                        && degeneracy(&s.geometry).is_none()
-                    {
-                        state[k] = DRAWABLE;
-                    }
-                    let earlier = latest.insert(hash, name, k, |j| {
-                        shapes.get(j).map_or("", |e| shapes.name(e))
-                    });
-                    k += 1;
-                    if let Some((earlier, earlier_line)) =
-                        earlier.and_then(|j| Some((j, shapes.get(j)?.line())))
-                    {
-                        state[earlier] |= SUPERSEDED;
-                        let (loc, width) = shapes.name_place(s);
-                        self.warn(
-                            At::Place(&loc, width),
-                            format!(
-                                "shape `{name}` is already defined (line {earlier_line}); the later definition replaces it"
-                            ),
-                            None,
-                        );
-                    }
-                    let material = shapes.material_of(s);
-                    if !shapes.material_defined_before(s)
-                        && d.material_index
-                            .contains_key(shapes.material_name(material))
-                    {
-                        self.resolve_material(&d, &first_def, 0, &shapes.material_ref(s));
-                    }
-                }
-            }
-        }
         // What is drawn: neither superseded, nor of a material that cannot be resolved, nor
         // degenerate.
         for (k, &st) in state.iter().enumerate() {
@@ -139,35 +65,13 @@ impl Builder<'_> {
             None => Some(0),
         };
 
-        let mut instances = Vec::new();
-        let mut names = Names::default();
-        if let Some(count) = fits {
-            let count = usize::try_from(count).unwrap_or(0);
-            instances.reserve_exact(count);
-            names.reserve(count, shapes.names_len());
-            let file = shapes.file().map(|f| names.file_id(f));
-            let mut k = 0;
-            for chunk in shapes.take_chunks() {
-                for s in chunk {
-                    k += 1;
-                    if state[k - 1] != DRAWABLE {
-                        continue;
-                    }
-                    let (Some(material), Some(file)) = (resolved[shapes.material_of(&s)], file)
-                    else {
-                        continue;
-                    };
-                    let object = names.add_object_in(shapes.name(&s), file, s.line(), s.col());
-                    instances.push(Instance {
-                        geometry: placed_geometry(s.geometry),
-                        material,
-                        transform: 0,
-                        object,
-                        parent: NO_NAME,
-                    });
-                }
+        let (instances, names) = match fits {
+            Some(count) => {
+                let count = usize::try_from(count).unwrap_or(0);
+                flat_instances(&mut shapes, &state, &resolved, count)
             }
-        }
+            None => (Vec::new(), Names::default()),
+        };
         drop(state);
         drop(shapes);
         let flat = Flat {
@@ -180,6 +84,133 @@ impl Builder<'_> {
         };
         self.jobs_of(&d, &snapshots, &flat, &Default::default())
     }
+
+    /// The state of each of `shapes` (`SUPERSEDED`, `DRAWABLE`), found in one walk over
+    /// them, which also points out the names defined again (later definitions replace
+    /// earlier ones) and the materials used before their definition.
+    fn flat_shape_states(
+        &mut self,
+        shapes: &FlatShapes,
+        resolved: &[Option<usize>],
+        d: &Definitions,
+        first_def: &HashMap<&str, (usize, u32)>,
+    ) -> Vec<u8> {
+        let mut state = vec![0u8; shapes.len()];
+        let mut latest = NameTable::new(shapes.len());
+        let mut hashes = Vec::new();
+        let mut k = 0;
+        for chunk in shapes.chunks() {
+            // The names of a chunk are hashed first: the table's slots, far apart in
+            // memory, are then looked up in a tight loop whose loads overlap.
+            hashes.clear();
+            hashes.extend(chunk.iter().map(|s| NameTable::hash(shapes.name(s))));
+            for (s, &hash) in chunk.iter().zip(&hashes) {
+                let name = shapes.name(s);
+                if resolved[shapes.material_of(s)].is_some() && degeneracy(&s.geometry).is_none() {
+                    state[k] = DRAWABLE;
+                }
+                let earlier = latest.insert(hash, name, k, |j| {
+                    shapes.get(j).map_or("", |e| shapes.name(e))
+                });
+                k += 1;
+                if let Some((earlier, earlier_line)) =
+                    earlier.and_then(|j| Some((j, shapes.get(j)?.line())))
+                {
+                    state[earlier] |= SUPERSEDED;
+                    let (loc, width) = shapes.name_place(s);
+                    self.warn(
+                        At::Place(&loc, width),
+                        format!(
+                            "shape `{name}` is already defined (line {earlier_line}); the later definition replaces it"
+                        ),
+                        None,
+                    );
+                }
+                let material = shapes.material_of(s);
+                if !shapes.material_defined_before(s)
+                    && d.material_index
+                        .contains_key(shapes.material_name(material))
+                {
+                    self.resolve_material(d, first_def, 0, &shapes.material_ref(s));
+                }
+            }
+        }
+        state
+    }
+}
+
+/// The uses of materials no statement defines, as (material, shape name), to be reported
+/// with the shapes using them as for shapes read as statements.
+fn unknown_material_uses(statements: &[Statement], shapes: &FlatShapes) -> Vec<(NameRef, String)> {
+    let defined: FastSet<&str> = statements
+        .iter()
+        .filter_map(|s| match &s.kind {
+            StatementKind::Material(m) => Some(m.name.as_str()),
+            _ => None,
+        })
+        .collect();
+    let unknown_ids: Vec<bool> = (0..shapes.material_count())
+        .map(|id| !defined.contains(shapes.material_name(id)))
+        .collect();
+    if unknown_ids.contains(&true) {
+        shapes
+            .iter()
+            .filter(|s| unknown_ids[shapes.material_of(s)])
+            .map(|s| (shapes.material_ref(s), shapes.name(s).to_string()))
+            .collect()
+    } else {
+        Vec::new()
+    }
+}
+
+/// Where each material is first defined, placed after every shape that the reader saw before
+/// it (index 0 in `Builder::flat_shape_states`): for "used before its definition".
+fn material_first_defs(statements: &[Statement]) -> HashMap<&str, (usize, u32)> {
+    let mut first_def: HashMap<&str, (usize, u32)> = HashMap::new();
+    for (index, stmt) in statements.iter().enumerate() {
+        if let StatementKind::Material(m) = &stmt.kind {
+            first_def
+                .entry(m.name.as_str())
+                .or_insert((index + 1, stmt.loc.line));
+        }
+    }
+    first_def
+}
+
+/// The instances of the shapes drawn (by `state`), `count` of them, with their names; each
+/// chunk of `shapes` is freed once turned into instances.
+fn flat_instances(
+    shapes: &mut FlatShapes,
+    state: &[u8],
+    resolved: &[Option<usize>],
+    count: usize,
+) -> (Vec<Instance>, Names) {
+    let mut instances = Vec::new();
+    let mut names = Names::default();
+    instances.reserve_exact(count);
+    names.reserve(count, shapes.names_len());
+    let file = shapes.file().map(|f| names.file_id(f));
+    let mut k = 0;
+    for chunk in shapes.take_chunks() {
+        for s in chunk {
+            k += 1;
+            if state[k - 1] != DRAWABLE {
+                continue;
+            }
+            let (Some(material), Some(file)) = (resolved[shapes.material_of(&s)], file) else {
+                continue;
+            };
+            let object = names.add_object_in(shapes.name(&s), file, s.line(), s.col());
+            instances.push(Instance {
+                geometry: placed_geometry(s.geometry),
+                material,
+                transform: 0,
+                object,
+                parent: NO_NAME,
+            });
+        }
+    }
+    (instances, names)
 }
 
 /// A shape's state in `flat_jobs`: a later shape of the same name replaces it.
