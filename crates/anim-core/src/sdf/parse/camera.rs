@@ -70,7 +70,31 @@ impl Parser<'_> {
         };
         let name = name_tok.text.to_string();
         let first = name_at + 1;
-        let mut nums = self.numbers(line, first, toks.len())?;
+        let nums = self.numbers(line, first, toks.len())?;
+        let nums = self.camera_layout(line, first, &name, nums)?;
+        let fov = self.camera_fov(line, first, &nums)?;
+        let mut def = CameraDef::at_origin(&name, fov);
+        if nums.len() == 4 {
+            def.eye = DVec3::new(nums[1], nums[2], nums[3]);
+        }
+        if nums.len() == 10 {
+            self.camera_pose(line, first, &name, &nums, &mut def)?;
+        }
+        self.emit_named(line, name_at, StatementKind::Camera(def));
+        Ok(())
+    }
+
+    /// The numbers `nums` of a camera line (from token `first`) in one of the canonical
+    /// layouts, <fov-x>, <fov-x> [eye] or <fov-x> [eye] [dir] [up] (1, 4 or 10 numbers), each
+    /// other layout that can be read warned of.
+    fn camera_layout(
+        &mut self,
+        line: &Line,
+        first: usize,
+        name: &str,
+        mut nums: Vec<f64>,
+    ) -> PResult<Vec<f64>> {
+        let toks = &line.tokens;
         // Two unambiguous layouts that their authors' renderers drew: the eye alone (looking
         // along -z with y up), and the full form with one stray number after it.
         if nums.len() == 4 {
@@ -81,38 +105,9 @@ impl Parser<'_> {
                 Some(format!("canonical form: `{FORM_CAMERA}`")),
             );
         } else if nums.len() == 3 && is_image_side(nums[1]) && is_image_side(nums[2]) {
-            // `camera eye 45 500 500`: renderers that size the image by the camera.
-            let size = (nums[1] as u32, nums[2] as u32);
-            self.warn(
-                line,
-                At::Span(first, first + 2),
-                format!(
-                    "image size {}×{} after the field of view: used by render lines of this camera that give none",
-                    size.0, size.1
-                ),
-                Some(format!(
-                    "the image size belongs on the render line: `render {name} <file> {} {}`",
-                    size.0, size.1
-                )),
-            );
-            self.camera_sizes.insert(name.clone(), size);
-            nums.truncate(1);
+            self.read_size_after_fov(line, first, name, &mut nums);
         } else if nums.len() == 7 && is_zero(DVec3::new(nums[4], nums[5], nums[6])) {
-            // `[eye] <yaw> <pitch> <roll>` in degrees (renderers that turn the default view):
-            // 0 0 0 is no turn, whereas as a direction it would be none.
-            self.warn(
-                line,
-                At::Span(first + 4, first + 6),
-                "camera with an eye position and `0 0 0` read as the yaw, pitch and roll of \
-                 the default view: looking along -z with +y up",
-                Some(format!(
-                    "write `define camera {name} {} {} 0 0 -1 0 1 0`",
-                    toks[first].text,
-                    joined(toks, first + 1, first + 4)
-                )),
-            );
-            nums.truncate(4);
-            nums.extend([0.0, 0.0, -1.0, 0.0, 1.0, 0.0]);
+            self.read_default_view_angles(line, first, name, &mut nums);
         } else if nums.len() == 7 {
             self.warn(
                 line,
@@ -122,58 +117,9 @@ impl Parser<'_> {
             );
             nums.extend([0.0, 1.0, 0.0]);
         } else if nums.len() == 9 && is_image_side(nums[1]) && is_image_side(nums[2]) {
-            // `<fov> <width> <height> [eye] [dir]`: cameras that carry the image size, in
-            // the order of their constructor.
-            let size = (nums[1] as u32, nums[2] as u32);
-            self.warn(
-                line,
-                At::Span(first + 1, first + 2),
-                format!(
-                    "camera read as <fov-x> <width> <height> [eye] [dir]: image size {}×{} for \
-                     render lines of this camera that give none, +y is up",
-                    size.0, size.1
-                ),
-                Some(format!(
-                    "the image size belongs on the render line: write `define camera {name} {} {}` \
-                     and `render {name} <file> {} {}`",
-                    toks[first].text,
-                    joined(toks, first + 3, first + 9),
-                    toks[first + 1].text,
-                    toks[first + 2].text
-                )),
-            );
-            self.camera_sizes.insert(name.clone(), size);
-            nums.drain(1..3);
-            nums.extend([0.0, 1.0, 0.0]);
+            self.read_size_before_pose(line, first, name, &mut nums);
         } else if let Some(orbit) = orbit(&nums) {
-            // `<fov> <angle> [center] <radius>`: a camera on a circle about the scene's
-            // center, as written by animation generators that circle the scene.
-            self.warn(
-                line,
-                At::Span(first + 1, first + 5),
-                format!(
-                    "6-number camera read as <fov-x> <angle> [center] <radius>: the eye on a \
-                     circle of radius {} about {} in the xz-plane, {}° from +x, looking at the \
-                     center with +y up",
-                    nums[5],
-                    joined(toks, first + 2, first + 5),
-                    nums[1]
-                ),
-                Some(format!(
-                    "write the pose it gives: `define camera {name} {} {} {} {} {} {} {} 0 1 0`",
-                    toks[first].text,
-                    orbit.0.x,
-                    orbit.0.y,
-                    orbit.0.z,
-                    orbit.1.x,
-                    orbit.1.y,
-                    orbit.1.z
-                )),
-            );
-            nums = vec![
-                nums[0], orbit.0.x, orbit.0.y, orbit.0.z, orbit.1.x, orbit.1.y, orbit.1.z, 0.0,
-                1.0, 0.0,
-            ];
+            self.read_orbit(line, first, name, orbit, &mut nums);
         } else if nums.len() == 11 {
             self.warn(
                 line,
@@ -209,6 +155,124 @@ impl Parser<'_> {
             );
             nums.rotate_right(1);
         }
+        Ok(nums)
+    }
+
+    /// `camera eye 45 500 500`: renderers that size the image by the camera. Keeps the size
+    /// for the render lines of the camera that give none.
+    fn read_size_after_fov(&mut self, line: &Line, first: usize, name: &str, nums: &mut Vec<f64>) {
+        let size = (nums[1] as u32, nums[2] as u32);
+        self.warn(
+            line,
+            At::Span(first, first + 2),
+            format!(
+                "image size {}×{} after the field of view: used by render lines of this camera that give none",
+                size.0, size.1
+            ),
+            Some(format!(
+                "the image size belongs on the render line: `render {name} <file> {} {}`",
+                size.0, size.1
+            )),
+        );
+        self.camera_sizes.insert(name.to_string(), size);
+        nums.truncate(1);
+    }
+
+    /// `[eye] <yaw> <pitch> <roll>` in degrees (renderers that turn the default view): 0 0 0
+    /// is no turn, whereas as a direction it would be none.
+    fn read_default_view_angles(
+        &mut self,
+        line: &Line,
+        first: usize,
+        name: &str,
+        nums: &mut Vec<f64>,
+    ) {
+        let toks = &line.tokens;
+        self.warn(
+            line,
+            At::Span(first + 4, first + 6),
+            "camera with an eye position and `0 0 0` read as the yaw, pitch and roll of \
+             the default view: looking along -z with +y up",
+            Some(format!(
+                "write `define camera {name} {} {} 0 0 -1 0 1 0`",
+                toks[first].text,
+                joined(toks, first + 1, first + 4)
+            )),
+        );
+        nums.truncate(4);
+        nums.extend([0.0, 0.0, -1.0, 0.0, 1.0, 0.0]);
+    }
+
+    /// `<fov> <width> <height> [eye] [dir]`: cameras that carry the image size, in the order
+    /// of their constructor. Keeps the size for the render lines of the camera that give
+    /// none.
+    fn read_size_before_pose(
+        &mut self,
+        line: &Line,
+        first: usize,
+        name: &str,
+        nums: &mut Vec<f64>,
+    ) {
+        let toks = &line.tokens;
+        let size = (nums[1] as u32, nums[2] as u32);
+        self.warn(
+            line,
+            At::Span(first + 1, first + 2),
+            format!(
+                "camera read as <fov-x> <width> <height> [eye] [dir]: image size {}×{} for \
+                 render lines of this camera that give none, +y is up",
+                size.0, size.1
+            ),
+            Some(format!(
+                "the image size belongs on the render line: write `define camera {name} {} {}` \
+                 and `render {name} <file> {} {}`",
+                toks[first].text,
+                joined(toks, first + 3, first + 9),
+                toks[first + 1].text,
+                toks[first + 2].text
+            )),
+        );
+        self.camera_sizes.insert(name.to_string(), size);
+        nums.drain(1..3);
+        nums.extend([0.0, 1.0, 0.0]);
+    }
+
+    /// `<fov> <angle> [center] <radius>`: a camera on a circle about the scene's center, as
+    /// written by animation generators that circle the scene; `orbit` is its eye and
+    /// direction.
+    fn read_orbit(
+        &mut self,
+        line: &Line,
+        first: usize,
+        name: &str,
+        orbit: (DVec3, DVec3),
+        nums: &mut Vec<f64>,
+    ) {
+        let toks = &line.tokens;
+        self.warn(
+            line,
+            At::Span(first + 1, first + 5),
+            format!(
+                "6-number camera read as <fov-x> <angle> [center] <radius>: the eye on a \
+                 circle of radius {} about {} in the xz-plane, {}° from +x, looking at the \
+                 center with +y up",
+                nums[5],
+                joined(toks, first + 2, first + 5),
+                nums[1]
+            ),
+            Some(format!(
+                "write the pose it gives: `define camera {name} {} {} {} {} {} {} {} 0 1 0`",
+                toks[first].text, orbit.0.x, orbit.0.y, orbit.0.z, orbit.1.x, orbit.1.y, orbit.1.z
+            )),
+        );
+        *nums = vec![
+            nums[0], orbit.0.x, orbit.0.y, orbit.0.z, orbit.1.x, orbit.1.y, orbit.1.z, 0.0, 1.0,
+            0.0,
+        ];
+    }
+
+    /// The field of view, the first of a camera line's numbers `nums` (from token `first`).
+    fn camera_fov(&mut self, line: &Line, first: usize, nums: &[f64]) -> PResult<f64> {
         let fov = nums[0];
         if !limits::fov_is_valid(fov) {
             let fov_last = nums.len() == 10 && limits::fov_is_valid(nums[9]);
@@ -235,69 +299,76 @@ impl Parser<'_> {
                 )),
             );
         }
-        let mut def = CameraDef::at_origin(&name, fov);
-        if nums.len() == 4 {
-            def.eye = DVec3::new(nums[1], nums[2], nums[3]);
+        Ok(fov)
+    }
+
+    /// The eye, direction and up vector of a camera line's ten numbers `nums` (from token
+    /// `first`) into `def`, with an up vector that gives no roll replaced by +y.
+    fn camera_pose(
+        &mut self,
+        line: &Line,
+        first: usize,
+        name: &str,
+        nums: &[f64],
+        def: &mut CameraDef,
+    ) -> PResult<()> {
+        let toks = &line.tokens;
+        let v = |i: usize| DVec3::new(nums[i], nums[i + 1], nums[i + 2]);
+        def.eye = v(1);
+        def.dir = v(4);
+        def.up = v(7);
+        if is_zero(def.dir) {
+            // Some renderers read these as rotation angles; 0 0 0 then means the default
+            // pose, which is written without them.
+            let eye = format!(
+                "{} {} {}",
+                toks[first + 1].text,
+                toks[first + 2].text,
+                toks[first + 3].text
+            );
+            return Err(self.error(
+                line,
+                At::Span(first + 4, first + 6),
+                "the camera's viewing direction is zero",
+                Some(format!(
+                    "to look along -z with +y up, write `define camera {name} {} {eye}`; otherwise `{FORM_CAMERA}`",
+                    toks[first].text
+                )),
+            ));
         }
-        if nums.len() == 10 {
-            let v = |i: usize| DVec3::new(nums[i], nums[i + 1], nums[i + 2]);
-            def.eye = v(1);
-            def.dir = v(4);
-            def.up = v(7);
-            if is_zero(def.dir) {
-                // Some renderers read these as rotation angles; 0 0 0 then means the default
-                // pose, which is written without them.
-                let eye = format!(
-                    "{} {} {}",
-                    toks[first + 1].text,
-                    toks[first + 2].text,
-                    toks[first + 3].text
-                );
-                return Err(self.error(
-                    line,
-                    At::Span(first + 4, first + 6),
-                    "the camera's viewing direction is zero",
-                    Some(format!(
-                        "to look along -z with +y up, write `define camera {name} {} {eye}`; otherwise `{FORM_CAMERA}`",
-                        toks[first].text
-                    )),
-                ));
-            }
-            if parallel(def.dir, def.up) && !parallel(def.dir, DVec3::Y) && toks.len() > first + 9 {
-                // An up vector that is zero or along the view gives no roll: nothing of the
-                // author's is lost by taking the default one (renderers that ignore it drew
-                // the view that way).
-                let what = if is_zero(def.up) {
-                    "zero"
-                } else {
-                    "parallel to its viewing direction"
-                };
-                self.warn(
-                    line,
-                    At::Span(first + 7, first + 9),
-                    format!("the camera's up vector is {what}: +y is up"),
-                    Some(format!(
-                        "up must point away from the viewing direction, e.g. 0 1 0; canonical form: `{FORM_CAMERA}`"
-                    )),
-                );
-                def.up = DVec3::Y;
-            }
-            if parallel(def.dir, def.up) {
-                // Without an up vector in the file, point at the direction that needs one.
-                let at = if toks.len() > first + 9 {
-                    At::Span(first + 7, first + 9)
-                } else {
-                    At::Span(first + 4, first + 6)
-                };
-                return Err(self.error(
-                    line,
-                    at,
-                    "the camera's up vector is zero or parallel to its viewing direction",
-                    Some("up must point away from the viewing direction, e.g. 0 1 0 when looking along -z".to_string()),
-                ));
-            }
+        if parallel(def.dir, def.up) && !parallel(def.dir, DVec3::Y) && toks.len() > first + 9 {
+            // An up vector that is zero or along the view gives no roll: nothing of the
+            // author's is lost by taking the default one (renderers that ignore it drew
+            // the view that way).
+            let what = if is_zero(def.up) {
+                "zero"
+            } else {
+                "parallel to its viewing direction"
+            };
+            self.warn(
+                line,
+                At::Span(first + 7, first + 9),
+                format!("the camera's up vector is {what}: +y is up"),
+                Some(format!(
+                    "up must point away from the viewing direction, e.g. 0 1 0; canonical form: `{FORM_CAMERA}`"
+                )),
+            );
+            def.up = DVec3::Y;
         }
-        self.emit_named(line, name_at, StatementKind::Camera(def));
+        if parallel(def.dir, def.up) {
+            // Without an up vector in the file, point at the direction that needs one.
+            let at = if toks.len() > first + 9 {
+                At::Span(first + 7, first + 9)
+            } else {
+                At::Span(first + 4, first + 6)
+            };
+            return Err(self.error(
+                line,
+                at,
+                "the camera's up vector is zero or parallel to its viewing direction",
+                Some("up must point away from the viewing direction, e.g. 0 1 0 when looking along -z".to_string()),
+            ));
+        }
         Ok(())
     }
 }
