@@ -1,6 +1,6 @@
 //! Lights, ambient light and the background colour.
 
-use super::{At, PResult, Parser};
+use super::{At, Fail, PResult, Parser};
 use crate::sdf::ast::{LightDef, StatementKind};
 use crate::sdf::lexer::{looks_numeric, Line};
 use glam::{DVec3, Vec3};
@@ -9,6 +9,31 @@ const FORM_LIGHT: &str = "define light <name> [pos] [color] <brightness>";
 const FORM_AMBIENT_LIGHT: &str = "define light ambient <name> [rgb]";
 const FORM_AMBIENT: &str = "ambient [rgb]";
 const FORM_BACKGROUND: &str = "background [rgb]";
+
+/// The numbers of a point light's line, after its name, for each way of reading them.
+struct LightNumbers<'a> {
+    name: &'a str,
+    nums: &'a [f64],
+}
+
+impl LightNumbers<'_> {
+    /// Numbers `i..i + 3` as a colour.
+    fn color(&self, i: usize) -> Vec3 {
+        let nums = self.nums;
+        Vec3::new(nums[i] as f32, nums[i + 1] as f32, nums[i + 2] as f32)
+    }
+
+    /// The light at the position of the first three numbers, with `color` and `brightness`.
+    fn light(&self, color: Vec3, brightness: f32) -> LightDef {
+        let nums = self.nums;
+        LightDef {
+            name: self.name.to_string(),
+            position: DVec3::new(nums[0], nums[1], nums[2]),
+            color,
+            brightness,
+        }
+    }
+}
 
 impl Parser<'_> {
     pub(super) fn light(&mut self, line: &Line) {
@@ -65,14 +90,6 @@ impl Parser<'_> {
         };
         let name = name_tok.text.to_string();
         let nums = self.numbers(line, name_at + 1, toks.len())?;
-        let v = |i: usize| DVec3::new(nums[i], nums[i + 1], nums[i + 2]);
-        let c = |i: usize| Vec3::new(nums[i] as f32, nums[i + 1] as f32, nums[i + 2] as f32);
-        let light = |color: Vec3, brightness: f32| LightDef {
-            name: name.clone(),
-            position: v(0),
-            color,
-            brightness,
-        };
         if let Some(worst) = nums
             .iter()
             .skip(3)
@@ -87,137 +104,165 @@ impl Parser<'_> {
                 Some("colours lie between 0 and 1, brightness is at least 0".to_string()),
             );
         }
+        let numbers = LightNumbers {
+            name: &name,
+            nums: &nums,
+        };
         match nums.len() {
-            10 => {
-                // `[pos] [La] [Ld] <brightness>`: the lecture's form with a brightness.
-                let ambient = c(3);
-                let l = light(c(6), nums[9] as f32);
-                self.variant(
-                    line,
-                    At::Span(name_at + 4, toks.len() - 1),
-                    "ten-number-light",
-                    "10-number light read as [pos] [La] [Ld] <brightness>: La is added to the \
-                     ambient light, the intensity is Ld × brightness"
-                        .to_string(),
-                    format!("read as `{}`", StatementKind::Light(l.clone())),
-                );
-                if ambient != Vec3::ZERO {
-                    self.emit(line, StatementKind::AmbientAdd(ambient));
-                }
-                self.emit_named(line, name_at, StatementKind::Light(l));
-            }
+            10 => self.lecture_light_with_brightness(line, name_at, &numbers),
             7 => {
-                let l = light(c(3), nums[6] as f32);
+                let l = numbers.light(numbers.color(3), nums[6] as f32);
                 self.emit_named(line, name_at, StatementKind::Light(l));
             }
             6 => {
-                let l = light(c(3), 1.0);
+                let l = numbers.light(numbers.color(3), 1.0);
                 self.emit_named(line, name_at, StatementKind::Light(l));
             }
-            9 => {
-                let last = c(6);
-                let nums_at = At::Span(name_at + 4, toks.len() - 1);
-                if last.max_element() > 1.0 {
-                    let l = light(c(3) * last, 1.0);
-                    if !self.nine_number_noted[0] {
-                        self.nine_number_noted[0] = true;
-                        self.warn(
-                            line,
-                            nums_at,
-                            "9-number light read as [pos] [color] [rgb-brightness] (a brightness above 1); \
-                             intensity = color × brightness per channel",
-                            Some(format!("read as `{}`", StatementKind::Light(l.clone()))),
-                        );
-                    }
-                    self.emit_named(line, name_at, StatementKind::Light(l));
-                } else {
-                    let ambient = c(3);
-                    let diffuse = last;
-                    if !self.nine_number_noted[1] {
-                        self.nine_number_noted[1] = true;
-                        self.warn(
-                            line,
-                            nums_at,
-                            "9-number light read as the lecture form [pos] [La] [Ld] (no number above 1): \
-                             La is added to the ambient light, Ld is the light's intensity",
-                            Some(format!(
-                                "for a brightness per channel, one of the last three numbers must exceed 1; \
-                                 canonical form: `{FORM_LIGHT}`"
-                            )),
-                        );
-                    }
-                    if ambient != Vec3::ZERO {
-                        self.emit(line, StatementKind::AmbientAdd(ambient));
-                    }
-                    if diffuse == Vec3::ZERO {
-                        // A pure ambient term: there is no point light to place.
-                        self.skipped.insert(name);
-                    } else {
-                        let l = light(diffuse, 1.0);
-                        self.emit_named(line, name_at, StatementKind::Light(l));
-                    }
-                }
-            }
+            9 => self.nine_number_light(line, name_at, &numbers),
             8 if !(0.0..=1.0).contains(&nums[3])
                 && nums[4..7].iter().all(|v| (0.0..=1.0).contains(v)) =>
             {
-                // `[pos] <radius> [color] <brightness>`: a spherical light of renderers with
-                // soft shadows. The fourth number cannot be a colour component and the next
-                // three can, so the layout is clear; the radius has no point-light meaning.
-                let l = light(c(4), nums[7] as f32);
-                self.variant(
-                    line,
-                    At::Tok(name_at + 4),
-                    "light-radius",
-                    format!(
-                        "8-number light read as [pos] <radius> [color] <brightness>: a point \
-                         light at its centre, the radius {} is ignored",
-                        nums[3]
-                    ),
-                    format!("read as `{}`", StatementKind::Light(l.clone())),
-                );
-                self.emit_named(line, name_at, StatementKind::Light(l));
+                self.light_with_radius(line, name_at, &numbers);
             }
-            4 => {
-                // No position: the only meaning left is an ambient term, colour × brightness
-                // (`define light ambient1 .3 .2 .6 5`), added like the lecture form's La.
-                let rgb = c(0) * nums[3] as f32;
-                self.warn(
-                    line,
-                    At::Span(name_at + 1, toks.len() - 1),
-                    "a light with 4 numbers has no position: read as ambient light [rgb] <brightness>, \
-                     added to the scene's ambient light",
-                    Some(format!(
-                        "write `{FORM_AMBIENT}` for ambient light, or `{FORM_LIGHT}` for a point light"
-                    )),
-                );
-                self.skipped.insert(name);
-                self.emit(line, StatementKind::AmbientAdd(rgb));
-            }
-            n => {
-                let at = if n > 7 {
-                    At::Span(name_at + 8, toks.len() - 1)
-                } else {
-                    At::End
-                };
-                let mut help = format!(
-                    "canonical form: `{FORM_LIGHT}`; 6 numbers (no brightness), 9 and 10 are also read, \
-                     and 8 as [pos] <radius> [color] <brightness> when the colour lies in 0..1 and the radius does not"
-                );
-                if matches!(n, 1 | 3) {
-                    help.push_str(&format!(
-                        ". An ambient light is written `{FORM_AMBIENT}` or `{FORM_AMBIENT_LIGHT}`"
-                    ));
-                }
-                return Err(self.error(
-                    line,
-                    at,
-                    format!("a light takes 7 numbers ([pos] [color] <brightness>), found {n}"),
-                    Some(help),
-                ));
-            }
+            4 => self.light_without_position(line, name_at, &numbers),
+            n => return Err(self.light_count_error(line, name_at, n)),
         }
         Ok(())
+    }
+
+    /// Ten numbers, `[pos] [La] [Ld] <brightness>`: the lecture's form with a brightness.
+    fn lecture_light_with_brightness(
+        &mut self,
+        line: &Line,
+        name_at: usize,
+        numbers: &LightNumbers,
+    ) {
+        let toks = &line.tokens;
+        let ambient = numbers.color(3);
+        let l = numbers.light(numbers.color(6), numbers.nums[9] as f32);
+        self.variant(
+            line,
+            At::Span(name_at + 4, toks.len() - 1),
+            "ten-number-light",
+            "10-number light read as [pos] [La] [Ld] <brightness>: La is added to the \
+             ambient light, the intensity is Ld × brightness"
+                .to_string(),
+            format!("read as `{}`", StatementKind::Light(l.clone())),
+        );
+        if ambient != Vec3::ZERO {
+            self.emit(line, StatementKind::AmbientAdd(ambient));
+        }
+        self.emit_named(line, name_at, StatementKind::Light(l));
+    }
+
+    /// Nine numbers: [pos] [color] [rgb-brightness] when one of the last three exceeds 1,
+    /// else the lecture's form [pos] [La] [Ld]. Each reading is explained once per file.
+    fn nine_number_light(&mut self, line: &Line, name_at: usize, numbers: &LightNumbers) {
+        let toks = &line.tokens;
+        let last = numbers.color(6);
+        let nums_at = At::Span(name_at + 4, toks.len() - 1);
+        if last.max_element() > 1.0 {
+            let l = numbers.light(numbers.color(3) * last, 1.0);
+            if !self.nine_number_noted[0] {
+                self.nine_number_noted[0] = true;
+                self.warn(
+                    line,
+                    nums_at,
+                    "9-number light read as [pos] [color] [rgb-brightness] (a brightness above 1); \
+                     intensity = color × brightness per channel",
+                    Some(format!("read as `{}`", StatementKind::Light(l.clone()))),
+                );
+            }
+            self.emit_named(line, name_at, StatementKind::Light(l));
+        } else {
+            let ambient = numbers.color(3);
+            let diffuse = last;
+            if !self.nine_number_noted[1] {
+                self.nine_number_noted[1] = true;
+                self.warn(
+                    line,
+                    nums_at,
+                    "9-number light read as the lecture form [pos] [La] [Ld] (no number above 1): \
+                     La is added to the ambient light, Ld is the light's intensity",
+                    Some(format!(
+                        "for a brightness per channel, one of the last three numbers must exceed 1; \
+                         canonical form: `{FORM_LIGHT}`"
+                    )),
+                );
+            }
+            if ambient != Vec3::ZERO {
+                self.emit(line, StatementKind::AmbientAdd(ambient));
+            }
+            if diffuse == Vec3::ZERO {
+                // A pure ambient term: there is no point light to place.
+                self.skipped.insert(numbers.name.to_string());
+            } else {
+                let l = numbers.light(diffuse, 1.0);
+                self.emit_named(line, name_at, StatementKind::Light(l));
+            }
+        }
+    }
+
+    /// `[pos] <radius> [color] <brightness>`: a spherical light of renderers with soft shadows.
+    /// The fourth number cannot be a colour component and the next three can, so the layout
+    /// is clear; the radius has no point-light meaning.
+    fn light_with_radius(&mut self, line: &Line, name_at: usize, numbers: &LightNumbers) {
+        let l = numbers.light(numbers.color(4), numbers.nums[7] as f32);
+        self.variant(
+            line,
+            At::Tok(name_at + 4),
+            "light-radius",
+            format!(
+                "8-number light read as [pos] <radius> [color] <brightness>: a point \
+                 light at its centre, the radius {} is ignored",
+                numbers.nums[3]
+            ),
+            format!("read as `{}`", StatementKind::Light(l.clone())),
+        );
+        self.emit_named(line, name_at, StatementKind::Light(l));
+    }
+
+    /// Four numbers, no position: the only meaning left is an ambient term, colour ×
+    /// brightness (`define light ambient1 .3 .2 .6 5`), added like the lecture form's La.
+    fn light_without_position(&mut self, line: &Line, name_at: usize, numbers: &LightNumbers) {
+        let toks = &line.tokens;
+        let rgb = numbers.color(0) * numbers.nums[3] as f32;
+        self.warn(
+            line,
+            At::Span(name_at + 1, toks.len() - 1),
+            "a light with 4 numbers has no position: read as ambient light [rgb] <brightness>, \
+             added to the scene's ambient light",
+            Some(format!(
+                "write `{FORM_AMBIENT}` for ambient light, or `{FORM_LIGHT}` for a point light"
+            )),
+        );
+        self.skipped.insert(numbers.name.to_string());
+        self.emit(line, StatementKind::AmbientAdd(rgb));
+    }
+
+    /// The error of a light line with `n` numbers, a count no reading takes.
+    fn light_count_error(&mut self, line: &Line, name_at: usize, n: usize) -> Fail {
+        let toks = &line.tokens;
+        let at = if n > 7 {
+            At::Span(name_at + 8, toks.len() - 1)
+        } else {
+            At::End
+        };
+        let mut help = format!(
+            "canonical form: `{FORM_LIGHT}`; 6 numbers (no brightness), 9 and 10 are also read, \
+             and 8 as [pos] <radius> [color] <brightness> when the colour lies in 0..1 and the radius does not"
+        );
+        if matches!(n, 1 | 3) {
+            help.push_str(&format!(
+                ". An ambient light is written `{FORM_AMBIENT}` or `{FORM_AMBIENT_LIGHT}`"
+            ));
+        }
+        self.error(
+            line,
+            at,
+            format!("a light takes 7 numbers ([pos] [color] <brightness>), found {n}"),
+            Some(help),
+        )
     }
 
     /// `ambient [<name>] <s>|[rgb]`, `define ambient [<name>] [rgb] [<k>]`.
