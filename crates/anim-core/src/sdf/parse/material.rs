@@ -1,7 +1,7 @@
 //! `define material`: colours, the Phong exponent, and the extras named by
 //! `--material-fields`.
 
-use super::layout::{default_layout, Slot};
+use super::layout::{default_layout, Layout, Slot};
 use super::{At, Fail, PResult, Parser};
 use crate::limits;
 use crate::sdf::ast::{MaterialDef, StatementKind};
@@ -70,12 +70,30 @@ impl Parser<'_> {
             opacity: 1.0,
             ior: repair::AIR_IOR,
         };
+        let opacity_at = self.material_extras(line, &layout, slots, &nums[9..], &mut def);
+        if let Some(at) = opacity_at.filter(|_| def.opacity == 0.0 && def.ior == 1.0) {
+            self.warn_invisible(line, at, &def);
+        }
+        self.emit_named(line, 2, StatementKind::Material(def));
+        Ok(())
+    }
+
+    /// The numbers after m, `extras` (read by `slots` of `layout`), into `def`: where the
+    /// opacity was set, if it was.
+    fn material_extras(
+        &mut self,
+        line: &Line,
+        layout: &Layout,
+        slots: &[Slot],
+        extras: &[f64],
+        def: &mut MaterialDef,
+    ) -> Option<At> {
         let mut opacity_at = None;
         for (k, &slot) in slots.iter().enumerate() {
-            let value = layout.value(slot, nums[9 + k]);
+            let value = layout.value(slot, extras[k]);
             let at = At::Tok(12 + k);
             match slot {
-                Slot::M => self.phong(line, at, value, &mut def),
+                Slot::M => self.phong(line, at, value, def),
                 Slot::Gloss | Slot::Field(MaterialField::Roughness) => {}
                 Slot::Field(MaterialField::Reflectivity) => {
                     def.reflectivity = self.unit_interval(line, at, "reflectivity", value);
@@ -102,28 +120,29 @@ impl Parser<'_> {
                 },
             }
         }
-        if let Some(at) = opacity_at.filter(|_| def.opacity == 0.0 && def.ior == 1.0) {
-            // Fully transparent without refraction: invisible. Every such material is named
-            // (a file often has several); the hint about the field list is given once.
-            let hint = if self.variants_noted.insert("invisible-material") {
-                "if this file means transparency by this number, load it with \
-                 --material-fields reflectivity,transparency,ior"
-                    .to_string()
-            } else {
-                "see the first invisible material for the field list to try".to_string()
-            };
-            self.warn(
-                line,
-                at,
-                format!(
-                    "material `{}` is invisible: fully transparent (opacity 0) and not refracting (ior 1)",
-                    def.name
-                ),
-                Some(hint),
-            );
-        }
-        self.emit_named(line, 2, StatementKind::Material(def));
-        Ok(())
+        opacity_at
+    }
+
+    /// Warns that material `def` is invisible: fully transparent (by the number at `at`)
+    /// without refraction. Every such material is named (a file often has several); the hint
+    /// about the field list is given once.
+    fn warn_invisible(&mut self, line: &Line, at: At, def: &MaterialDef) {
+        let hint = if self.variants_noted.insert("invisible-material") {
+            "if this file means transparency by this number, load it with \
+             --material-fields reflectivity,transparency,ior"
+                .to_string()
+        } else {
+            "see the first invisible material for the field list to try".to_string()
+        };
+        self.warn(
+            line,
+            at,
+            format!(
+                "material `{}` is invisible: fully transparent (opacity 0) and not refracting (ior 1)",
+                def.name
+            ),
+            Some(hint),
+        );
     }
 
     /// The Phong exponent `m` at `at`, repaired with a warning where it means nothing.
