@@ -75,41 +75,7 @@ impl Parser<'_> {
             } else {
                 At::Span(from, to - 1)
             };
-            let v = |k: usize| DVec3::new(nums[k], nums[k + 1], nums[k + 2]);
-            let op = match (keyword, nums.len()) {
-                ("translate", 3) => Some(TransformOp::Translate(v(0))),
-                ("rotate", 4) if v(1) != DVec3::ZERO => Some(TransformOp::Rotate {
-                    degrees: nums[0],
-                    axis: v(1),
-                }),
-                ("rotate", 4) => {
-                    self.error(line, at, "a rotation needs a non-zero axis", help());
-                    None
-                }
-                ("scale", 1 | 3) => {
-                    let s = if nums.len() == 1 {
-                        DVec3::splat(nums[0])
-                    } else {
-                        v(0)
-                    };
-                    if s.cmpeq(DVec3::ZERO).any() {
-                        self.error(line, at, "a scale of 0 cannot be undone", help());
-                        None
-                    } else {
-                        Some(TransformOp::Scale(s))
-                    }
-                }
-                (k, n) => {
-                    let wanted = match k {
-                        "translate" => "3 numbers",
-                        "rotate" => "4 numbers (degrees, then the axis)",
-                        _ => "1 or 3 numbers",
-                    };
-                    self.error(line, at, format!("`{k}` takes {wanted}, found {n}"), help());
-                    None
-                }
-            };
-            match op {
+            match self.motion_op(line, keyword, &nums, at) {
                 Some(op) => ops.push(op),
                 None => failed = true,
             }
@@ -124,6 +90,52 @@ impl Parser<'_> {
             1,
             StatementKind::Motion(MotionDef { target, at: u, ops }),
         );
+    }
+
+    /// The operation `keyword` of a motion line with its numbers `nums` (at `at`), or `None`
+    /// once its problem is reported.
+    fn motion_op(
+        &mut self,
+        line: &Line,
+        keyword: &str,
+        nums: &[f64],
+        at: At,
+    ) -> Option<TransformOp> {
+        let help = || Some(FORM.to_string());
+        let v = |k: usize| DVec3::new(nums[k], nums[k + 1], nums[k + 2]);
+        match (keyword, nums.len()) {
+            ("translate", 3) => Some(TransformOp::Translate(v(0))),
+            ("rotate", 4) if v(1) != DVec3::ZERO => Some(TransformOp::Rotate {
+                degrees: nums[0],
+                axis: v(1),
+            }),
+            ("rotate", 4) => {
+                self.error(line, at, "a rotation needs a non-zero axis", help());
+                None
+            }
+            ("scale", 1 | 3) => {
+                let s = if nums.len() == 1 {
+                    DVec3::splat(nums[0])
+                } else {
+                    v(0)
+                };
+                if s.cmpeq(DVec3::ZERO).any() {
+                    self.error(line, at, "a scale of 0 cannot be undone", help());
+                    None
+                } else {
+                    Some(TransformOp::Scale(s))
+                }
+            }
+            (k, n) => {
+                let wanted = match k {
+                    "translate" => "3 numbers",
+                    "rotate" => "4 numbers (degrees, then the axis)",
+                    _ => "1 or 3 numbers",
+                };
+                self.error(line, at, format!("`{k}` takes {wanted}, found {n}"), help());
+                None
+            }
+        }
     }
 
     /// Once the whole file is read: every motion names a thing the file defines, and the
