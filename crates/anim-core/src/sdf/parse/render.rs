@@ -5,6 +5,7 @@ use crate::limits::{self, DEFAULT_IMAGE_SIZE};
 
 use crate::sdf::ast::{NameRef, RenderDef, StatementKind};
 use crate::sdf::lexer::{self, looks_numeric, Line};
+use std::ops::Range;
 
 const FORM_RENDER: &str = "render <camera> <file> <width> <height> [<samples>]";
 
@@ -29,6 +30,18 @@ pub(super) struct PendingRender {
     pub(super) notes: Vec<String>,
     /// Whether the line gives the image size.
     pub(super) size_given: bool,
+}
+
+/// The names of a render line, read.
+struct RenderNames {
+    camera: RenderCamera,
+    /// The token naming the camera, or that may (`RenderCamera::Ambiguous`).
+    camera_at: Option<usize>,
+    output: Option<String>,
+    /// Where the output name is written.
+    output_at: At,
+    /// The words after the image size.
+    tail: Range<usize>,
 }
 
 impl Parser<'_> {
@@ -59,60 +72,19 @@ impl Parser<'_> {
         camera_expected: bool,
         variant: Option<&str>,
     ) {
-        let toks = &line.tokens;
         let mut notes: Vec<String> = variant.map(str::to_string).into_iter().collect();
         let names_end = names_end(line, from);
         let nums_end = Self::number_run_end(line, names_end);
-        let mut tail = nums_end..toks.len();
-        let names = from..names_end;
-
-        let mut camera = RenderCamera::Missing;
-        let mut camera_at = None;
-        let mut output: Option<String> = None;
-        let mut output_at = At::Tok(0);
-        let file_pieces = match (camera_expected, names.len()) {
-            (_, 0) => None,
-            (true, 1) => {
-                if tail.len() == 1 && nums_end - names_end >= 2 {
-                    // `render cam 800 600 out.ppm`
-                    notes.push("image size written before the file name".to_string());
-                    camera = RenderCamera::Named;
-                    camera_at = Some(from);
-                    let pieces = tail.clone();
-                    tail = toks.len()..toks.len();
-                    Some(pieces)
-                } else {
-                    camera = RenderCamera::Ambiguous(toks[from].text.to_string());
-                    camera_at = Some(from);
-                    output_at = At::Tok(from);
-                    None
-                }
-            }
-            (true, _) => {
-                camera = RenderCamera::Named;
-                camera_at = Some(from);
-                Some(from + 1..names_end)
-            }
-            (false, _) => Some(names.clone()),
+        let Ok(RenderNames {
+            camera,
+            camera_at,
+            output,
+            output_at,
+            tail,
+        }) = self.render_names(line, from..names_end, nums_end, camera_expected, &mut notes)
+        else {
+            return;
         };
-        if let Some(pieces) = file_pieces {
-            output_at = At::Span(pieces.start, pieces.end.saturating_sub(1).max(pieces.start));
-            match self.file_name(line, pieces.clone()) {
-                Some(name) => output = Some(name),
-                None => {
-                    self.error(
-                        line,
-                        At::Span(from, names_end - 1),
-                        format!(
-                            "expected <camera> <file> before the image size, found {} names",
-                            names.len()
-                        ),
-                        Some(format!("canonical form: `{FORM_RENDER}`")),
-                    );
-                    return;
-                }
-            }
-        }
         let Ok(nums) = self.numbers(line, names_end, nums_end) else {
             return;
         };
@@ -162,6 +134,74 @@ impl Parser<'_> {
             size_given: !nums.is_empty(),
         });
         self.emit(line, StatementKind::Render(def));
+    }
+
+    /// How the names of a render line (tokens `names`, before its numbers, which end at
+    /// `nums_end`) divide into its camera and its file.
+    fn render_names(
+        &mut self,
+        line: &Line,
+        names: Range<usize>,
+        nums_end: usize,
+        camera_expected: bool,
+        notes: &mut Vec<String>,
+    ) -> PResult<RenderNames> {
+        let toks = &line.tokens;
+        let (from, names_end) = (names.start, names.end);
+        let mut tail = nums_end..toks.len();
+        let mut camera = RenderCamera::Missing;
+        let mut camera_at = None;
+        let mut output: Option<String> = None;
+        let mut output_at = At::Tok(0);
+        let file_pieces = match (camera_expected, names.len()) {
+            (_, 0) => None,
+            (true, 1) => {
+                if tail.len() == 1 && nums_end - names_end >= 2 {
+                    // `render cam 800 600 out.ppm`
+                    notes.push("image size written before the file name".to_string());
+                    camera = RenderCamera::Named;
+                    camera_at = Some(from);
+                    let pieces = tail.clone();
+                    tail = toks.len()..toks.len();
+                    Some(pieces)
+                } else {
+                    camera = RenderCamera::Ambiguous(toks[from].text.to_string());
+                    camera_at = Some(from);
+                    output_at = At::Tok(from);
+                    None
+                }
+            }
+            (true, _) => {
+                camera = RenderCamera::Named;
+                camera_at = Some(from);
+                Some(from + 1..names_end)
+            }
+            (false, _) => Some(names.clone()),
+        };
+        if let Some(pieces) = file_pieces {
+            output_at = At::Span(pieces.start, pieces.end.saturating_sub(1).max(pieces.start));
+            match self.file_name(line, pieces.clone()) {
+                Some(name) => output = Some(name),
+                None => {
+                    return Err(self.error(
+                        line,
+                        At::Span(from, names_end - 1),
+                        format!(
+                            "expected <camera> <file> before the image size, found {} names",
+                            names.len()
+                        ),
+                        Some(format!("canonical form: `{FORM_RENDER}`")),
+                    ));
+                }
+            }
+        }
+        Ok(RenderNames {
+            camera,
+            camera_at,
+            output,
+            output_at,
+            tail,
+        })
     }
 
     /// The image size from the numbers `nums` starting at token `at`; the default (with a
