@@ -2,10 +2,10 @@
 //! to skipped definitions pruned.
 
 use super::render::RenderCamera;
-use super::Parser;
+use super::{Anchor, Parser};
 use crate::diag::{Diagnostic, Loc, Severity};
 use crate::limits;
-use crate::sdf::ast::{CameraDef, NameRef, Statement, StatementKind};
+use crate::sdf::ast::{CameraDef, NameRef, RenderDef, Statement, StatementKind};
 use crate::sdf::lexer;
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
@@ -120,20 +120,7 @@ impl Parser<'_> {
         let mut need_default_camera = false;
         let mut rejected = Vec::new();
         let mut outputs: HashMap<String, u32> = HashMap::new();
-        let defined_cameras: HashSet<&str> = self
-            .statements
-            .iter()
-            .filter_map(|s| match &s.kind {
-                StatementKind::Camera(c) => Some(c.name.as_str()),
-                _ => None,
-            })
-            .collect();
-        let rejected_cameras: HashSet<String> = self
-            .camera_errors
-            .iter()
-            .map(|(name, _)| name.clone())
-            .filter(|name| !defined_cameras.contains(name.as_str()))
-            .collect();
+        let rejected_cameras = self.rejected_cameras();
         let mut skipped_renders: HashMap<String, Vec<u32>> = HashMap::new();
         for pending in std::mem::take(&mut self.pending) {
             let mut notes = pending.notes;
@@ -147,56 +134,15 @@ impl Parser<'_> {
             let mut camera_missing = false;
             match pending.camera {
                 RenderCamera::Named if self.camera_names.contains(&def.camera.name) => {}
-                RenderCamera::Named => match self.camera_names.as_slice() {
-                    // One camera: the line can only mean it (a renamed or misspelt camera).
-                    [only] => {
-                        let help = match crate::diag::suggest(&def.camera.name, [only.as_str()]) {
-                            Some(s) => format!("did you mean `{s}`?"),
-                            None => format!("write `render {only} ...`"),
-                        };
-                        let d = Diagnostic::new(
-                            Severity::Warning,
-                            def.camera.loc.clone(),
-                            format!(
-                                "unknown camera `{}`: the file's only camera `{only}` is used",
-                                def.camera.name
-                            ),
-                        )
-                        .with_source(
-                            pending.anchor.text.clone(),
-                            def.camera.name.chars().count() as u32,
-                        )
-                        .with_help(help);
-                        self.diagnostics.push(d);
-                        def.camera.name = only.clone();
-                    }
-                    cameras => {
-                        let help = match crate::diag::suggest(
-                            &def.camera.name,
-                            cameras.iter().map(String::as_str),
-                        ) {
-                            Some(s) => format!("did you mean `{s}`?"),
-                            None if cameras.is_empty() => {
-                                "the file defines no camera: add `define camera <name> <fov-x>`"
-                                    .to_string()
-                            }
-                            None => format!("cameras of this file: {}", cameras.join(", ")),
-                        };
-                        let d = Diagnostic::new(
-                            Severity::Error,
-                            def.camera.loc.clone(),
-                            format!("unknown camera `{}`", def.camera.name),
-                        )
-                        .with_source(
-                            pending.anchor.text.clone(),
-                            def.camera.name.chars().count() as u32,
-                        )
-                        .with_help(help);
+                RenderCamera::Named => {
+                    let d = unknown_camera(def, &self.camera_names, &pending.anchor);
+                    if d.is_error() {
                         self.render_errors.push(d);
                         rejected.push(pending.index);
                         continue;
                     }
-                },
+                    self.diagnostics.push(d);
+                }
                 RenderCamera::Ambiguous(word) => {
                     if self.camera_names.contains(&word) {
                         def.camera.name = word;
@@ -207,23 +153,8 @@ impl Parser<'_> {
                 }
                 RenderCamera::Missing => camera_missing = true,
             }
-            if camera_missing {
-                match &first_camera {
-                    Some(c) => {
-                        def.camera.name = c.clone();
-                        notes.push(format!(
-                            "no camera named: the file's first camera `{c}` is used"
-                        ));
-                    }
-                    None => {
-                        def.camera.name = "default".to_string();
-                        need_default_camera = true;
-                        notes.push(format!(
-                            "no camera named and none defined: a default camera (fov {}) is used",
-                            limits::DEFAULT_FOV_DEG
-                        ));
-                    }
-                }
+            if camera_missing && !take_first_camera(def, first_camera.as_deref(), &mut notes) {
+                need_default_camera = true;
             }
             if rejected_cameras.contains(&def.camera.name) {
                 // Its camera's problem is reported once, on the camera's line.
@@ -235,64 +166,19 @@ impl Parser<'_> {
                 continue;
             }
             if !pending.size_given {
-                match self.camera_sizes.get(&def.camera.name) {
-                    Some(&(w, h)) => {
-                        (def.width, def.height) = (w, h);
-                        notes.push(format!(
-                            "no image size given: {w}×{h} from the camera's line is used"
-                        ));
-                    }
-                    None => {
-                        notes.push(format!("no image size given: {}×{}", def.width, def.height))
-                    }
-                }
+                settle_size(def, &self.camera_sizes, &mut notes);
             }
-            if def.output.is_empty() {
-                def.output = default_output.clone();
-                if !pending.output_given {
-                    notes.push(format!(
-                        "no output file named: `{default_output}` is written"
-                    ));
-                }
-            }
-            if let Some(image) = image_name(&def.output) {
-                // The renderers these files were written for save PPM whatever the name
-                // says; a name without an image extension (or the scene's own) means that.
-                notes.push(format!(
-                    "`{}` is no image file name: `{image}` is written",
-                    def.output
-                ));
-                def.output = image;
-            }
+            settle_output(def, pending.output_given, &default_output, &mut notes);
             let output = def.output.clone();
             let canonical = StatementKind::Render(def.clone()).to_string();
             if is_scene_file(self.path, &output) {
                 rejected.push(pending.index);
-                let anchor = pending.output_anchor;
-                let d = Diagnostic::new(
-                    Severity::Error,
-                    anchor.loc,
-                    format!("the render output `{output}` is this scene file itself"),
-                )
-                .with_source(anchor.text, anchor.width)
-                .with_help("name an image file such as image.png");
-                self.render_errors.push(d);
+                self.render_errors
+                    .push(output_is_scene_file(&output, pending.output_anchor));
                 continue;
             }
-            match outputs.get(&output) {
-                Some(&first) => {
-                    let anchor = pending.output_anchor.clone();
-                    self.report(
-                        Severity::Warning,
-                        anchor,
-                        format!("render line {first} also writes `{output}`: this image replaces it"),
-                        Some("give each render line its own file name, e.g. frame001.png, frame002.png".to_string()),
-                    );
-                }
-                None => {
-                    outputs.insert(output.clone(), pending.anchor.loc.line);
-                }
-            }
+            let line = pending.anchor.loc.line;
+            self.warn_repeated_output(&mut outputs, output, &pending.output_anchor, line);
             if !notes.is_empty() {
                 self.report(
                     Severity::Warning,
@@ -308,20 +194,194 @@ impl Parser<'_> {
         }
         self.settle_render_errors(&skipped_renders);
         if need_default_camera {
-            let loc = Loc {
-                file: self.file.clone(),
-                line: 1,
-                col: 1,
-            };
-            self.statements.insert(
-                0,
-                Statement::new(
-                    StatementKind::Camera(CameraDef::at_origin("default", limits::DEFAULT_FOV_DEG)),
-                    loc,
-                ),
-            );
+            self.insert_default_camera();
         }
     }
+
+    /// Cameras whose lines were all rejected: no statement defines them.
+    fn rejected_cameras(&self) -> HashSet<String> {
+        let defined_cameras: HashSet<&str> = self
+            .statements
+            .iter()
+            .filter_map(|s| match &s.kind {
+                StatementKind::Camera(c) => Some(c.name.as_str()),
+                _ => None,
+            })
+            .collect();
+        self.camera_errors
+            .iter()
+            .map(|(name, _)| name.clone())
+            .filter(|name| !defined_cameras.contains(name.as_str()))
+            .collect()
+    }
+
+    /// Warns when the render line on `line` writes `output` (named at `output_anchor`), which
+    /// an earlier one writes too (`outputs`: output → the first line writing it).
+    fn warn_repeated_output(
+        &mut self,
+        outputs: &mut HashMap<String, u32>,
+        output: String,
+        output_anchor: &Anchor,
+        line: u32,
+    ) {
+        match outputs.get(&output) {
+            Some(&first) => {
+                self.report(
+                    Severity::Warning,
+                    output_anchor.clone(),
+                    format!("render line {first} also writes `{output}`: this image replaces it"),
+                    Some(
+                        "give each render line its own file name, e.g. frame001.png, frame002.png"
+                            .to_string(),
+                    ),
+                );
+            }
+            None => {
+                outputs.insert(output, line);
+            }
+        }
+    }
+
+    /// Puts the default camera, which a render line takes when the file defines none, first.
+    fn insert_default_camera(&mut self) {
+        let loc = Loc {
+            file: self.file.clone(),
+            line: 1,
+            col: 1,
+        };
+        self.statements.insert(
+            0,
+            Statement::new(
+                StatementKind::Camera(CameraDef::at_origin("default", limits::DEFAULT_FOV_DEG)),
+                loc,
+            ),
+        );
+    }
+}
+
+/// The diagnostic of a render line naming `def.camera`, which the file (with `cameras`)
+/// does not define: with one camera, a warning and the line takes it (a renamed or misspelt
+/// camera); otherwise an error. The line is quoted from `anchor`.
+fn unknown_camera(def: &mut RenderDef, cameras: &[String], anchor: &Anchor) -> Diagnostic {
+    match cameras {
+        [only] => {
+            let help = match crate::diag::suggest(&def.camera.name, [only.as_str()]) {
+                Some(s) => format!("did you mean `{s}`?"),
+                None => format!("write `render {only} ...`"),
+            };
+            let d = Diagnostic::new(
+                Severity::Warning,
+                def.camera.loc.clone(),
+                format!(
+                    "unknown camera `{}`: the file's only camera `{only}` is used",
+                    def.camera.name
+                ),
+            )
+            .with_source(anchor.text.clone(), def.camera.name.chars().count() as u32)
+            .with_help(help);
+            def.camera.name = only.clone();
+            d
+        }
+        cameras => {
+            let help =
+                match crate::diag::suggest(&def.camera.name, cameras.iter().map(String::as_str)) {
+                    Some(s) => format!("did you mean `{s}`?"),
+                    None if cameras.is_empty() => {
+                        "the file defines no camera: add `define camera <name> <fov-x>`".to_string()
+                    }
+                    None => format!("cameras of this file: {}", cameras.join(", ")),
+                };
+            Diagnostic::new(
+                Severity::Error,
+                def.camera.loc.clone(),
+                format!("unknown camera `{}`", def.camera.name),
+            )
+            .with_source(anchor.text.clone(), def.camera.name.chars().count() as u32)
+            .with_help(help)
+        }
+    }
+}
+
+/// Gives a render line that names no camera the file's first, `first_camera`; false when
+/// the file defines none, and the line takes the default camera.
+fn take_first_camera(
+    def: &mut RenderDef,
+    first_camera: Option<&str>,
+    notes: &mut Vec<String>,
+) -> bool {
+    match first_camera {
+        Some(c) => {
+            def.camera.name = c.to_string();
+            notes.push(format!(
+                "no camera named: the file's first camera `{c}` is used"
+            ));
+            true
+        }
+        None => {
+            def.camera.name = "default".to_string();
+            notes.push(format!(
+                "no camera named and none defined: a default camera (fov {}) is used",
+                limits::DEFAULT_FOV_DEG
+            ));
+            false
+        }
+    }
+}
+
+/// The image size of a render line that gives none: the one its camera's line gives
+/// (`camera_sizes`), else the default size `def` holds.
+fn settle_size(
+    def: &mut RenderDef,
+    camera_sizes: &HashMap<String, (u32, u32)>,
+    notes: &mut Vec<String>,
+) {
+    match camera_sizes.get(&def.camera.name) {
+        Some(&(w, h)) => {
+            (def.width, def.height) = (w, h);
+            notes.push(format!(
+                "no image size given: {w}×{h} from the camera's line is used"
+            ));
+        }
+        None => notes.push(format!("no image size given: {}×{}", def.width, def.height)),
+    }
+}
+
+/// The output of a render line: `default_output` when it names none (`output_given` false,
+/// or its only name was taken as the file), and an image file name when its name is none.
+fn settle_output(
+    def: &mut RenderDef,
+    output_given: bool,
+    default_output: &str,
+    notes: &mut Vec<String>,
+) {
+    if def.output.is_empty() {
+        def.output = default_output.to_string();
+        if !output_given {
+            notes.push(format!(
+                "no output file named: `{default_output}` is written"
+            ));
+        }
+    }
+    if let Some(image) = image_name(&def.output) {
+        // The renderers these files were written for save PPM whatever the name says; a name
+        // without an image extension (or the scene's own) means that.
+        notes.push(format!(
+            "`{}` is no image file name: `{image}` is written",
+            def.output
+        ));
+        def.output = image;
+    }
+}
+
+/// The error of a render line whose output, written at `anchor`, is the scene file itself.
+fn output_is_scene_file(output: &str, anchor: Anchor) -> Diagnostic {
+    Diagnostic::new(
+        Severity::Error,
+        anchor.loc,
+        format!("the render output `{output}` is this scene file itself"),
+    )
+    .with_source(anchor.text, anchor.width)
+    .with_help("name an image file such as image.png")
 }
 
 impl Parser<'_> {
