@@ -220,17 +220,7 @@ fn mutate_once(rng: &mut Rng, input: &mut Vec<u8>, other: &[u8]) {
                 b'.', b'e', b'/',
             ]);
         }
-        // Insert a line (from this input or the other seed).
-        2 => {
-            let source = if rng.below(2) == 0 { &input[..] } else { other };
-            let lines = lines_of(source);
-            if lines.is_empty() {
-                return;
-            }
-            let line = rng.pick(&lines).to_vec();
-            let at = line_start(input, rng);
-            input.splice(at..at, line);
-        }
+        2 => insert_line(rng, input, other),
         // Delete a line.
         3 => {
             let ranges = line_ranges(input);
@@ -239,22 +229,7 @@ fn mutate_once(rng: &mut Rng, input: &mut Vec<u8>, other: &[u8]) {
                 input.drain(a..b);
             }
         }
-        // Duplicate a line, a few or many times.
-        4 => {
-            let ranges = line_ranges(input);
-            if !ranges.is_empty() {
-                let (a, b) = *rng.pick(&ranges);
-                let line = input[a..b].to_vec();
-                let times = if rng.below(8) == 0 {
-                    1 + rng.below(200)
-                } else {
-                    1
-                };
-                for _ in 0..times {
-                    input.splice(b..b, line.iter().copied());
-                }
-            }
-        }
+        4 => duplicate_line(rng, input),
         // Replace a token by one of the other seed.
         5 => {
             let mine = token_ranges(input);
@@ -266,21 +241,7 @@ fn mutate_once(rng: &mut Rng, input: &mut Vec<u8>, other: &[u8]) {
             let (c, d) = *rng.pick(&theirs);
             input.splice(a..b, other[c..d].iter().copied());
         }
-        // Replace a number by an extreme.
-        6 | 7 => {
-            let numbers: Vec<(usize, usize)> = token_ranges(input)
-                .into_iter()
-                .filter(|&(a, _)| {
-                    let c = input[a];
-                    c.is_ascii_digit() || c == b'-' || c == b'.' || c == b'+'
-                })
-                .collect();
-            if numbers.is_empty() {
-                return;
-            }
-            let (a, b) = *rng.pick(&numbers);
-            input.splice(a..b, rng.pick(EXTREMES).bytes());
-        }
+        6 | 7 => replace_number(rng, input),
         // Insert a word.
         8 => {
             let at = rng.below(input.len() + 1);
@@ -310,6 +271,51 @@ fn mutate_once(rng: &mut Rng, input: &mut Vec<u8>, other: &[u8]) {
             }
         }
     }
+}
+
+/// Inserts a line, from `input` or from `other`, at the start of a line of `input`.
+fn insert_line(rng: &mut Rng, input: &mut Vec<u8>, other: &[u8]) {
+    let source = if rng.below(2) == 0 { &input[..] } else { other };
+    let lines = lines_of(source);
+    if lines.is_empty() {
+        return;
+    }
+    let line = rng.pick(&lines).to_vec();
+    let at = line_start(input, rng);
+    input.splice(at..at, line);
+}
+
+/// Repeats a line of `input` after itself, a few or many times.
+fn duplicate_line(rng: &mut Rng, input: &mut Vec<u8>) {
+    let ranges = line_ranges(input);
+    if !ranges.is_empty() {
+        let (a, b) = *rng.pick(&ranges);
+        let line = input[a..b].to_vec();
+        let times = if rng.below(8) == 0 {
+            1 + rng.below(200)
+        } else {
+            1
+        };
+        for _ in 0..times {
+            input.splice(b..b, line.iter().copied());
+        }
+    }
+}
+
+/// Replaces a number of `input` by an extreme one.
+fn replace_number(rng: &mut Rng, input: &mut Vec<u8>) {
+    let numbers: Vec<(usize, usize)> = token_ranges(input)
+        .into_iter()
+        .filter(|&(a, _)| {
+            let c = input[a];
+            c.is_ascii_digit() || c == b'-' || c == b'.' || c == b'+'
+        })
+        .collect();
+    if numbers.is_empty() {
+        return;
+    }
+    let (a, b) = *rng.pick(&numbers);
+    input.splice(a..b, rng.pick(EXTREMES).bytes());
 }
 
 fn line_ranges(bytes: &[u8]) -> Vec<(usize, usize)> {
@@ -465,8 +471,9 @@ struct Report {
     elapsed: Duration,
 }
 
-fn run(settings: &Settings) -> Report {
-    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+/// The SDF and spec seeds (the corpus's and the repository's scenes and specs), announced with
+/// the run's settings.
+fn seeds(settings: &Settings, repo: &Path) -> (Seeds, Seeds) {
     let sdf_seeds = read_seeds(
         &[
             settings.corpus.clone(),
@@ -494,7 +501,12 @@ fn run(settings: &Settings) -> Report {
         settings.execs,
         settings.timeout
     );
-    let base = Arc::new(base_scene(repo));
+    (sdf_seeds, spec_seeds)
+}
+
+/// The message of the last panic, kept by a panic hook (until `panic::take_hook`) for the
+/// worker to report.
+fn record_panics() -> Arc<Mutex<String>> {
     let last_panic = Arc::new(Mutex::new(String::new()));
     {
         let last_panic = last_panic.clone();
@@ -504,6 +516,31 @@ fn run(settings: &Settings) -> Report {
             }
         }));
     }
+    last_panic
+}
+
+/// The next input: a seed of the target chosen, mutated a few times with another seed.
+fn next_input(rng: &mut Rng, sdf_seeds: &Seeds, spec_seeds: &Seeds) -> (Target, Vec<u8>) {
+    // Four in five inputs are scenes: the SDF reader has far more paths than the spec's.
+    let (target, seeds) = if rng.below(5) == 0 {
+        (Target::Spec, spec_seeds)
+    } else {
+        (Target::Sdf, sdf_seeds)
+    };
+    let mut input = rng.pick(&seeds.files).clone();
+    let other = rng.pick(&seeds.files);
+    for _ in 0..1 + rng.below(4) {
+        mutate_once(rng, &mut input, other);
+    }
+    input.truncate(MAX_INPUT);
+    (target, input)
+}
+
+fn run(settings: &Settings) -> Report {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let (sdf_seeds, spec_seeds) = seeds(settings, repo);
+    let base = Arc::new(base_scene(repo));
+    let last_panic = record_panics();
     let mut worker = spawn_worker(base.clone(), last_panic.clone());
     let mut rng = Rng(settings.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1);
     let start = Instant::now();
@@ -511,18 +548,7 @@ fn run(settings: &Settings) -> Report {
     let mut slowest = (Duration::ZERO, 0u64);
     let report_every = (settings.execs / 20).max(1);
     for exec in 0..settings.execs {
-        // Four in five inputs are scenes: the SDF reader has far more paths than the spec's.
-        let (target, seeds) = if rng.below(5) == 0 {
-            (Target::Spec, &spec_seeds)
-        } else {
-            (Target::Sdf, &sdf_seeds)
-        };
-        let mut input = rng.pick(&seeds.files).clone();
-        let other = rng.pick(&seeds.files);
-        for _ in 0..1 + rng.below(4) {
-            mutate_once(&mut rng, &mut input, other);
-        }
-        input.truncate(MAX_INPUT);
+        let (target, input) = next_input(&mut rng, &sdf_seeds, &spec_seeds);
         let variant = rng.next();
         let began = Instant::now();
         worker
