@@ -372,64 +372,88 @@ fn reference_hit(g: &Geometry, o: DVec3, d: DVec3) -> Option<(f64, DVec3)> {
             }
         }
         Geometry::Cylinder { p1, p2, radius } => {
-            let h = (p2 - p1).length();
-            let w = (p2 - p1) / h;
-            let oc = o - p1;
-            let (oz, dz) = (oc.dot(w), d.dot(w));
-            let a = d.dot(d) - dz * dz;
-            let b = 2.0 * (oc.dot(d) - oz * dz);
-            let c = oc.dot(oc) - oz * oz - radius * radius;
-            if a > 0.0 {
-                for t in roots(a, b, c).into_iter().flatten() {
-                    let z = oz + t * dz;
-                    if (0.0..=h).contains(&z) {
-                        let q = oc + d * t;
-                        offer(t, (q - w * z).normalize());
-                    }
-                }
-            }
-            if dz != 0.0 {
-                for (zc, n) in [(0.0, -w), (h, w)] {
-                    let t = (zc - oz) / dz;
-                    let q = oc + d * t;
-                    if q.dot(q) - zc * zc <= radius * radius {
-                        offer(t, n);
-                    }
-                }
-            }
+            cylinder_crossings(p1, p2, radius, o, d, &mut offer)
         }
-        Geometry::Cone { base, tip, radius } => {
-            // With P = o − tip: on the side, |P|² = (1 + k²)·z², z = P·w, 0 ≤ z ≤ h.
-            let h = (base - tip).length();
-            let w = (base - tip) / h;
-            let k = radius / h;
-            let m = 1.0 + k * k;
-            let oc = o - tip;
-            let (oz, dz) = (oc.dot(w), d.dot(w));
-            let a = d.dot(d) - m * dz * dz;
-            let b = 2.0 * (oc.dot(d) - m * oz * dz);
-            let c = oc.dot(oc) - m * oz * oz;
-            for t in roots(a, b, c).into_iter().flatten() {
-                let q = oc + d * t;
-                let z = q.dot(w);
-                if (0.0..=h).contains(&z) {
-                    // Gradient of |P|² − m z²: 2P − 2m z w.
-                    offer(t, (q - w * (m * z)).normalize_or_zero());
-                }
-            }
-            if dz != 0.0 {
-                let t = (h - oz) / dz;
-                let q = oc + d * t;
-                if q.dot(q) - h * h <= radius * radius {
-                    offer(t, w);
-                }
-            }
-        }
+        Geometry::Cone { base, tip, radius } => cone_crossings(base, tip, radius, o, d, &mut offer),
         Geometry::Plane { .. } | Geometry::Triangle { .. } | Geometry::Mesh(_) => {
             unreachable!("not closed (or not made here)")
         }
     }
     best
+}
+
+/// Offers each crossing of the ray `o + t·d` with the closed cylinder of `radius` about
+/// `p1 → p2` to `offer`: (t, outward normal).
+fn cylinder_crossings(
+    p1: DVec3,
+    p2: DVec3,
+    radius: f64,
+    o: DVec3,
+    d: DVec3,
+    offer: &mut impl FnMut(f64, DVec3),
+) {
+    let h = (p2 - p1).length();
+    let w = (p2 - p1) / h;
+    let oc = o - p1;
+    let (oz, dz) = (oc.dot(w), d.dot(w));
+    let a = d.dot(d) - dz * dz;
+    let b = 2.0 * (oc.dot(d) - oz * dz);
+    let c = oc.dot(oc) - oz * oz - radius * radius;
+    if a > 0.0 {
+        for t in roots(a, b, c).into_iter().flatten() {
+            let z = oz + t * dz;
+            if (0.0..=h).contains(&z) {
+                let q = oc + d * t;
+                offer(t, (q - w * z).normalize());
+            }
+        }
+    }
+    if dz != 0.0 {
+        for (zc, n) in [(0.0, -w), (h, w)] {
+            let t = (zc - oz) / dz;
+            let q = oc + d * t;
+            if q.dot(q) - zc * zc <= radius * radius {
+                offer(t, n);
+            }
+        }
+    }
+}
+
+/// Offers each crossing of the ray `o + t·d` with the closed cone of `radius` at `base` and
+/// apex `tip` to `offer`: (t, outward normal).
+fn cone_crossings(
+    base: DVec3,
+    tip: DVec3,
+    radius: f64,
+    o: DVec3,
+    d: DVec3,
+    offer: &mut impl FnMut(f64, DVec3),
+) {
+    // With P = o − tip: on the side, |P|² = (1 + k²)·z², z = P·w, 0 ≤ z ≤ h.
+    let h = (base - tip).length();
+    let w = (base - tip) / h;
+    let k = radius / h;
+    let m = 1.0 + k * k;
+    let oc = o - tip;
+    let (oz, dz) = (oc.dot(w), d.dot(w));
+    let a = d.dot(d) - m * dz * dz;
+    let b = 2.0 * (oc.dot(d) - m * oz * dz);
+    let c = oc.dot(oc) - m * oz * oz;
+    for t in roots(a, b, c).into_iter().flatten() {
+        let q = oc + d * t;
+        let z = q.dot(w);
+        if (0.0..=h).contains(&z) {
+            // Gradient of |P|² − m z²: 2P − 2m z w.
+            offer(t, (q - w * (m * z)).normalize_or_zero());
+        }
+    }
+    if dz != 0.0 {
+        let t = (h - oz) / dz;
+        let q = oc + d * t;
+        if q.dot(q) - h * h <= radius * radius {
+            offer(t, w);
+        }
+    }
 }
 
 // ------------------------------------------------------------------------------------------
