@@ -75,20 +75,9 @@ fn uv_sphere(segments: usize, rings: usize) -> Mesh {
     }
 }
 
-/// Fires rays at every vertex, every edge mid-point and random points along every edge of
-/// `mesh` placed by `xf`, each from outside and heading into the solid (towards a random
-/// interior point), and requires the nearest hit among the triangles around that feature to
-/// be at the aimed point. A ray slipping through would instead hit the far side or nothing.
-/// Returns the number of rays.
-fn check_watertight(
-    name: &str,
-    mesh: &Mesh,
-    interior_radius: f64,
-    xf: &Transform,
-    rng: &mut Rng,
-) -> usize {
-    let prims: Vec<Primitive> = mesh
-        .triangles
+/// The triangles of `mesh` placed by `xf`, as the renderer holds them.
+fn placed_triangles(mesh: &Mesh, xf: &Transform) -> Vec<Primitive> {
+    mesh.triangles
         .iter()
         .map(|t| {
             Primitive::new(
@@ -100,13 +89,14 @@ fn check_watertight(
             )
             .expect("mesh triangles are not degenerate")
         })
-        .collect();
-    // The vertices exactly as the baked triangles hold them.
-    let baked: Vec<DVec3> = mesh
-        .vertices
-        .iter()
-        .map(|&v| v32(xf.point(v)).as_dvec3())
-        .collect();
+        .collect()
+}
+
+/// An edge of a mesh, its ends in ascending order, with the triangles around it.
+type Edge = ((usize, usize), Vec<usize>);
+
+/// The triangles around each vertex of `mesh`, and its edges, sorted.
+fn triangles_around(mesh: &Mesh) -> (Vec<Vec<usize>>, Vec<Edge>) {
     let mut around_vertex: Vec<Vec<usize>> = vec![Vec::new(); mesh.vertices.len()];
     let mut around_edge: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
     for (ti, t) in mesh.triangles.iter().enumerate() {
@@ -121,6 +111,29 @@ fn check_watertight(
     }
     let mut edges: Vec<_> = around_edge.into_iter().collect();
     edges.sort();
+    (around_vertex, edges)
+}
+
+/// Fires rays at every vertex, every edge mid-point and random points along every edge of
+/// `mesh` placed by `xf`, each from outside and heading into the solid (towards a random
+/// interior point), and requires the nearest hit among the triangles around that feature to
+/// be at the aimed point. A ray slipping through would instead hit the far side or nothing.
+/// Returns the number of rays.
+fn check_watertight(
+    name: &str,
+    mesh: &Mesh,
+    interior_radius: f64,
+    xf: &Transform,
+    rng: &mut Rng,
+) -> usize {
+    let prims = placed_triangles(mesh, xf);
+    // The vertices exactly as the baked triangles hold them.
+    let baked: Vec<DVec3> = mesh
+        .vertices
+        .iter()
+        .map(|&v| v32(xf.point(v)).as_dvec3())
+        .collect();
+    let (around_vertex, edges) = triangles_around(mesh);
 
     let mut targets: Vec<(DVec3, &[usize], String)> = Vec::new();
     for (v, tris) in around_vertex.iter().enumerate() {
@@ -266,24 +279,7 @@ fn quadric_apex_and_rims_are_watertight() {
                 xf: &pl.xf,
                 size: obj.min_dim * pl.s_min,
             };
-            let (ends, radius, apex) = match obj.geometry {
-                Geometry::Cone { base, tip, radius } => (vec![base], radius, Some(tip)),
-                Geometry::Cylinder { p1, p2, radius } => (vec![p1, p2], radius, None),
-                _ => unreachable!(),
-            };
-            let w = match obj.geometry {
-                Geometry::Cone { base, tip, .. } => (tip - base).normalize(),
-                Geometry::Cylinder { p1, p2, .. } => (p2 - p1).normalize(),
-                _ => unreachable!(),
-            };
-            let (u, v) = w.any_orthonormal_pair();
-            let mut targets: Vec<DVec3> = apex.into_iter().collect();
-            for end in &ends {
-                for _ in 0..8 {
-                    let phi = rng.range(0.0, TAU);
-                    targets.push(*end + (u * phi.cos() + v * phi.sin()) * radius);
-                }
-            }
+            let (apex, targets) = apex_and_rim_points(&obj, &mut rng);
             for target in targets {
                 for _ in 0..16 {
                     let t_w = pl.xf.point(target);
@@ -349,4 +345,28 @@ fn quadric_apex_and_rims_are_watertight() {
         );
     }
     assert!(spawned.rays > 300_000 && spawned_object_space.rays > 300_000);
+}
+
+/// The apex of `obj` (a cone's) and the points to aim at on it (object space): the apex and
+/// eight points at random angles around each rim.
+fn apex_and_rim_points(obj: &Object, rng: &mut Rng) -> (Option<DVec3>, Vec<DVec3>) {
+    let (ends, radius, apex) = match obj.geometry {
+        Geometry::Cone { base, tip, radius } => (vec![base], radius, Some(tip)),
+        Geometry::Cylinder { p1, p2, radius } => (vec![p1, p2], radius, None),
+        _ => unreachable!(),
+    };
+    let w = match obj.geometry {
+        Geometry::Cone { base, tip, .. } => (tip - base).normalize(),
+        Geometry::Cylinder { p1, p2, .. } => (p2 - p1).normalize(),
+        _ => unreachable!(),
+    };
+    let (u, v) = w.any_orthonormal_pair();
+    let mut targets: Vec<DVec3> = apex.into_iter().collect();
+    for end in &ends {
+        for _ in 0..8 {
+            let phi = rng.range(0.0, TAU);
+            targets.push(*end + (u * phi.cos() + v * phi.sin()) * radius);
+        }
+    }
+    (apex, targets)
 }
