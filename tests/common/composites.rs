@@ -136,69 +136,7 @@ pub fn mixed(seed: u64) -> Tree {
     let mut t = Tree::default();
     let mut part = Vec::new();
     for k in 0..20 {
-        let m = format!("m{}", k % 6);
-        let (x, y, z) = (r.num(0.0, 10.0), r.num(0.0, 10.0), r.num(0.0, 10.0));
-        let (line, ops): (String, Vec<String>) = match k % 7 {
-            0 => (
-                format!(
-                    "box {x} {y} {z} {} {} {} {m}",
-                    r.num(10.5, 12.0),
-                    r.num(10.5, 12.0),
-                    r.num(10.5, 12.0)
-                ),
-                vec![format!("rotate {} 0 1 0.3", r.num(5.0, 60.0))],
-            ),
-            1 => (
-                format!(
-                    "triangle {x} {y} {z} {} {} {} {} {} {} {m}",
-                    r.num(0.0, 10.0),
-                    r.num(0.0, 10.0),
-                    r.num(0.0, 10.0),
-                    r.num(0.0, 10.0),
-                    r.num(0.0, 10.0),
-                    r.num(0.0, 10.0)
-                ),
-                Vec::new(),
-            ),
-            2 => (
-                format!(
-                    "cylinder {x} {y} {z} {} {} {} {} {m}",
-                    r.num(0.0, 10.0),
-                    r.num(0.0, 10.0),
-                    r.num(0.0, 10.0),
-                    r.num(0.3, 1.0)
-                ),
-                Vec::new(),
-            ),
-            3 => (
-                format!("sphere 0 0 0 {} {m}", r.num(0.5, 1.5)),
-                vec![
-                    "scale 2 0.6 1".to_string(),
-                    format!("translate {x} {y} {z}"),
-                ],
-            ),
-            4 => (
-                format!(
-                    "cone {x} {y} {z} {} {} {} {} {m}",
-                    r.num(0.0, 10.0),
-                    r.num(0.0, 10.0),
-                    r.num(0.0, 10.0),
-                    r.num(0.3, 1.5)
-                ),
-                Vec::new(),
-            ),
-            5 => (
-                format!("sphere {x} {y} {z} {} {m}", r.num(0.3, 1.2)),
-                vec![
-                    "scale 1.5 1.5 1.5".to_string(),
-                    "translate 0.5 -1 0.25".to_string(),
-                ],
-            ),
-            _ => (
-                format!("sphere {x} {y} {z} {} {m}", r.num(0.3, 1.5)),
-                Vec::new(),
-            ),
-        };
+        let (line, ops) = part_shape(&mut r, k);
         part.push(t.shape(&format!("s{k}"), line, &ops));
     }
     let part = t.composite("part", &part, &[]);
@@ -268,4 +206,72 @@ pub fn mixed(seed: u64) -> Tree {
     uses.push(t.shape("loose", "sphere 3 3 -25 2 m4".to_string(), &[]));
     t.composite("root", &uses, &[]);
     t
+}
+
+/// The line (`<kind> <numbers…> <material>`) and transform operations of shape `k` of
+/// `mixed`'s part: each kind of shape in turn, some moved.
+fn part_shape(r: &mut Lcg, k: usize) -> (String, Vec<String>) {
+    let m = format!("m{}", k % 6);
+    let (x, y, z) = (r.num(0.0, 10.0), r.num(0.0, 10.0), r.num(0.0, 10.0));
+    match k % 7 {
+        0 => (
+            format!(
+                "box {x} {y} {z} {} {} {} {m}",
+                r.num(10.5, 12.0),
+                r.num(10.5, 12.0),
+                r.num(10.5, 12.0)
+            ),
+            vec![format!("rotate {} 0 1 0.3", r.num(5.0, 60.0))],
+        ),
+        1 => (
+            format!(
+                "triangle {x} {y} {z} {} {} {} {} {} {} {m}",
+                r.num(0.0, 10.0),
+                r.num(0.0, 10.0),
+                r.num(0.0, 10.0),
+                r.num(0.0, 10.0),
+                r.num(0.0, 10.0),
+                r.num(0.0, 10.0)
+            ),
+            Vec::new(),
+        ),
+        2 => (
+            format!(
+                "cylinder {x} {y} {z} {} {} {} {} {m}",
+                r.num(0.0, 10.0),
+                r.num(0.0, 10.0),
+                r.num(0.0, 10.0),
+                r.num(0.3, 1.0)
+            ),
+            Vec::new(),
+        ),
+        3 => (
+            format!("sphere 0 0 0 {} {m}", r.num(0.5, 1.5)),
+            vec![
+                "scale 2 0.6 1".to_string(),
+                format!("translate {x} {y} {z}"),
+            ],
+        ),
+        4 => (
+            format!(
+                "cone {x} {y} {z} {} {} {} {} {m}",
+                r.num(0.0, 10.0),
+                r.num(0.0, 10.0),
+                r.num(0.0, 10.0),
+                r.num(0.3, 1.5)
+            ),
+            Vec::new(),
+        ),
+        5 => (
+            format!("sphere {x} {y} {z} {} {m}", r.num(0.3, 1.2)),
+            vec![
+                "scale 1.5 1.5 1.5".to_string(),
+                "translate 0.5 -1 0.25".to_string(),
+            ],
+        ),
+        _ => (
+            format!("sphere {x} {y} {z} {} {m}", r.num(0.3, 1.5)),
+            Vec::new(),
+        ),
+    }
 }
