@@ -1,8 +1,8 @@
 //! The architecture, checked: crates depend one way (Cargo enforces it: the `anim` command
 //! → {anim-pipeline, anim-bench} → anim-core), imports inside each crate run one way through
 //! its layers below, no two files import each other (directly or round a loop), only the
-//! command layer knows the command line and prints, and no source file grows past what one
-//! reader can hold.
+//! command layer knows the command line and prints, and no source file, nor function, grows
+//! past what one reader can hold.
 //!
 //! The layers of each crate, top to bottom (a module may import only modules of lower layers
 //! of its own crate):
@@ -375,4 +375,79 @@ fn no_source_file_is_longer_than_a_reader_can_hold() {
         })
         .collect();
     assert!(long.is_empty(), "{}", long.join("\n"));
+}
+/// Most lines of one function, its signature and closing brace included: what can be read
+/// as one piece.
+const MAX_FUNCTION_LINES: usize = 100;
+
+/// The functions of `text` (formatted by rustfmt, so a body closes at its `fn`'s indentation)
+/// longer than [`MAX_FUNCTION_LINES`]: name, first line, length.
+fn long_functions(text: &str) -> Vec<(String, usize, usize)> {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut long = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let code = line.trim_start();
+        let indent = &line[..line.len() - code.len()];
+        let after_fn = [
+            "fn ",
+            "pub fn ",
+            "pub(crate) fn ",
+            "pub(super) fn ",
+            "const fn ",
+        ]
+        .iter()
+        .chain(&["pub const fn ", "pub(crate) const fn "])
+        .find_map(|p| code.strip_prefix(p));
+        let Some(rest) = after_fn else { continue };
+        let name: String = rest
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect();
+        // A declaration without a body (in a trait) ends with `;` before any `{`.
+        let Some(open) = (i..lines.len()).find(|&j| {
+            let l = lines[j].trim_end();
+            l.ends_with('{') || l.ends_with(';')
+        }) else {
+            continue;
+        };
+        if lines[open].trim_end().ends_with(';') {
+            continue;
+        }
+        let close = format!("{indent}}}");
+        if let Some(end) = (open..lines.len())
+            .find(|&j| lines[j] == close || lines[j].trim_end().ends_with('}') && j == open)
+        {
+            let n = end - i + 1;
+            if n > MAX_FUNCTION_LINES {
+                long.push((name, i + 1, n));
+            }
+        }
+    }
+    long
+}
+
+#[test]
+fn no_function_is_longer_than_a_reader_can_hold() {
+    let mut long = Vec::new();
+    for f in workspace_files() {
+        let text = std::fs::read_to_string(&f).unwrap();
+        for (name, line, n) in long_functions(&text) {
+            long.push(format!("{}:{line}: fn {name} has {n} lines", f.display()));
+        }
+    }
+    assert!(long.is_empty(), "{}", long.join("\n"));
+}
+
+#[test]
+fn the_function_length_check_measures_what_it_claims() {
+    let body = "    let x = 1;\n".repeat(MAX_FUNCTION_LINES - 2);
+    let exact = format!("fn fits() {{\n{body}}}\n");
+    assert!(long_functions(&exact).is_empty());
+    let over = format!("    pub fn grown(\n        a: u32,\n    ) -> u32 {{\n{body}    }}\n");
+    assert_eq!(
+        long_functions(&over),
+        vec![("grown".to_string(), 1, MAX_FUNCTION_LINES + 2)]
+    );
+    let declared = "    fn declared(&self) -> u32;\n}\n";
+    assert!(long_functions(declared).is_empty());
 }

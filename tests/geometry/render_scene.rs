@@ -167,6 +167,36 @@ fn brute_in_tree_order(prims: &[Primitive], ray: &Ray, t_limit: f32) -> Option<(
     best
 }
 
+/// The instanced scene expands to the flattened one's shapes, with bit-identical world
+/// transforms, in the same order.
+fn assert_same_shapes(instanced: &Scene, flat: &Scene) {
+    assert!(instanced.has_prototypes() && !flat.has_prototypes());
+    assert!(instanced.instances.len() < flat.instances.len() / 2);
+    let expanded = instanced.flattened();
+    assert_eq!(expanded.len(), flat.instances.len());
+    assert_eq!(instanced.shape_count(), flat.instances.len() as u64);
+    for ((inst, xf), f) in expanded.iter().zip(flat.instances.iter()) {
+        assert_eq!((&inst.geometry, inst.material), (&f.geometry, f.material));
+        assert_eq!(xf, flat.transform_of(f));
+    }
+}
+
+/// The any-hit answers of both scenes for a ray that brute force finds `blocked` or not: the
+/// same answer, and an occluder that the ray does hit.
+fn check_any_hit(scenes: [&Compiled; 2], ray: &Ray, t_limit: f32, blocked: bool, what: &str) {
+    for s in scenes {
+        assert_eq!(s.occluded(ray, t_limit), blocked, "{what}");
+        let occluder = s.occluder(ray, t_limit);
+        assert_eq!(occluder.is_some(), blocked, "{what}");
+        if let Some(id) = occluder {
+            assert!(s.hit(id, ray, t_limit).is_some(), "{what}");
+        }
+    }
+    let a = scenes[0];
+    let any = a.any_candidate(ray, t_limit, |id| a.hit(id, ray, t_limit).is_some());
+    assert_eq!(any, blocked, "{what}");
+}
+
 /// Instancing differential: a scene with shared and nested-shared composites, transforms and
 /// exact ties, loaded as written (instanced) and with every use copied (flattened), must give
 /// the same closest hits to the bit (distance, point, normal, material, the same winner of
@@ -178,16 +208,7 @@ fn instanced_render_scene_equals_flattened_and_brute_force() {
         let tree = composites::mixed(seed);
         let instanced = loaded_scene(&format!("{}{}", composites::MATERIALS, tree.shared()));
         let flat = loaded_scene(&format!("{}{}", composites::MATERIALS, tree.flattened()));
-        assert!(instanced.has_prototypes() && !flat.has_prototypes());
-        assert!(instanced.instances.len() < flat.instances.len() / 2);
-        // The same shapes with bit-identical world transforms, in the same order.
-        let expanded = instanced.flattened();
-        assert_eq!(expanded.len(), flat.instances.len());
-        assert_eq!(instanced.shape_count(), flat.instances.len() as u64);
-        for ((inst, xf), f) in expanded.iter().zip(flat.instances.iter()) {
-            assert_eq!((&inst.geometry, inst.material), (&f.geometry, f.material));
-            assert_eq!(xf, flat.transform_of(f));
-        }
+        assert_same_shapes(&instanced, &flat);
         let prims: Vec<Primitive> = flat
             .instances
             .iter()
@@ -250,18 +271,8 @@ fn instanced_render_scene_equals_flattened_and_brute_force() {
                 let again = a.intersect(ida, &ray, t_limit).unwrap();
                 assert_eq!(again.t.to_bits(), t.to_bits());
             }
-            let blocked = brute.is_some();
-            assert_eq!(a.occluded(&ray, t_limit), blocked, "seed {seed} ray {i}");
-            assert_eq!(b.occluded(&ray, t_limit), blocked, "seed {seed} ray {i}");
-            for s in [&a, &b] {
-                let occluder = s.occluder(&ray, t_limit);
-                assert_eq!(occluder.is_some(), blocked, "seed {seed} ray {i}");
-                if let Some(id) = occluder {
-                    assert!(s.hit(id, &ray, t_limit).is_some(), "seed {seed} ray {i}");
-                }
-            }
-            let any = a.any_candidate(&ray, t_limit, |id| a.hit(id, &ray, t_limit).is_some());
-            assert_eq!(any, blocked, "seed {seed} ray {i}");
+            let what = format!("seed {seed} ray {i}");
+            check_any_hit([&a, &b], &ray, t_limit, brute.is_some(), &what);
         }
         let (lo, size) = (DVec3::new(-50.0, -30.0, -20.0), DVec3::splat(100.0));
         for s in [&a, &b] {
