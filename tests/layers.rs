@@ -451,3 +451,73 @@ fn the_function_length_check_measures_what_it_claims() {
     let declared = "    fn declared(&self) -> u32;\n}\n";
     assert!(long_functions(declared).is_empty());
 }
+
+/// Whether a comment line quotes a measurement of speed: an instruction count, or a
+/// percentage or ratio of time or cost. Such figures go stale silently where they sit; they
+/// live in BENCHMARKS.md and its history, which comments may cite.
+fn quotes_a_speed(comment: &str) -> bool {
+    let lower = comment.to_lowercase();
+    let chars: Vec<char> = lower.chars().collect();
+    // Numbers standing alone (not the digits of `i32` or `x86`), and what follows each.
+    let mut numbers = Vec::new();
+    let mut i = 0;
+    while i < chars.len() {
+        let starts = chars[i].is_ascii_digit()
+            && (i == 0 || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_'));
+        if !starts {
+            i += 1;
+            continue;
+        }
+        while i < chars.len() && (chars[i].is_ascii_digit() || chars[i] == '.') {
+            i += 1;
+        }
+        numbers.push(chars[i..].iter().collect::<String>());
+    }
+    // A share (`5 %`) or a ratio (`0.97×`, not a size like `4×4` or `3 × f32`).
+    let ratio = numbers.iter().any(|rest| {
+        rest.trim_start().starts_with('%')
+            || (rest.starts_with('×')
+                && !rest['×'.len_utf8()..].starts_with(|c: char| c.is_ascii_digit()))
+    });
+    let speed_words = ["instruction", "cpu", "faster", "slower", "cost", "time"];
+    let speaks_of_speed = speed_words.iter().any(|w| lower.contains(w));
+    (lower.contains("instruction") && !numbers.is_empty()) || (speaks_of_speed && ratio)
+}
+
+#[test]
+fn no_comment_quotes_a_measurement_of_speed() {
+    let mut quoted = Vec::new();
+    for (src, _) in CRATES {
+        let mut files = Vec::new();
+        rust_files(&root().join(src), &mut files);
+        for f in files {
+            let text = std::fs::read_to_string(&f).unwrap();
+            for (n, line) in text.lines().enumerate() {
+                let Some(at) = line.find("//") else { continue };
+                if quotes_a_speed(&line[at..]) {
+                    quoted.push(format!("{}:{}: {}", f.display(), n + 1, line.trim()));
+                }
+            }
+        }
+    }
+    assert!(quoted.is_empty(), "{}", quoted.join("\n"));
+}
+
+#[test]
+fn the_measurement_check_tells_a_speed_from_a_size() {
+    assert!(quotes_a_speed("// costs 5 % of the render"));
+    assert!(quotes_a_speed("/// about 90 instructions per camera ray"));
+    assert!(quotes_a_speed("// 1.06× main's CPU time in turns"));
+    assert!(!quotes_a_speed(
+        "/// half-way between keys 90° apart to 71 % of its size"
+    ));
+    assert!(!quotes_a_speed(
+        "// one conversion instruction where `usize` takes several"
+    ));
+    assert!(!quotes_a_speed(
+        "/// 4×4 walks the tree once for twice the rays, at little cost"
+    ));
+    assert!(!quotes_a_speed(
+        "/// Bytes an image costs per pixel: radiance (3 × f32)"
+    ));
+}

@@ -11,11 +11,10 @@ pub const IMAGE_SIDE: RangeInclusive<u32> = 1..=65536;
 pub const SAMPLES: RangeInclusive<u32> = 1..=4096;
 
 /// Adaptive sampling (the default when neither `--spp` nor the render line gives a count):
-/// target error per refined pixel, in 8-bit levels, when `--error` is not given. Chosen by
-/// measurement (scripts/adaptive-measure.sh, 640×360, against 256-spp uniform renders):
-/// whole-image RMSE 0.24 on scenes/bench/mirror-glass.sdf and 0.498 on scenes/showcase.sdf,
-/// at 1.9 and 3.1 samples per pixel. The per-pixel target is far above the RMSE because only
-/// pixels on edges carry any error at all. Lower it for cleaner edges.
+/// target error per refined pixel, in 8-bit levels, when `--error` is not given, chosen by
+/// measuring error against time (`scripts/bench/adaptive.sh`; BENCHMARKS.md, "Time against
+/// error"). The per-pixel target is far above the image's RMSE because only pixels on edges
+/// carry any error at all. Lower it for cleaner edges.
 pub const DEFAULT_ERROR: f32 = 2.0;
 
 /// Most samples one pixel may take when `--max-spp` is not given. Measured: 64 bought no
@@ -106,8 +105,8 @@ pub fn image_extensions_list() -> String {
 /// shapes would need more than the memory budget (`--max-memory`, else
 /// [`default_memory_budget`]) is refused before it is built: a composite tree that multiplies
 /// out of all proportion (each level listing the one below twice) is refused from its counts,
-/// and a flat file from its size. Measured with scripts/bench-scale.sh (peak RSS of
-/// `anim render --spp 1` on 10^6 spheres: 361 B a sphere, BENCHMARKS.md "Scale"), rounded up.
+/// and a flat file from its size: the peak resident memory a sphere takes in a render
+/// (`scripts/bench/scale.sh`; BENCHMARKS.md, "Scale"), rounded up.
 /// A file whose shapes are read as statements (one with a transform or a composite) holds
 /// about 300 bytes more per shape statement while it is built.
 pub const SCENE_BYTES_PER_SHAPE: u64 = 384;
@@ -146,9 +145,8 @@ pub const INSTANCE_MIN_SHAPES: u64 = 16;
 /// Composites are instanced only when the flattened tree would take more than this share
 /// (1/64) of the memory budget (`--max-memory`): instancing trades work per ray (entering a
 /// use, placing its shapes) for memory, which is worth it only when memory is at stake.
-/// Measured (BENCHMARKS.md §13): a chain of composites doubling 16 times, 65 536 spheres,
-/// renders 9× slower instanced (with 1/65 of the memory), while 1000 uses of a 1000-sphere
-/// composite render faster instanced than flattened (with 1/26 of the memory).
+/// A deep chain of composites renders many times slower instanced than flattened, while many
+/// uses of a large composite render faster instanced (BENCHMARKS.md, "Instancing").
 pub const INSTANCE_BUDGET_SHARE: u64 = 64;
 
 /// Shapes the flattened tree of an instanced scene may number: each is still told apart by a

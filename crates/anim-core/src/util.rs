@@ -107,8 +107,8 @@ impl Fnv64 {
 
 /// A fast deterministic hasher for the reader's and the scene builder's tables of names
 /// (the multiply-rotate hash of rustc's `FxHasher`): keys come from one file, not from an
-/// adversary probing collisions, and std's SipHash took an eighth of loading a flat file of a
-/// million shapes (BENCHMARKS.md §10).
+/// adversary probing collisions, and std's SipHash is a noticeable share of loading a flat
+/// file of a million shapes (docs/benchmarks-history.md §10).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct FastHasher(u64);
 

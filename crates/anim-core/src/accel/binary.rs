@@ -12,9 +12,8 @@ const TRAVERSAL_COST: f32 = 0.5;
 /// Nodes of at least this many primitives choose their split from a sample of about
 /// `SAMPLED_ITEMS` of them, one from each run of their order (`sample`): binning is most of a
 /// large build, and a thousand centroids place a split among 16 bins about as well as all
-/// of them. Measured (BENCHMARKS.md §10.1): a million spheres' setup 5.7 % fewer
-/// instructions and their render unchanged to 0.2 %; at 2048/512 the bunny's render took
-/// 0.3 % more.
+/// of them; below a few thousand, the sample would place splits worse than the full bins
+/// (docs/benchmarks-history.md §10.1).
 const SAMPLED_MIN: usize = 4096;
 const SAMPLED_ITEMS: usize = 1024;
 /// Deepest level of the binary tree (the root is level 0); deeper nodes become leaves. The
@@ -228,8 +227,8 @@ fn sample(len: usize, stride: usize) -> impl Iterator<Item = usize> {
 
 /// The bin of a centroid `x` bin widths from the lowest: `(x as usize).min(BINS - 1)` for
 /// every float (NaN and negatives to bin 0, large ones to the last), without that
-/// float-to-u64 conversion, which with an array map was a fifth of a 100k-sphere build's
-/// instructions.
+/// float-to-u64 conversion and its saturating range checks, which the build's innermost
+/// loop pays for every item.
 #[inline(always)]
 fn bin(x: f32) -> usize {
     (x as i32).clamp(0, BINS as i32 - 1) as usize

@@ -14,8 +14,8 @@ use crate::math::Aabb;
 use glam::Vec3A;
 
 /// Cells per side of each cube face: 32 × 32 × 6 = 6 144 cells a point, about 100 KiB with
-/// their lists. Against 16 a side, the rooms of BENCHMARKS.md §4.6 take 0.9–6.6 % fewer
-/// instructions (shorter lists), and 0.97× the CPU time in turns.
+/// their lists. Finer cells see fewer primitives each, so their lists are shorter
+/// (docs/benchmarks-history.md §4.6).
 const SIDE: usize = 32;
 
 /// Widening of every primitive's footprint on a face, in face coordinates (which run from −1

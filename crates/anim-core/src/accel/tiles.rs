@@ -30,8 +30,8 @@ const ENTRIES_PER_PRIMITIVE: usize = 8;
 const ENTRIES_PER_TILE: usize = 16;
 /// Lists are padded to a multiple of this many entries, so that they are tested four at once.
 const GROUP: usize = 4;
-/// Tiles of an image around a light, per primitive. Against 2, grid10k and random1k at
-/// 1280×720 take 1.7 % and 3 % fewer instructions (shorter lists); 16 gains nothing more.
+/// Tiles of an image around a light, per primitive: finer tiles list fewer primitives each,
+/// up to where more tiles stop shortening the lists (docs/benchmarks-history.md §9.8).
 const TILES_PER_PRIMITIVE: usize = 8;
 /// Most pixels along a side of an image around a light (1 MiB of tile starts).
 const AROUND_SIDE_MAX: usize = 2048;
@@ -213,8 +213,8 @@ impl Rect {
 /// Sorts `keys` by their upper halves, keeping the order of keys whose upper halves are
 /// equal: a least-significant-digit radix sort, 11 bits a pass. The tiles' keys are a
 /// distance's bits above a primitive's number, pushed in order of number, so this is their
-/// order as whole numbers; on random100k's keys it takes half the instructions of a
-/// comparison sort (BENCHMARKS.md §9.11).
+/// order as whole numbers, in linear time where a comparison sort takes n log n
+/// (docs/benchmarks-history.md §9.11).
 fn sort_by_upper_half(keys: &mut Vec<u64>) {
     const DIGIT_BITS: u32 = 11;
     const DIGITS: usize = 1 << DIGIT_BITS;

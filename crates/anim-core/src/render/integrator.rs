@@ -32,7 +32,7 @@ const CLEAR_RUN_SKIP: u8 = 8;
 /// alternate (a packet of camera rays crossing gaps between spheres), the blocker of two
 /// rays ago is often the next one's too. So it is tried until a few clear rays in a row.
 /// Rays that cross only glass neither count nor break the run: making them break it cost
-/// the glass scenes 0.4–0.9 % more instructions (BENCHMARKS.md §9.7).
+/// the glass scenes more than it saved (docs/benchmarks-history.md §9.7).
 #[derive(Clone, Copy, Debug)]
 struct LastShadows {
     blocker: u32,

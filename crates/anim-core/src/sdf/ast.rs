@@ -64,8 +64,8 @@ const FLAT_CHUNK: usize = 1 << 14;
 
 /// The primitive shape statements of a file read from text, when nothing in the file refers
 /// to a shape by name (no composite, no transform, no mesh), kept compactly instead of as
-/// [`Statement`]s: a flat file of a million spheres is held in about 120 bytes a sphere
-/// (BENCHMARKS.md §10). Each shape keeps what the scene builder can point at: where its
+/// [`Statement`]s, so that a flat file of a million shapes loads in little memory
+/// (BENCHMARKS.md, "Scale"). Each shape keeps what the scene builder can point at: where its
 /// statement, name and material are written.
 #[derive(Debug, Default)]
 pub struct FlatShapes {

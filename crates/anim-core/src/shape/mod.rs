@@ -103,8 +103,8 @@ impl Shape {
 
     /// The faces a kept hit lies on or near, for lifting rays spawned from it off all of them
     /// (`crate::render::geometry::Primitive::surface`). Only the kept hit asks, once.
-    // Always inlined: with a second caller of `surface` (moving shapes) it was not, and the
-    // call cost still frames 0.7 % more instructions.
+    // Always inlined: with a second caller of `surface` (moving shapes) it was not, and every
+    // kept hit paid for the call.
     #[inline(always)]
     pub fn faces_near(&self, hit: &ShapeHit) -> NearFaces {
         match self {

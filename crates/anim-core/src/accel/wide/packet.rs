@@ -53,8 +53,7 @@ impl<const N: usize> Packet<N> {
     /// visited in different orders, and the single-ray walk is the one to take.
     ///
     /// Built four rays at a time, transposed into lanes (`1/d` is `Vec3A::recip`'s division
-    /// lane by lane, so the same floats): gathering them ray by ray and axis by axis cost
-    /// about 90 instructions per camera ray.
+    /// lane by lane, so the same floats), rather than gathered ray by ray and axis by axis.
     pub fn new(rays: &[Ray; N]) -> Option<Packet<N>> {
         let mut origin = [[0.0f32; N]; 3];
         let mut inv_dir = [[0.0f32; N]; 3];

@@ -231,7 +231,7 @@ impl<'f> FirstPass<'f> {
     /// What the samples added to pixel (x, y) know of the lights: those that every shadow ray
     /// of the centres around it saw fully, taken as visible where their camera rays hit. A
     /// shadow edge inside the pixel that none of the nine centres' trees met is lost, as the
-    /// flat test loses a sliver between centres (BENCHMARKS.md, "Known-clear lights").
+    /// flat test loses a sliver between centres (docs/benchmarks-history.md §4.4).
     pub fn prior(&self, x: usize, y: usize) -> PixelPrior {
         let (w, h) = self.frame.size;
         let mut seen = 0;

@@ -14,7 +14,8 @@ use glam::Vec3A;
 /// A packet of the uniform path: `BLOCK_W × BLOCK_H` pixels, one sample position each.
 /// The uniform path hands out work a row of packets at a time (`BLOCK_H` rows).
 /// 4×4 walks the tree once for twice the rays of 4×2 at little more cost per node; wider
-/// blocks saved less, and cost the scenes of scattered spheres (BENCHMARKS.md).
+/// blocks saved less, and cost the scenes of scattered spheres (docs/benchmarks-history.md
+/// §9.6).
 pub(super) const BLOCK_W: u32 = 4;
 pub const BLOCK_H: u32 = 4;
 pub(super) const BLOCK: usize = (BLOCK_W * BLOCK_H) as usize;

@@ -19,20 +19,21 @@ pub const MIN_SAMPLES: u32 = 4;
 /// Fewest samples of a pixel that motion touches. Its instants are stratified, one in each
 /// 1/n of the exposure, so n samples all miss only what covers the pixel for less than about
 /// 1/n of it: at 4, a moving shadow's blurred end went unseen often enough to leave the
-/// blurred frames of animations/blur.ron at 0.92–0.98 levels RMS from the mean of 16
-/// instants; at 8, 0.54–0.59; at 8 with pass 3 of `render_adaptive` (which looks in the
-/// neighbours for what 8 still miss), 0.41–0.48 (BENCHMARKS.md §14.2).
+/// blurred frames of animations/blur.ron visibly off the mean of many instants, and 8 with
+/// the adaptive sampler's third pass (which looks in the neighbours for what 8 still miss)
+/// brings them within half a level (docs/benchmarks-history.md §14.2).
 pub const MOTION_MIN_SAMPLES: u32 = 8;
 
 /// Largest contrast (8-bit levels) between a pixel's centre sample and its 8 neighbours'
 /// for the pixel to be flat and keep its centre sample, if all nine hit the same surface.
 /// Smooth shading changes by about a level from pixel to pixel; a shadow or highlight edge,
-/// or an edge in a reflection, by more. Measured: 3 gave a higher RMSE for the same time.
+/// or an edge in a reflection, by more; a looser bound gave a higher error for the same time
+/// (docs/benchmarks-history.md §4).
 pub const FLAT_CONTRAST: f32 = 2.0;
 
 /// Share of the neighbourhood contrast taken as the error a few samples leave on an edge
-/// pixel, for [`min_samples`]. Measured: 0.25 took 5% more samples on the showcase for an
-/// RMSE of 0.483 instead of 0.50; 0.2 is what keeps it within a third of uniform 16 spp.
+/// pixel, for [`min_samples`]: a larger share buys little error for its samples, a smaller
+/// one misses thin features (docs/benchmarks-history.md §4).
 const EDGE_ERROR_SHARE: f32 = 0.2;
 
 pub use crate::render::film::{tone, tone3};
