@@ -28,28 +28,22 @@ use anim_core::shape::Shape;
 use glam::Vec3A;
 use rayon::prelude::*;
 
-/// Names of the primitive kinds, in the order of [`RehitCount::by_kind`].
-pub const KINDS: [&str; 6] = ["sphere", "box", "plane", "triangle", "cylinder", "cone"];
-
-/// The index in [`KINDS`] of a primitive's shape (`None`: a packed world-space sphere), or
-/// `None` for a mesh, which is not judged: it is neither convex nor one flat face, so leaving
-/// one of its triangles a ray may rightly meet another.
+/// The kind of a primitive's shape (`None`: a packed world-space sphere), as an index of
+/// `Shape::KINDS`; `None` for a kind that is not judged: one neither convex nor one flat
+/// face (a mesh), which a ray leaving one of its faces may rightly meet again.
 fn kind_index(shape: Option<&Shape>) -> Option<usize> {
-    Some(match shape {
-        None | Some(Shape::Sphere(_)) => 0,
-        Some(Shape::Box(_)) => 1,
-        Some(Shape::Plane(_)) => 2,
-        Some(Shape::Triangle(_)) => 3,
-        Some(Shape::Cylinder(_)) => 4,
-        Some(Shape::Cone(_)) => 5,
-        Some(Shape::Mesh(_)) => return None,
-    })
+    match shape {
+        // A packed sphere: `Shape::KINDS` lists spheres first.
+        None => Some(0),
+        Some(s) if s.is_convex() || s.is_flat() => Some(s.kind_index()),
+        Some(_) => None,
+    }
 }
 
-/// Spawned rays and re-hits, per primitive kind (indices of [`KINDS`]).
+/// Spawned rays and re-hits, per primitive kind (indices of `Shape::KINDS`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RehitCount {
-    pub by_kind: [(u64, u64); 6],
+    pub by_kind: [(u64, u64); Shape::KINDS.len()],
 }
 
 impl RehitCount {
@@ -114,7 +108,7 @@ impl Walk<'_> {
             return;
         };
         let outward = normal.dot(dir) >= 0.0;
-        let flat = matches!(shape, Some(Shape::Plane(_) | Shape::Triangle(_)));
+        let flat = shape.is_some_and(Shape::is_flat);
         if flat || outward || again.normal.dot(dir) < 0.0 {
             out.by_kind[kind].1 += 1;
         }

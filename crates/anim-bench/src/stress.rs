@@ -9,12 +9,13 @@
 //! positions and the camera's eye, direction and up are mapped. The renderer then compiles it
 //! to f32 as it does any scene, so every numerical path of a real file is exercised.
 
-use super::rehit::{self, RehitCount, KINDS};
+use super::rehit::{self, RehitCount};
 use super::report::write_text;
 use super::{load_scenes, render_measured, BenchConfig, BenchScene};
 use anim_core::math::Transform;
 use anim_core::render::RenderSettings;
 use anim_core::scene::RenderJob;
+use anim_core::shape::Shape;
 use glam::DVec3;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -265,7 +266,7 @@ pub fn markdown(report: &StressReport) -> String {
         );
     }
     out.push_str("\nSpawned rays and re-hits per primitive kind, all rows together:\n\n| primitive | spawned | re-hits |\n|---|---:|---:|\n");
-    for (name, (spawned, rehits)) in KINDS.iter().zip(report.kinds.by_kind.iter()) {
+    for (name, (spawned, rehits)) in Shape::KINDS.iter().zip(report.kinds.by_kind.iter()) {
         let _ = writeln!(out, "| {name} | {spawned} | {rehits} |");
     }
     out

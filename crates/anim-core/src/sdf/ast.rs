@@ -546,26 +546,13 @@ impl fmt::Display for StatementKind {
                 geometry,
                 material,
             } => {
-                let body = match geometry {
-                    Geometry::Sphere { center, radius } => {
-                        format!("sphere {name} {} {}", v3(*center), Num(*radius))
+                let body = match (geometry, geometry.numbers()) {
+                    (_, Some((kind, nums))) => {
+                        let nums: Vec<String> = nums.iter().map(|n| Num(*n).to_string()).collect();
+                        format!("{kind} {name} {}", nums.join(" "))
                     }
-                    Geometry::Box { p1, p2 } => format!("box {name} {} {}", v3(*p1), v3(*p2)),
-                    Geometry::Plane { point, normal } => {
-                        format!("plane {name} {} {}", v3(*point), v3(*normal))
-                    }
-                    Geometry::Triangle {
-                        vertices: [a, b, c],
-                    } => {
-                        format!("triangle {name} {} {} {}", v3(*a), v3(*b), v3(*c))
-                    }
-                    Geometry::Cylinder { p1, p2, radius } => {
-                        format!("cylinder {name} {} {} {}", v3(*p1), v3(*p2), Num(*radius))
-                    }
-                    Geometry::Cone { base, tip, radius } => {
-                        format!("cone {name} {} {} {}", v3(*base), v3(*tip), Num(*radius))
-                    }
-                    Geometry::Mesh(m) => format!("obj {name} {}", m.file),
+                    (Geometry::Mesh(m), None) => format!("obj {name} {}", m.file),
+                    (_, None) => unreachable!("every primitive but a mesh has numbers"),
                 };
                 write!(f, "define shape {body} {}", material.name)
             }

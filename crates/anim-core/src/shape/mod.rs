@@ -21,7 +21,7 @@ mod triangle;
 pub use aabox::{AaBox, BoxRay, Slabs4};
 pub use cone::Cone;
 pub use cylinder::Cylinder;
-pub use geometry::{degeneracy, Geometry};
+pub use geometry::{degeneracy, Degenerate, Geometry};
 pub use mesh::{Mesh, MeshFile};
 pub use plane::Plane;
 pub use sphere::{Sphere, SphereRay};
@@ -122,6 +122,37 @@ impl Shape {
             Shape::Cone(c) => c.apex_escape_near(point, step),
             _ => None,
         }
+    }
+
+    /// The names of the kinds of shape, in the order of [`Shape::kind_index`].
+    pub const KINDS: [&'static str; 7] = [
+        "sphere", "box", "plane", "triangle", "cylinder", "cone", "mesh",
+    ];
+
+    /// This shape's place in [`Shape::KINDS`].
+    pub fn kind_index(&self) -> usize {
+        match self {
+            Shape::Sphere(_) => 0,
+            Shape::Box(_) => 1,
+            Shape::Plane(_) => 2,
+            Shape::Triangle(_) => 3,
+            Shape::Cylinder(_) => 4,
+            Shape::Cone(_) => 5,
+            Shape::Mesh(_) => 6,
+        }
+    }
+
+    /// Whether the shape is convex: a ray leaving it outwards never meets it again.
+    pub fn is_convex(&self) -> bool {
+        matches!(
+            self,
+            Shape::Sphere(_) | Shape::Box(_) | Shape::Cylinder(_) | Shape::Cone(_)
+        )
+    }
+
+    /// Whether the shape is one flat face: a ray leaving it never meets it again.
+    pub fn is_flat(&self) -> bool {
+        matches!(self, Shape::Plane(_) | Shape::Triangle(_))
     }
 
     /// Whether the shape encloses a solid, which a camera can be inside: planes, triangles

@@ -179,17 +179,17 @@ impl Bounds {
     /// Object-space bounds, loose for cylinders and cones (a sphere around each end); an
     /// infinite plane counts as its anchor point.
     fn of_geometry(g: &Geometry) -> Bounds {
+        if let Some((points, radius)) = g.span() {
+            return Bounds::around(&points, radius);
+        }
         match g {
-            Geometry::Sphere { center, radius } => Bounds::around(&[*center], *radius),
-            Geometry::Box { p1, p2 } => Bounds::around(&[*p1, *p2], 0.0),
             Geometry::Plane { point, .. } => Bounds::point(*point),
-            Geometry::Triangle { vertices } => Bounds::around(vertices, 0.0),
-            Geometry::Cylinder { p1, p2, radius } => Bounds::around(&[*p1, *p2], *radius),
-            Geometry::Cone { base, tip, radius } => Bounds::around(&[*base, *tip], *radius),
             Geometry::Mesh(m) => m.mesh().map_or(Bounds::point(DVec3::ZERO), |m| {
                 let b = m.bounds();
                 Bounds::around(&[b.min.as_dvec3(), b.max.as_dvec3()], 0.0)
             }),
+            // Every other primitive has a span.
+            _ => Bounds::point(DVec3::ZERO),
         }
     }
 

@@ -4,9 +4,9 @@
 use crate::math::{
     gamma, relative_offset, spawn_origin_lifted, Aabb, Lift, Ray, Transform, UNIT_ROUNDOFF,
 };
-use crate::shape::Geometry;
-use crate::shape::{AaBox, Cone, Cylinder, NearFaces, Plane, Shape, ShapeHit, Sphere, Triangle};
-use glam::{Affine3A, DMat3, DVec3, Mat3A, Vec3A};
+pub use crate::shape::Degenerate;
+use crate::shape::{AaBox, Geometry, NearFaces, Shape, ShapeHit, Sphere};
+use glam::{Affine3A, DVec3, Mat3A, Vec3A};
 
 /// The kept hit of a closest-hit query, in world space.
 #[derive(Clone, Copy, Debug)]
@@ -265,36 +265,8 @@ pub struct Primitive {
     pub bounds: Aabb,
 }
 
-/// Why a geometry cannot become a primitive (degenerate input); the reader reports these
-/// before the renderer ever sees them, so here they only guard against misuse.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Degenerate;
-
 fn f(v: DVec3) -> Vec3A {
     v.as_vec3().into()
-}
-
-/// Whether `m` is a rotation times a uniform scale (keeps spheres spheres, circles circles).
-fn similarity_scale(m: DMat3) -> Option<f64> {
-    let gram = m.transpose() * m;
-    let s2 = gram.x_axis.x;
-    let tol = 1e-9 * s2;
-    let uniform = (gram.y_axis.y - s2).abs() <= tol
-        && (gram.z_axis.z - s2).abs() <= tol
-        && gram.x_axis.y.abs() <= tol
-        && gram.x_axis.z.abs() <= tol
-        && gram.y_axis.z.abs() <= tol;
-    uniform.then(|| s2.sqrt())
-}
-
-/// Whether `m` is diagonal (an axis-aligned box stays axis-aligned).
-fn is_diagonal(m: DMat3) -> bool {
-    m.x_axis.y == 0.0
-        && m.x_axis.z == 0.0
-        && m.y_axis.x == 0.0
-        && m.y_axis.z == 0.0
-        && m.z_axis.x == 0.0
-        && m.z_axis.y == 0.0
 }
 
 impl Primitive {
@@ -305,48 +277,25 @@ impl Primitive {
         xf: &Transform,
         material: u32,
     ) -> Result<Primitive, Degenerate> {
-        let lin = xf.linear();
-        let baked: Option<Shape> = if xf.is_identity() {
-            Some(make_shape(geometry, &Transform::IDENTITY)?)
-        } else {
-            match geometry {
-                Geometry::Sphere { .. } | Geometry::Cylinder { .. } | Geometry::Cone { .. } => {
-                    similarity_scale(lin)
-                        .map(|_| make_shape(geometry, xf))
-                        .transpose()?
-                }
-                Geometry::Box { .. } => is_diagonal(lin)
-                    .then(|| make_shape(geometry, xf))
-                    .transpose()?,
-                Geometry::Plane { .. } | Geometry::Triangle { .. } => {
-                    Some(make_shape(geometry, xf)?)
-                }
-                // One mesh is shared by all its instances: each keeps its own matrix.
-                Geometry::Mesh(_) => None,
-            }
-        };
-        let (shape, object) = match baked {
-            Some(shape) => (shape, None),
-            None => {
-                let shape = make_shape(geometry, &Transform::IDENTITY)?;
-                let local = shape.bounds();
-                let anchor = if local.is_finite() {
-                    xf.point(local.centroid().as_dvec3())
-                } else {
-                    xf.point(DVec3::ZERO)
-                };
-                let mut rebased = xf.object_from_world;
-                // Composed in f64, so the object-space anchor keeps its precision.
-                rebased.w_axis = xf.object_from_world.transform_point3(anchor).extend(1.0);
-                let object = ObjectSpace::new(
-                    f(anchor),
-                    Affine3A::from_mat4(rebased.as_mat4()),
-                    Affine3A::from_mat4(xf.world_from_object.as_mat4()),
-                    Mat3A::from(xf.normal_matrix().as_mat3()),
-                );
-                (shape, Some(Box::new(object)))
-            }
-        };
+        let baked = geometry.keeps_kind_under(xf);
+        let shape = geometry.shape_under(if baked { xf } else { &Transform::IDENTITY })?;
+        let object = (!baked).then(|| {
+            let local = shape.bounds();
+            let anchor = if local.is_finite() {
+                xf.point(local.centroid().as_dvec3())
+            } else {
+                xf.point(DVec3::ZERO)
+            };
+            let mut rebased = xf.object_from_world;
+            // Composed in f64, so the object-space anchor keeps its precision.
+            rebased.w_axis = xf.object_from_world.transform_point3(anchor).extend(1.0);
+            Box::new(ObjectSpace::new(
+                f(anchor),
+                Affine3A::from_mat4(rebased.as_mat4()),
+                Affine3A::from_mat4(xf.world_from_object.as_mat4()),
+                Mat3A::from(xf.normal_matrix().as_mat3()),
+            ))
+        });
         let local = shape.bounds();
         let bounds = match &object {
             Some(o) if local.is_finite() => Aabb::from_points(
@@ -540,35 +489,6 @@ impl Primitive {
             _ => None,
         }
     }
-}
-
-/// Builds the shape for `geometry` mapped through `xf` (which must keep its class).
-fn make_shape(geometry: &Geometry, xf: &Transform) -> Result<Shape, Degenerate> {
-    let p = |v: DVec3| f(xf.point(v));
-    let shape = match geometry {
-        Geometry::Sphere { center, radius } => {
-            let s = similarity_scale(xf.linear()).ok_or(Degenerate)?;
-            Sphere::new(p(*center), (radius.abs() * s) as f32).map(Shape::Sphere)
-        }
-        Geometry::Box { p1, p2 } => AaBox::new(p(*p1), p(*p2)).map(Shape::Box),
-        Geometry::Plane { point, normal } => {
-            Plane::new(p(*point), f(xf.normal_matrix() * *normal)).map(Shape::Plane)
-        }
-        Geometry::Triangle {
-            vertices: [a, b, c],
-        } => Triangle::new(p(*a), p(*b), p(*c)).map(Shape::Triangle),
-        Geometry::Cylinder { p1, p2, radius } => {
-            let s = similarity_scale(xf.linear()).ok_or(Degenerate)?;
-            Cylinder::new(p(*p1), p(*p2), (radius * s) as f32).map(Shape::Cylinder)
-        }
-        Geometry::Cone { base, tip, radius } => {
-            let s = similarity_scale(xf.linear()).ok_or(Degenerate)?;
-            Cone::new(p(*base), p(*tip), (radius * s) as f32).map(Shape::Cone)
-        }
-        Geometry::Mesh(m) if xf.is_identity() => m.mesh().cloned().map(Shape::Mesh),
-        Geometry::Mesh(_) => None,
-    };
-    shape.ok_or(Degenerate)
 }
 
 #[cfg(test)]

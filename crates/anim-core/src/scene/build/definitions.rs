@@ -366,15 +366,7 @@ pub(super) fn finite_statement(kind: &StatementKind) -> bool {
                 && m.opacity.is_finite()
                 && m.ior.is_finite()
         }
-        StatementKind::Shape { geometry, .. } => match geometry {
-            Geometry::Sphere { center, radius } => v(center) && radius.is_finite(),
-            Geometry::Box { p1, p2 } => v(p1) && v(p2),
-            Geometry::Plane { point, normal } => v(point) && v(normal),
-            Geometry::Triangle { vertices } => vertices.iter().all(v),
-            Geometry::Cylinder { p1, p2, radius } => v(p1) && v(p2) && radius.is_finite(),
-            Geometry::Cone { base, tip, radius } => v(base) && v(tip) && radius.is_finite(),
-            Geometry::Mesh(_) => true,
-        },
+        StatementKind::Shape { geometry, .. } => geometry.is_finite(),
         StatementKind::Light(l) => v(&l.position) && c(&l.color) && l.brightness.is_finite(),
         StatementKind::Ambient(rgb)
         | StatementKind::AmbientAdd(rgb)

@@ -8,7 +8,7 @@ use super::Builder;
 use crate::limits::{
     scene_memory, INSTANCE_BUDGET_SHARE, INSTANCE_MAX_FLAT, INSTANCE_MIN_SHAPES, MAX_NESTING,
 };
-use crate::scene::{Geometry, Instanced, Prototype, Use};
+use crate::scene::{Instanced, Prototype, Use};
 use std::sync::Arc;
 
 /// No prototype made yet for an object.
@@ -111,7 +111,7 @@ impl Builder<'_> {
                     Counts {
                         shapes: u64::from(material.is_some()),
                         height: 0,
-                        unbounded: matches!(geometry, Geometry::Plane { .. }),
+                        unbounded: !geometry.is_bounded(),
                     }
                 }
                 ObjectKind::Composite { .. } => {

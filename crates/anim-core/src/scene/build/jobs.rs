@@ -378,10 +378,7 @@ impl Builder<'_> {
 /// A shape's geometry as an instance holds it: the parser makes radii positive, statements
 /// made by a program may not.
 pub(super) fn placed_geometry(mut geometry: Geometry) -> Geometry {
-    if let Geometry::Sphere { radius, .. }
-    | Geometry::Cylinder { radius, .. }
-    | Geometry::Cone { radius, .. } = &mut geometry
-    {
+    if let Some(radius) = geometry.radius_mut() {
         *radius = limits::fixed_radius(*radius);
     }
     geometry

@@ -223,20 +223,11 @@ fn slot_centres(
 /// A box around `g` in its own space, if it is bounded and its extent is known without
 /// loading anything.
 fn object_box(g: &Geometry) -> Option<(DVec3, DVec3)> {
-    let span = |points: &[DVec3], r: f64| {
-        let lo = points.iter().fold(DVec3::INFINITY, |a, p| a.min(*p));
-        let hi = points.iter().fold(DVec3::NEG_INFINITY, |a, p| a.max(*p));
-        (lo - DVec3::splat(r.abs()), hi + DVec3::splat(r.abs()))
-    };
-    match g {
-        Geometry::Sphere { center, radius } => Some(span(&[*center], *radius)),
-        Geometry::Box { p1, p2 } => Some(span(&[*p1, *p2], 0.0)),
-        Geometry::Triangle { vertices } => Some(span(vertices, 0.0)),
-        Geometry::Cylinder { p1, p2, radius } => Some(span(&[*p1, *p2], *radius)),
-        Geometry::Cone { base, tip, radius } => Some(span(&[*base, *tip], *radius)),
-        Geometry::Plane { .. } | Geometry::Mesh(_) => None,
-    }
-    .filter(|(lo, hi)| lo.is_finite() && hi.is_finite())
+    let (points, r) = g.span()?;
+    let lo = points.iter().fold(DVec3::INFINITY, |a, p| a.min(*p));
+    let hi = points.iter().fold(DVec3::NEG_INFINITY, |a, p| a.max(*p));
+    let (lo, hi) = (lo - DVec3::splat(r.abs()), hi + DVec3::splat(r.abs()));
+    (lo.is_finite() && hi.is_finite()).then_some((lo, hi))
 }
 
 /// Whether the file's motion lines move any shape or composite (the composite tree is then

@@ -47,16 +47,6 @@ const DEFINE_KINDS: [&str; 8] = [
     "transform",
     "render",
 ];
-const SHAPE_KINDS: [&str; 7] = [
-    "sphere",
-    "box",
-    "triangle",
-    "cylinder",
-    "cone",
-    "plane",
-    "composite",
-];
-
 /// The statements of a file, the problems met, and what the reader left out.
 pub struct Parsed {
     /// The statements, but for those in `shapes`.
@@ -590,7 +580,7 @@ impl Parser<'_> {
                 let note = format!("`define {}` read as `render`", kind.text);
                 self.render(line, 2, true, Some(&note))
             }
-            k if SHAPE_KINDS.contains(&k) => self.shape(line, 1),
+            k if shape::SHAPE_KINDS.contains(&k) => self.shape(line, 1),
             other => {
                 let help = suggest(other, DEFINE_KINDS)
                     .map(|s| format!("did you mean `{s}`?"))

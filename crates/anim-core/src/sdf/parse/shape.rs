@@ -1,6 +1,6 @@
 //! `define shape`: the geometric primitives and composites.
 
-use super::{At, Fail, PResult, Parser, SHAPE_KINDS};
+use super::{At, Fail, PResult, Parser};
 use crate::diag::suggest;
 use crate::limits;
 use crate::sdf::ast::{FlatShapeLine, StatementKind};
@@ -8,6 +8,17 @@ use crate::sdf::lexer::{self, looks_numeric, Line};
 use crate::shape::geometry::degeneracy;
 use crate::shape::{Geometry, MeshFile};
 use glam::DVec3;
+
+/// The kinds a `define shape` statement names by keyword (a mesh is `obj`, read apart).
+pub(super) const SHAPE_KINDS: [&str; 7] = [
+    "sphere",
+    "box",
+    "triangle",
+    "cylinder",
+    "cone",
+    "plane",
+    "composite",
+];
 
 const FORM_SPHERE: &str = "define shape sphere <name> [center] <radius> <material>";
 const FORM_BOX: &str = "define shape box <name> [p1] [p2] <material>";
@@ -140,12 +151,10 @@ impl Parser<'_> {
             }
         }
         let geometry = geometry_from(kind, &nums[..expected]);
-        let warned = match geometry {
-            Geometry::Sphere { radius, .. }
-            | Geometry::Cylinder { radius, .. }
-            | Geometry::Cone { radius, .. } => radius < 0.0,
-            Geometry::Box { p1, p2 } => (p2 - p1).to_array().contains(&0.0),
-            _ => false,
+        let warned = match (geometry.radius(), &geometry) {
+            (Some(radius), _) => radius < 0.0,
+            (None, Geometry::Box { p1, p2 }) => (*p2 - *p1).to_array().contains(&0.0),
+            (None, _) => false,
         };
         let pos = self.statements.len();
         if warned
@@ -316,10 +325,7 @@ impl Parser<'_> {
     ) {
         // The radius, where there is one, is the last number.
         let radius_at = At::Tok(args.nums_to - 1);
-        if let Geometry::Sphere { radius, .. }
-        | Geometry::Cylinder { radius, .. }
-        | Geometry::Cone { radius, .. } = geometry
-        {
+        if let Some(radius) = geometry.radius_mut() {
             if *radius < 0.0 {
                 self.warn(
                     line,
@@ -348,13 +354,10 @@ impl Parser<'_> {
             }
         }
         if let Some(reason) = degeneracy(geometry) {
-            let at = match geometry {
-                Geometry::Sphere { .. } | Geometry::Cylinder { .. } | Geometry::Cone { .. }
-                    if reason.contains("radius") =>
-                {
-                    radius_at
-                }
-                _ => At::Span(args.nums_from, args.nums_to - 1),
+            let at = if geometry.radius().is_some() && reason.contains("radius") {
+                radius_at
+            } else {
+                At::Span(args.nums_from, args.nums_to - 1)
             };
             self.warn(
                 line,
@@ -509,30 +512,11 @@ fn geometry_from(kind: &str, nums: &[f64]) -> Geometry {
             }
         };
     }
-    match kind {
-        "sphere" => Geometry::Sphere {
-            center: p(0),
-            radius: nums[3],
-        },
-        "box" => Geometry::Box { p1: p(0), p2: p(3) },
-        "triangle" => Geometry::Triangle {
-            vertices: [p(0), p(3), p(6)],
-        },
-        "cylinder" => Geometry::Cylinder {
-            p1: p(0),
-            p2: p(3),
-            radius: nums[6],
-        },
-        "cone" => Geometry::Cone {
-            base: p(0),
-            tip: p(3),
-            radius: nums[6],
-        },
-        _ => Geometry::Plane {
-            point: p(0),
-            normal: p(3),
-        },
-    }
+    // The layouts admit the keywords of primitives alone, and a plane's last.
+    Geometry::from_numbers(kind, nums).unwrap_or_else(|| Geometry::Plane {
+        point: p(0),
+        normal: p(3),
+    })
 }
 
 #[cfg(test)]
