@@ -7,6 +7,13 @@
 //! A key is decomposed about a centre given in object space (`MotionKeys::new`): the
 //! translation is where the centre goes, so a thing turning about its own centre keeps it
 //! still between keys, whatever its object space's origin.
+//!
+//! Motion, one home per layer: `crate::math::motion` (keys and their interpolation),
+//! `crate::sdf::parse::motion` (the `motion` lines), `crate::scene::motion` (what moves in a
+//! scene) with `crate::scene::build::motion` (made from the lines),
+//! `crate::render::geometry::motion` (moving shapes as primitives), `crate::render::motion`
+//! (the exposure, as the samplers see it), and the animation pipeline's `keyframe::motion`
+//! (the lines a spec with a `shutter` writes).
 
 use super::Transform;
 use glam::{DMat3, DMat4, DQuat, DVec3};

@@ -10,6 +10,11 @@
 //! scene after building ([`Scene::transform_all`]) are applied last. The shapes are also
 //! numbered as the flattened tree would number them (depth first), so that equally close
 //! hits resolve the same way.
+//!
+//! Instancing, one home per layer: `crate::scene::instancing` (what a composite drawn in
+//! several places expands to), `crate::scene::build::instancing` (which composites are kept
+//! once) and `crate::render::geometry::instancing` (their hierarchies, entered by a use's
+//! transform).
 
 use super::{Instance, Scene};
 use crate::limits::MAX_NESTING;

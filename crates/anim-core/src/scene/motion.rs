@@ -6,6 +6,13 @@
 //! A slot's world placement at instant `u` composes its ancestors' placements at `u`: a
 //! moving composite carries its children, each part interpolated about its own centre
 //! (`crate::math::motion`).
+//!
+//! Motion, one home per layer: `crate::math::motion` (keys and their interpolation),
+//! `crate::sdf::parse::motion` (the `motion` lines), `crate::scene::motion` (what moves in a
+//! scene) with `crate::scene::build::motion` (made from the lines),
+//! `crate::render::geometry::motion` (moving shapes as primitives), `crate::render::motion`
+//! (the exposure, as the samplers see it), and the animation pipeline's `keyframe::motion`
+//! (the lines a spec with a `shutter` writes).
 
 use super::Camera;
 use crate::math::motion::MotionKeys;

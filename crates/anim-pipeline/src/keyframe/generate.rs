@@ -14,8 +14,8 @@
 //! (each transform statement applies after the earlier ones) that is four statements appended
 //! after the base file's: translate −p, scale S, rotate R, translate p + T.
 
+use super::motion::{self, TrackPose};
 use super::orbit;
-use super::shutter::{self, TrackPose};
 use super::spec::{Animation, SceneNames, Source, TargetKind, Track};
 use super::tidy::{tidy, tidy3};
 use anim_core::diag::{Diagnostic, Loc};
@@ -435,7 +435,7 @@ impl<'a> Generator<'a> {
     /// at evenly spread instants.
     fn exposure_motion(&self, i: usize, mid: f64) -> Result<Vec<Statement>, Vec<Diagnostic>> {
         let anim = self.anim;
-        let steps = shutter::steps(anim, i);
+        let steps = motion::steps(anim, i);
         let instants: Vec<(f64, f64)> = (0..=steps)
             .map(|j| {
                 let u = j as f64 / steps as f64;
@@ -473,7 +473,7 @@ impl<'a> Generator<'a> {
             let centre = pose(mid)?;
             let deltas = instants
                 .iter()
-                .map(|&(_, t)| Ok(shutter::camera_delta_ops(&centre, &pose(t)?)))
+                .map(|&(_, t)| Ok(motion::camera_delta_ops(&centre, &pose(t)?)))
                 .collect::<Result<_, Vec<Diagnostic>>>()?;
             add(&anim.camera, deltas);
         }
@@ -511,7 +511,7 @@ impl<'a> Generator<'a> {
             let deltas = poses
                 .iter()
                 .map(|at| match tracks.as_slice() {
-                    [(track, pivot)] => shutter::delta_ops(&centre[0], &at[0], *pivot, track.axis),
+                    [(track, pivot)] => motion::delta_ops(&centre[0], &at[0], *pivot, track.axis),
                     _ => {
                         let placed = |ps: &[TrackPose]| -> Vec<TransformOp> {
                             ps.iter()
@@ -519,9 +519,9 @@ impl<'a> Generator<'a> {
                                 .flat_map(|(p, (tr, pivot))| p.ops(*pivot, tr.axis))
                                 .collect()
                         };
-                        let mut ops = shutter::inverse_ops(&placed(&centre));
+                        let mut ops = motion::inverse_ops(&placed(&centre));
                         ops.extend(placed(at));
-                        shutter::simplify(ops)
+                        motion::simplify(ops)
                     }
                 })
                 .collect();

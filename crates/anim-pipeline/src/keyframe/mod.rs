@@ -2,15 +2,15 @@
 //! file per frame.
 //!
 //! [`spec`] reads and checks the spec, [`interp`] samples keyed values, [`orbit`] places the
-//! turntable camera, [`shutter`] describes motion during a blurred frame's exposure and
-//! [`generate`] writes the frames. Imports run one way: `generate` → `shutter` → `orbit` →
+//! turntable camera, [`motion`] describes motion during a blurred frame's exposure and
+//! [`generate`] writes the frames. Imports run one way: `generate` → `motion` → `orbit` →
 //! `spec` → {`interp`, `locate`, `tidy`}.
 
 pub mod generate;
 pub mod interp;
 pub mod locate;
+pub mod motion;
 pub mod orbit;
-pub mod shutter;
 pub mod spec;
 pub mod tidy;
 

@@ -9,6 +9,10 @@
 //! drops out where its own hits since have moved `t_max` before the box, as the single walk
 //! does when it pops the entry. Leaves are handed over ray by ray, so what a leaf test finds
 //! is the single walk's, too.
+//!
+//! Packets, one home per layer: `crate::accel::wide::packet` (the shared walk of the
+//! hierarchy), `crate::render::geometry::packet` (closest hits of a packet) and
+//! `crate::render::sampler::packet` (camera rays of a block of pixels, traced together).
 
 use super::{Bvh, Node, LEAF, STACK_SIZE, WIDTH};
 use crate::math::{Ray, SLAB_WIDEN};

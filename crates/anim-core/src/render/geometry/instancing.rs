@@ -1,9 +1,12 @@
 //! The prototypes of a scene's instanced composites, compiled: one hierarchy each, over its
 //! shapes and nested uses in its own frame, entered by a use's transform (pbrt's
 //! `TransformedPrimitive`). A top-level use is one primitive of the geometry's table
-//! (`Kind::Instance`). Siblings: `crate::scene::instancing` (what a composite drawn in
-//! several places expands to) and `crate::scene::build::instancing` (when a composite is
-//! kept once).
+//! (`Kind::Instance`).
+//!
+//! Instancing, one home per layer: `crate::scene::instancing` (what a composite drawn in
+//! several places expands to), `crate::scene::build::instancing` (which composites are kept
+//! once) and `crate::render::geometry::instancing` (their hierarchies, entered by a use's
+//! transform).
 //!
 //! The hierarchies only cull. A shape they offer is placed with the world transform the
 //! flattened tree gives it (`Scene::prototype_world`, composed top-down as the flattening

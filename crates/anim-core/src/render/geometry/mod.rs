@@ -4,11 +4,11 @@
 //! whatever renders that scene.
 //!
 //! It answers two questions about a ray, each in its own file: the closest hit
-//! ([`closest`]) and whether, and what, the ray meets before a distance ([`occlusion`]);
+//! (`closest.rs`) and whether, and what, the ray meets before a distance (`occlusion.rs`);
 //! both for every primitive (walking the hierarchy, or one flat leaf in a small scene) or for
-//! a list of candidates a [`super::view::View`] looked up ([`Candidates`]). [`packet`] asks
+//! a list of candidates a [`super::view::View`] looked up ([`Candidates`]). `packet.rs` asks
 //! the closest hit for several coherent rays at once. A leaf's primitives are tested four at
-//! a time ([`leaf`]). Instanced composites ([`instancing`]) and moving shapes ([`motion`])
+//! a time (`leaf.rs`). Instanced composites ([`instancing`]) and moving shapes ([`motion`])
 //! are primitives of the table like the others: a [`Kind`] says which, and each answers the
 //! same two questions.
 

@@ -1,11 +1,15 @@
 //! The moving part of a compiled scene's geometry (docs/scene-language.md §10): shapes whose
 //! transform slot moves during the exposure, each a primitive of the geometry's table
 //! (`Kind::Moving`, pbrt's `AnimatedPrimitive`) bounded over the whole exposure and placed at
-//! the time of the ray that tests it. Siblings: `crate::math::motion` (keys and their
-//! interpolation), `crate::sdf::parse::motion` (the `motion` statements),
-//! `crate::scene::motion` (what moves in a scene description) and `crate::render::motion`
-//! (the exposure: instants of camera samples, the camera at an instant, and what adaptive
-//! sampling asks of motion). Moving lights are shading data (`crate::render::shading`).
+//! the time of the ray that tests it. Moving lights are shading data
+//! (`crate::render::shading`).
+//!
+//! Motion, one home per layer: `crate::math::motion` (keys and their interpolation),
+//! `crate::sdf::parse::motion` (the `motion` lines), `crate::scene::motion` (what moves in a
+//! scene) with `crate::scene::build::motion` (made from the lines),
+//! `crate::render::geometry::motion` (moving shapes as primitives), `crate::render::motion`
+//! (the exposure, as the samplers see it), and the animation pipeline's `keyframe::motion`
+//! (the lines a spec with a `shutter` writes).
 //!
 //! Static geometry pays nothing: its primitives and their tests are those of a frame without
 //! motion. A moving shape is placed by `Motion::slot_matrix` at the ray's time, a function of

@@ -1,8 +1,10 @@
-//! Closest hits of packets of coherent rays (see `crate::accel::Packet`, whose walk they
-//! share, and `crate::render::sampler::packet`, which makes them of camera rays): one walk
-//! of the hierarchy for all of them, each leaf tested ray by ray with the single-ray leaf
-//! tests, so every ray's answer is [`Geometry::closest`]'s to the bit (the same winner of
-//! ties too).
+//! Closest hits of packets of coherent rays: one walk of the hierarchy for all of them, each
+//! leaf tested ray by ray with the single-ray leaf tests, so every ray's answer is
+//! [`Geometry::closest`]'s to the bit (the same winner of ties too).
+//!
+//! Packets, one home per layer: `crate::accel::wide::packet` (the shared walk of the
+//! hierarchy), `crate::render::geometry::packet` (closest hits of a packet) and
+//! `crate::render::sampler::packet` (camera rays of a block of pixels, traced together).
 
 use super::leaf::{fours, gather, Best, LANES};
 use super::{Candidates, Geometry, PrimId, Primitive, Scratch, SurfaceHit};

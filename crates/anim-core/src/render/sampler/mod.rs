@@ -1,12 +1,12 @@
 //! Samplers: where each pixel's camera samples go and when a pixel has enough. Each traces
 //! its samples through the frame's camera and the integrator into the pixels of the film.
 //!
-//! - [`uniform`]: the same samples in every pixel.
-//! - [`adaptive`]: one sample in every pixel, then more where the first pass says a pixel
-//!   needs them ([`first_pass`]), at the points of each pixel's own scrambled Sobol pattern
+//! - `uniform`: the same samples in every pixel.
+//! - `adaptive`: one sample in every pixel, then more where the first pass says a pixel
+//!   needs them (`first_pass`), at the points of each pixel's own scrambled Sobol pattern
 //!   ([`pattern`]). What the first pass learned travels to the integrator as a value, the
 //!   `PixelPrior` of each added sample.
-//! - [`packet`]: camera rays of still frames, traced a block at a time.
+//! - `packet`: camera rays of still frames, traced a block at a time.
 
 mod adaptive;
 mod first_pass;

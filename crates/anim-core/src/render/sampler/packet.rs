@@ -1,10 +1,12 @@
 //! Camera rays traced in packets: the rays of a small block of pixels share their origin and
 //! nearly their direction, so one walk of the hierarchy serves them all
-//! (`RenderScene::intersect_camera_packet`, whose packet walk is
-//! `crate::render::geometry::packet` over `crate::accel::Packet`); each is then shaded on its
-//! own. Every ray's closest hit is the single-ray one to the bit and each pixel sums its
+//! (`RenderScene::intersect_camera_packet`); each is then shaded on its own. Every ray's closest hit is the single-ray one to the bit and each pixel sums its
 //! samples in the same order, so the image is the one the single-ray loops make. Frames with
 //! motion never come here: the rays of a block sample different instants.
+//!
+//! Packets, one home per layer: `crate::accel::wide::packet` (the shared walk of the
+//! hierarchy), `crate::render::geometry::packet` (closest hits of a packet) and
+//! `crate::render::sampler::packet` (camera rays of a block of pixels, traced together).
 
 use super::Frame;
 use crate::math::Ray;

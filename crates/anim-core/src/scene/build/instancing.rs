@@ -1,6 +1,11 @@
 //! Which composites are kept once as prototypes (see `crate::scene::Instanced`), and their
 //! making while the tree is flattened: a composite listed more than once, big enough to be
 //! worth it, becomes a prototype the first time it is met, and a use wherever it is listed.
+//!
+//! Instancing, one home per layer: `crate::scene::instancing` (what a composite drawn in
+//! several places expands to), `crate::scene::build::instancing` (which composites are kept
+//! once) and `crate::render::geometry::instancing` (their hierarchies, entered by a use's
+//! transform).
 
 use super::definitions::{Definitions, ObjectKind};
 use super::jobs::{Expansion, Flatten};

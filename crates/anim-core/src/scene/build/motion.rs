@@ -1,6 +1,13 @@
 //! `motion` lines (docs/scene-language.md §10) made into a job's [`Motion`]: per moving
 //! target its transforms at the lines' instants (its own transforms followed by the line's
 //! operations), keyed about its centre.
+//!
+//! Motion, one home per layer: `crate::math::motion` (keys and their interpolation),
+//! `crate::sdf::parse::motion` (the `motion` lines), `crate::scene::motion` (what moves in a
+//! scene) with `crate::scene::build::motion` (made from the lines),
+//! `crate::render::geometry::motion` (moving shapes as primitives), `crate::render::motion`
+//! (the exposure, as the samplers see it), and the animation pipeline's `keyframe::motion`
+//! (the lines a spec with a `shutter` writes).
 
 use super::definitions::{Definitions, ObjectKind};
 use super::transforms::{finite_transform, Snapshot, Space};

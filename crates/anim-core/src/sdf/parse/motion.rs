@@ -1,6 +1,13 @@
 //! `motion` lines: where a shape, composite, light or camera is at an instant of the exposure
 //! (docs/scene-language.md §10). `anim generate` writes them for specs with a `shutter`; they
 //! take the canonical operations only, as a program writes them.
+//!
+//! Motion, one home per layer: `crate::math::motion` (keys and their interpolation),
+//! `crate::sdf::parse::motion` (the `motion` lines), `crate::scene::motion` (what moves in a
+//! scene) with `crate::scene::build::motion` (made from the lines),
+//! `crate::render::geometry::motion` (moving shapes as primitives), `crate::render::motion`
+//! (the exposure, as the samplers see it), and the animation pipeline's `keyframe::motion`
+//! (the lines a spec with a `shutter` writes).
 
 use super::{At, Parser};
 use crate::diag::{suggest, Diagnostic, Loc, Severity};

@@ -6,6 +6,10 @@
 //! The instants are evenly spread, close enough that no thing turns more than
 //! `limits::MOTION_KEY_DEGREES` from one to the next, so a reader interpolating between them
 //! follows arcs rather than chords.
+//!
+//! Motion has a home in each layer of the renderer library too: `anim_core::math::motion`
+//! (keys), `anim_core::sdf::parse::motion` (reading these lines), `anim_core::scene::motion`
+//! and `anim_core::render::motion`.
 
 use super::orbit::{self, Pose};
 use super::spec::{Animation, Track};
