@@ -240,13 +240,13 @@ impl Geometry {
         let first_unbounded = order.len() as u32;
         order.extend(unbounded);
         let all_spheres = table.tags.iter().all(|&t| t == BOUNDS_OF_SPHERE);
-        let (bounds_min, bounds_max) = packed_bounds(&table, &order, all_spheres);
+        let plan = policy::geometry_plan(first_unbounded as usize, moving.is_some(), all_spheres);
+        let (bounds_min, bounds_max) = packed_bounds(&table, &order, plan.spheres_only);
         let permute = |v: &[u32]| order.iter().map(|&i| v[i as usize]).collect::<Vec<u32>>();
         let (material, key) = (permute(&table.material), permute(&table.key));
         let kind = order.iter().map(|&i| table.kind[i as usize]).collect();
         let mut spheres: Vec<Vec4> = order.iter().map(|&i| table.spheres[i as usize]).collect();
         spheres.resize(order.len() + LANES - 1, Vec4::NAN);
-        let plan = policy::geometry_plan(first_unbounded as usize, moving.is_some(), all_spheres);
         let geometry = Geometry {
             material,
             kind,
@@ -524,9 +524,9 @@ impl Geometry {
 }
 
 /// The table's bounds in the hierarchy's `order`, each with its kind's tag in `w` and padded
-/// by `LANES - 1` NaN entries (empty when every primitive is a packed sphere).
-fn packed_bounds(table: &Table, order: &[u32], all_spheres: bool) -> (Vec<Vec4>, Vec<Vec4>) {
-    if all_spheres {
+/// by `LANES - 1` NaN entries (none when the leaves test packed spheres alone).
+fn packed_bounds(table: &Table, order: &[u32], spheres_only: bool) -> (Vec<Vec4>, Vec<Vec4>) {
+    if spheres_only {
         return (Vec::new(), Vec::new());
     }
     let (mut min, mut max): (Vec<Vec4>, Vec<Vec4>) = order
