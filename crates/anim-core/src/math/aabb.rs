@@ -4,7 +4,9 @@ use glam::Vec3A;
 /// Axis-aligned bounding box. The empty box has `min = +inf`, `max = -inf`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
+    /// The lowest corner: the smallest x, y and z the box holds.
     pub min: Vec3A,
+    /// The highest corner: the largest x, y and z the box holds.
     pub max: Vec3A,
 }
 
@@ -14,11 +16,13 @@ pub const SLAB_WIDEN: f32 =
     1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
 impl Aabb {
+    /// The box that holds nothing, which any union leaves unchanged.
     pub const EMPTY: Aabb = Aabb {
         min: Vec3A::splat(f32::INFINITY),
         max: Vec3A::splat(f32::NEG_INFINITY),
     };
 
+    /// The box with opposite corners `a` and `b`, given in either order.
     pub fn new(a: Vec3A, b: Vec3A) -> Self {
         Aabb {
             min: a.min(b),
@@ -26,12 +30,14 @@ impl Aabb {
         }
     }
 
+    /// The smallest box holding every point; [`Aabb::EMPTY`] when there is none.
     pub fn from_points(points: impl IntoIterator<Item = Vec3A>) -> Self {
         points
             .into_iter()
             .fold(Aabb::EMPTY, |acc, p| acc.union_point(p))
     }
 
+    /// The smallest box holding both boxes.
     pub fn union(self, o: Aabb) -> Aabb {
         Aabb {
             min: self.min.min(o.min),
@@ -39,6 +45,7 @@ impl Aabb {
         }
     }
 
+    /// The smallest box holding this box and the point `p`.
     pub fn union_point(self, p: Vec3A) -> Aabb {
         Aabb {
             min: self.min.min(p),
@@ -46,22 +53,29 @@ impl Aabb {
         }
     }
 
+    /// Whether the box holds no point: `min` lies above `max` on some axis. A flat box, with
+    /// `min == max` on an axis, is not empty.
     pub fn is_empty(&self) -> bool {
         self.min.cmpgt(self.max).any()
     }
 
+    /// Whether both corners are finite. False for the empty box and for the bounds of an
+    /// unbounded shape such as a plane.
     pub fn is_finite(&self) -> bool {
         self.min.is_finite() && self.max.is_finite()
     }
 
+    /// The point half-way between the corners. Not a point for the empty box.
     pub fn centroid(&self) -> Vec3A {
         (self.min + self.max) * 0.5
     }
 
+    /// The size along each axis, `max - min`; negative for the empty box.
     pub fn extent(&self) -> Vec3A {
         self.max - self.min
     }
 
+    /// The total area of the six faces; 0 for the empty box.
     pub fn surface_area(&self) -> f32 {
         if self.is_empty() {
             return 0.0;
@@ -70,6 +84,8 @@ impl Aabb {
         2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
     }
 
+    /// The eight corners. Bit 0 of an index picks the high x, bit 1 the high y, bit 2 the
+    /// high z.
     pub fn corners(&self) -> [Vec3A; 8] {
         let (a, b) = (self.min, self.max);
         [

@@ -13,7 +13,9 @@ use glam::Vec3A;
 /// keep the world-space parameter `t`, so hits from differently transformed shapes compare.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
+    /// Where the ray starts: in world space, or in a shape's object space once moved there.
     pub origin: Vec3A,
+    /// The direction of travel: `t` counts multiples of it.
     pub dir: Vec3A,
     /// The instant of the exposure the ray belongs to (0 at shutter open, 1 at close): its
     /// camera sample's, inherited by every ray spawned from it. Only moving things read it.
@@ -36,6 +38,7 @@ impl Ray {
         Ray { time, ..self }
     }
 
+    /// The point at parameter `t` along the ray.
     pub fn at(&self, t: f32) -> Vec3A {
         self.origin + self.dir * t
     }

@@ -27,6 +27,8 @@ const POLAR_ITERATIONS: usize = 100;
 pub struct Decomposed {
     /// Where the centre goes.
     pub translation: DVec3,
+    /// The rotation, as a unit quaternion. A mirroring transform keeps its reflection in
+    /// `stretch`, so this is always a proper rotation.
     pub rotation: DQuat,
     /// Symmetric: the scale and shear left once the rotation is taken out.
     pub stretch: DMat3,

@@ -4,7 +4,9 @@ use glam::{DMat3, DMat4, DVec3};
 /// long statement sequences do not accumulate f32 round-off.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Transform {
+    /// Maps object-space points and vectors to world space.
     pub world_from_object: DMat4,
+    /// The inverse of `world_from_object`: maps world-space points and vectors to object space.
     pub object_from_world: DMat4,
 }
 
@@ -15,11 +17,13 @@ impl Default for Transform {
 }
 
 impl Transform {
+    /// The transform that leaves everything where it is.
     pub const IDENTITY: Transform = Transform {
         world_from_object: DMat4::IDENTITY,
         object_from_world: DMat4::IDENTITY,
     };
 
+    /// A move by `v`.
     pub fn translate(v: DVec3) -> Self {
         Transform {
             world_from_object: DMat4::from_translation(v),
@@ -58,14 +62,18 @@ impl Transform {
         }
     }
 
+    /// Whether the transform is exactly the identity, with no tolerance for round-off.
     pub fn is_identity(&self) -> bool {
         self.world_from_object == DMat4::IDENTITY
     }
 
+    /// The point `p`, taken from object space to world space.
     pub fn point(&self, p: DVec3) -> DVec3 {
         self.world_from_object.transform_point3(p)
     }
 
+    /// The direction or offset `v`, taken from object space to world space: the translation
+    /// does not apply, and a unit vector may not stay unit length.
     pub fn vector(&self, v: DVec3) -> DVec3 {
         self.world_from_object.transform_vector3(v)
     }
@@ -75,6 +83,8 @@ impl Transform {
         DMat3::from_mat4(self.object_from_world).transpose()
     }
 
+    /// The linear part of the object-to-world map (rotation, scale and shear), without the
+    /// translation.
     pub fn linear(&self) -> DMat3 {
         DMat3::from_mat4(self.world_from_object)
     }
