@@ -5,39 +5,51 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+/// How serious a diagnostic is. A warning orders below an error.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Severity {
+    /// Worth the author's attention, but the file still loads.
     Warning,
+    /// The file cannot be loaded as it is.
     Error,
 }
 
 /// A position in a source file; `line` and `col` count from 1, `col` in characters.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Loc {
+    /// The file, as its path was given.
     pub file: Arc<Path>,
+    /// The line, counted from 1.
     pub line: u32,
+    /// The column, counted from 1 in characters (not bytes).
     pub col: u32,
 }
 
+/// One problem met while reading a file: how serious it is, where it is, what is wrong, and
+/// perhaps the line it is on and a hint to fix it. `Display` writes it as compilers do.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Diagnostic {
+    /// Whether the problem stops the file from loading.
     pub severity: Severity,
     /// `None` for problems with the file as a whole (cannot be read, ...).
     pub loc: Option<Loc>,
     /// Used when `loc` is `None`.
     pub file: PathBuf,
+    /// What is wrong, in words for the author; shown after the place and the severity.
     pub message: String,
     /// The source line, shown with a caret under `loc.col` spanning `width` characters.
     pub source_line: Option<String>,
     /// The column (in characters, from 1) of the line at which `source_line` starts: a
     /// quote of a very long line keeps only the part around `loc.col`.
     pub source_start: u32,
+    /// How many characters, from `loc.col`, the carets under the quoted line span.
     pub width: u32,
     /// "did you mean `glass`?", the canonical form of a statement, ...
     pub help: Option<String>,
 }
 
 impl Diagnostic {
+    /// A problem at `loc`, with no line quoted and no help yet.
     pub fn new(severity: Severity, loc: Loc, message: impl Into<String>) -> Self {
         Diagnostic {
             severity,
@@ -65,6 +77,8 @@ impl Diagnostic {
         }
     }
 
+    /// The same diagnostic quoting `line`, the whole source line at `loc`, with carets
+    /// spanning `width` characters (at least one).
     pub fn with_source(mut self, line: impl AsRef<str>, width: u32) -> Self {
         self.width = width.max(1);
         self.quote(line.as_ref());
@@ -92,16 +106,19 @@ impl Diagnostic {
         self.source_line = Some(quoted);
     }
 
+    /// The same diagnostic with a hint, shown under it after `= help:`.
     pub fn with_help(mut self, help: impl Into<String>) -> Self {
         self.help = Some(help.into());
         self
     }
 
+    /// The same problem, reported as `severity` instead.
     pub fn with_severity(mut self, severity: Severity) -> Self {
         self.severity = severity;
         self
     }
 
+    /// Whether the problem is an error, one that stops the file from loading.
     pub fn is_error(&self) -> bool {
         self.severity == Severity::Error
     }

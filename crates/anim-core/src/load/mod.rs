@@ -25,7 +25,10 @@ const TEXT_SNIFF_BYTES: usize = 8 << 10;
 /// A successfully loaded file: its images to render and the warnings met on the way.
 #[derive(Clone, Debug)]
 pub struct Loaded {
+    /// The images to render, one job each.
     pub jobs: Vec<RenderJob>,
+    /// The warnings, none of them an error: at most [`MAX_DIAGNOSTICS`], then one counting
+    /// those left out. Each quotes its source line when it has a place in the file.
     pub diagnostics: Vec<Diagnostic>,
 }
 

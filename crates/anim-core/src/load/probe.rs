@@ -55,6 +55,8 @@ enum Seen {
 /// Why an image would show nothing.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Blank {
+    /// Why, as a clause the author can act on ("the scene has no lights and no ambient light:
+    /// every surface is black"); the warning quotes it after "would be blank:".
     pub reason: String,
 }
 
