@@ -6,7 +6,9 @@ use glam::{Mat4, Vec3A, Vec4};
 /// Axis-aligned box; a zero extent on one axis is allowed and renders as a rectangle.
 #[derive(Clone, Debug)]
 pub struct AaBox {
+    /// The lowest corner.
     pub min: Vec3A,
+    /// The highest corner: at least `min` on every axis, equal to it where the box is flat.
     pub max: Vec3A,
 }
 
@@ -19,10 +21,13 @@ impl AaBox {
         })
     }
 
+    /// The box itself, as bounds.
     pub fn bounds(&self) -> Aabb {
         Aabb::new(self.min, self.max)
     }
 
+    /// The nearest hit with `0 < t < t_max`: the face the ray enters by, or the face it
+    /// leaves by when it starts inside. The normal is that face's outward unit normal.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
         let inv = ray.dir.recip();
@@ -92,12 +97,19 @@ pub struct BoxRay {
 /// Four boxes against one ray ([`BoxRay::slabs4`]): per lane the largest entry and the
 /// smallest exit over the three slabs, and the `w` of each box's `min`.
 pub struct Slabs4 {
+    /// Per box, the ray parameter at which the ray's line enters it (negative when the ray
+    /// starts inside or past it).
     pub enter: Vec4,
+    /// Per box, the ray parameter at which the ray's line leaves it. The ray misses a box
+    /// whose `exit` is below its `enter` or not above 0.
     pub exit: Vec4,
+    /// Per box, the `w` of its `min`, passed through untouched: a mark the caller stores
+    /// there, such as what kind of primitive the box bounds.
     pub tag: Vec4,
 }
 
 impl BoxRay {
+    /// `ray`, ready to be tested against four boxes at once.
     #[inline]
     pub fn new(ray: &Ray) -> BoxRay {
         let inv = ray.dir.recip();

@@ -12,10 +12,14 @@ use super::{NearFaces, ShapeHit};
 use crate::math::{Aabb, Ray};
 use glam::{DVec3, Vec3A};
 
+/// Cone with its apex at `tip` and a disc of `radius` at `base`, closed by that disc.
 #[derive(Clone, Debug)]
 pub struct Cone {
+    /// The centre of the base disc.
     pub base: Vec3A,
+    /// The apex.
     pub tip: Vec3A,
+    /// The radius of the base disc, positive and finite.
     pub radius: f32,
     /// Origin at the tip, w towards the base.
     frame: AxisFrame,
@@ -41,6 +45,7 @@ impl Cone {
         })
     }
 
+    /// A box holding the cone, padded so that rounding to f32 cannot cut it.
     pub fn bounds(&self) -> Aabb {
         let (lo, hi) = self
             .frame
@@ -49,6 +54,7 @@ impl Cone {
         conservative_aabb(lo.min(tip), hi.max(tip))
     }
 
+    /// The nearest hit with `0 < t < t_max`, on the side or the base disc.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
         let l = self.frame.to_local(ray)?;

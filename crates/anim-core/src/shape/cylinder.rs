@@ -272,8 +272,11 @@ pub(super) enum Part {
 /// Cylinder of `radius` around the axis `p1 → p2`, closed by a disc at each end.
 #[derive(Clone, Debug)]
 pub struct Cylinder {
+    /// The centre of one end disc.
     pub p1: Vec3A,
+    /// The centre of the other end disc.
     pub p2: Vec3A,
+    /// The radius, positive and finite.
     pub radius: f32,
     frame: AxisFrame,
 }
@@ -294,6 +297,7 @@ impl Cylinder {
         })
     }
 
+    /// A box holding the cylinder, padded so that rounding to f32 cannot cut it.
     pub fn bounds(&self) -> Aabb {
         let r = self.radius as f64;
         let (lo0, hi0) = self.frame.disc_bounds(0.0, r);
@@ -301,6 +305,7 @@ impl Cylinder {
         conservative_aabb(lo0.min(lo1), hi0.max(hi1))
     }
 
+    /// The nearest hit with `0 < t < t_max`, on the side or either end disc.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
         let l = self.frame.to_local(ray)?;

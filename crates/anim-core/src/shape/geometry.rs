@@ -14,32 +14,50 @@ use glam::{DMat3, DVec3, Vec3A};
 /// A primitive as written in its own (object) space.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Geometry {
+    /// A sphere of `radius` around `center`.
     Sphere {
+        /// The centre.
         center: DVec3,
+        /// The radius; its sign is ignored.
         radius: f64,
     },
     /// Corners in any order.
     Box {
+        /// One corner.
         p1: DVec3,
+        /// The opposite corner.
         p2: DVec3,
     },
+    /// An infinite plane through `point`, perpendicular to `normal`.
     Plane {
+        /// A point the plane passes through.
         point: DVec3,
+        /// A direction perpendicular to the plane, of any length but zero.
         normal: DVec3,
     },
+    /// One triangle, hit from both sides.
     Triangle {
+        /// The corners. Their order orients the normal, `(v1 − v0) × (v2 − v0)`.
         vertices: [DVec3; 3],
     },
     /// Axis p1 → p2, both ends capped.
     Cylinder {
+        /// The centre of one end.
         p1: DVec3,
+        /// The centre of the other end.
         p2: DVec3,
+        /// The radius, positive for a shape that can be drawn (the reader makes a negative
+        /// radius positive).
         radius: f64,
     },
     /// Radius at the base, apex at the tip, base capped.
     Cone {
+        /// The centre of the base.
         base: DVec3,
+        /// The apex.
         tip: DVec3,
+        /// The radius of the base, positive for a shape that can be drawn (the reader makes
+        /// a negative radius positive).
         radius: f64,
     },
     /// Triangles of an OBJ file (`define shape obj`), loaded by the scene builder.

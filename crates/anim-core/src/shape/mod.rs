@@ -36,8 +36,11 @@ use std::sync::Arc;
 /// with no edge nearby: the hit's normal is then the only face.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct NearFaces {
+    /// The outward unit normals of the listed faces, in the first `len` places.
     pub normals: [Vec3A; 3],
+    /// The point's distance from each face's plane, in shape space: 0 for a face it lies on.
     pub distances: [f32; 3],
+    /// How many faces are listed, from 0 to 3.
     pub len: usize,
     /// At a cone's apex (no faces listed): the unit direction into the solid along the axis
     /// and the sine of the half-angle, the clearance from every generator's plane per unit
@@ -58,6 +61,7 @@ impl NearFaces {
         }
     }
 
+    /// The listed faces, each as its normal and the point's distance from it.
     pub fn iter(&self) -> impl Iterator<Item = (Vec3A, f32)> + '_ {
         self.normals
             .iter()
@@ -70,24 +74,37 @@ impl NearFaces {
 /// A hit in the shape's own space.
 #[derive(Clone, Copy, Debug)]
 pub struct ShapeHit {
+    /// The ray parameter of the hit, in multiples of the ray's `dir`.
     pub t: f32,
+    /// The hit point, on the surface to within f32 rounding.
     pub point: Vec3A,
+    /// The geometric normal at `point`, outwards for a closed shape; not necessarily unit
+    /// length.
     pub normal: Vec3A,
 }
 
+/// One primitive of the closed set, in its own space, ready to be intersected.
 #[derive(Clone, Debug)]
 pub enum Shape {
+    /// A sphere.
     Sphere(Sphere),
+    /// A box with faces along the axes.
     Box(AaBox),
+    /// An infinite plane.
     Plane(Plane),
+    /// One triangle, hit from both sides.
     Triangle(Triangle),
+    /// A cylinder closed at both ends.
     Cylinder(Cylinder),
+    /// A cone closed at its base.
     Cone(Cone),
     /// Shared by every instance of the mesh.
     Mesh(Arc<Mesh>),
 }
 
 impl Shape {
+    /// The nearest hit with `0 < t < t_max`, in the shape's own space, as the module's
+    /// contract describes it.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
         match self {
@@ -161,6 +178,7 @@ impl Shape {
         !matches!(self, Shape::Plane(_) | Shape::Triangle(_) | Shape::Mesh(_))
     }
 
+    /// A box holding the whole shape in its own space; infinite for a plane.
     pub fn bounds(&self) -> Aabb {
         match self {
             Shape::Sphere(s) => s.bounds(),

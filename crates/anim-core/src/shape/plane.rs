@@ -5,16 +5,23 @@ use glam::Vec3A;
 /// Infinite plane through `point` with unit `normal`.
 #[derive(Clone, Debug)]
 pub struct Plane {
+    /// A point the plane passes through.
     pub point: Vec3A,
+    /// The unit normal, reported for every hit whichever side the ray comes from.
     pub normal: Vec3A,
 }
 
 impl Plane {
+    /// The plane through `point` perpendicular to `normal`, which is made unit length.
+    /// `None` when `normal` cannot be normalised (zero or not finite) or `point` is not
+    /// finite.
     pub fn new(point: Vec3A, normal: Vec3A) -> Option<Self> {
         let normal = normal.try_normalize()?;
         point.is_finite().then_some(Plane { point, normal })
     }
 
+    /// The hit with `0 < t < t_max`, from either side. `None` as well for a ray parallel to
+    /// the plane, and for a hit point too far out to be held in f32.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
         let denom = ray.dir.dot(self.normal);

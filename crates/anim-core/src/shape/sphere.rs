@@ -2,9 +2,12 @@ use super::ShapeHit;
 use crate::math::{Aabb, Ray};
 use glam::{Mat4, Vec3A, Vec4};
 
+/// Sphere of `radius` around `center`.
 #[derive(Clone, Debug)]
 pub struct Sphere {
+    /// The centre.
     pub center: Vec3A,
+    /// The radius, positive and finite.
     pub radius: f32,
 }
 
@@ -15,6 +18,7 @@ impl Sphere {
             .then_some(Sphere { center, radius })
     }
 
+    /// The cube that holds the sphere, touching it at the middle of every face.
     pub fn bounds(&self) -> Aabb {
         Aabb::new(
             self.center - Vec3A::splat(self.radius),
@@ -79,6 +83,7 @@ pub struct SphereRay {
 }
 
 impl SphereRay {
+    /// `ray`, ready to be tested against four spheres at once.
     #[inline]
     pub fn new(ray: &Ray) -> SphereRay {
         SphereRay {

@@ -12,10 +12,14 @@ use super::ShapeHit;
 use crate::math::{Aabb, Ray};
 use glam::{DVec3, Vec3A};
 
+/// Triangle with corners `v0`, `v1` and `v2`, hit from both sides.
 #[derive(Clone, Debug)]
 pub struct Triangle {
+    /// The first corner.
     pub v0: Vec3A,
+    /// The second corner.
     pub v1: Vec3A,
+    /// The third corner.
     pub v2: Vec3A,
     /// Unit geometric normal along `(v1 − v0) × (v2 − v0)`, computed once in f64.
     pub normal: Vec3A,
@@ -50,6 +54,7 @@ impl Triangle {
         })
     }
 
+    /// The smallest box holding the three corners.
     pub fn bounds(&self) -> Aabb {
         Aabb::from_points([self.v0, self.v1, self.v2])
     }

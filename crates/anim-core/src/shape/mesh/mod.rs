@@ -33,9 +33,11 @@ pub struct Mesh {
 /// Why vertex and index arrays cannot make a mesh.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum MeshError {
+    /// The triangle array is empty.
     NoTriangles,
     /// A triangle names a vertex beyond the position array.
     BadIndex,
+    /// A vertex position is not finite.
     NonFinite,
 }
 
@@ -90,10 +92,12 @@ impl Mesh {
         })
     }
 
+    /// How many triangles the mesh has.
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
     }
 
+    /// How many vertex positions the mesh holds, shared among its triangles.
     pub fn vertex_count(&self) -> usize {
         self.positions.len()
     }
@@ -110,6 +114,7 @@ impl Mesh {
             + self.bvh.bytes()
     }
 
+    /// The smallest box holding every triangle, in the mesh's own space.
     pub fn bounds(&self) -> Aabb {
         self.bounds
     }
@@ -176,11 +181,14 @@ impl fmt::Debug for Mesh {
 /// every instance of a shape draws from one set of arrays.
 #[derive(Clone)]
 pub struct MeshFile {
+    /// The path as the statement writes it; a relative one is taken from the scene file's
+    /// folder.
     pub file: String,
     loaded: Arc<OnceLock<Arc<Mesh>>>,
 }
 
 impl MeshFile {
+    /// The file named `file`, its mesh not loaded yet.
     pub fn new(file: impl Into<String>) -> MeshFile {
         MeshFile {
             file: file.into(),
@@ -195,6 +203,7 @@ impl MeshFile {
         m
     }
 
+    /// The loaded mesh; `None` until the scene builder has loaded it, or when it could not.
     pub fn mesh(&self) -> Option<&Arc<Mesh>> {
         self.loaded.get()
     }
