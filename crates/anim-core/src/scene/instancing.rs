@@ -24,6 +24,7 @@ use arrayvec::ArrayVec;
 /// The instanced part of a scene, shared by the jobs of a file.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Instanced {
+    /// Every composite kept once, by `Use::prototype`.
     pub prototypes: Vec<Prototype>,
     /// Uses at the top of the tree, in depth-first order; their `slot` is a slot of
     /// `Scene::transforms`.
@@ -56,6 +57,7 @@ pub struct Prototype {
 /// One place a prototype is listed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Use {
+    /// The prototype listed, by its index in `Instanced::prototypes`.
     pub prototype: u32,
     /// The slot its frame is in (of the scene at the top, local inside a prototype).
     pub slot: u32,
@@ -68,7 +70,9 @@ pub struct Use {
 /// Where one shape of an instanced composite is: the prototype leaf and its world frame.
 #[derive(Clone, Debug)]
 pub struct Placed<'s> {
+    /// The shape as the prototype holds it: its `transform` is a local slot of the prototype.
     pub instance: &'s Instance,
+    /// The shape's world transform, as the flattened tree would give it, moves included.
     pub transform: Transform,
     /// Depth-first number in the flattened tree.
     pub flat: u64,

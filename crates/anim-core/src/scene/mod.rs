@@ -17,11 +17,17 @@ use glam::{DVec3, Vec3};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+/// How a surface reflects light: the coefficients of the shading model (`docs/shading.md`
+/// §2 and §3), one value per RGB channel where the model has a colour.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
+    /// The name its definition gives it.
     pub name: String,
+    /// Ka: the ambient reflection coefficient, the share of the ambient light reflected.
     pub ka: Vec3,
+    /// Kd: the diffuse reflection coefficient.
     pub kd: Vec3,
+    /// Ks: the specular reflection coefficient, the strength of the Phong highlight.
     pub ks: Vec3,
     /// Phong exponent.
     pub m: f32,
@@ -55,6 +61,7 @@ impl Material {
 /// [`Scene::instance_name`], [`Scene::instance_loc`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Instance {
+    /// The primitive, in its object space: as its statement writes it, before `transform`.
     pub geometry: Geometry,
     /// Index into `Scene::materials`.
     pub material: usize,
@@ -174,8 +181,12 @@ impl Names {
 /// A point light, already in world space. Intensity is brightness · colour.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Light {
+    /// The name its definition gives it.
     pub name: String,
+    /// Where the light is, in world space.
     pub position: DVec3,
+    /// `I_l` of the shading model per channel, not limited to [0, 1]; it does not fall off
+    /// with distance.
     pub intensity: Vec3,
 }
 
@@ -183,11 +194,15 @@ pub struct Light {
 /// be unit length or orthogonal; the renderer re-orthonormalises them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
+    /// The name its definition gives it, by which `render` lines choose it.
     pub name: String,
     /// Full horizontal field of view in degrees.
     pub fov_x_deg: f64,
+    /// The eye point, in world space.
     pub eye: DVec3,
+    /// The direction the camera looks in, in world space.
     pub dir: DVec3,
+    /// The direction that shows as up in the image, in world space.
     pub up: DVec3,
 }
 
@@ -204,17 +219,25 @@ impl Camera {
     }
 }
 
+/// What there is to see: the placed shapes, their materials, the lights, the ambient light and
+/// the background, in world space.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Scene {
+    /// The materials, by `Instance::material`.
     pub materials: Vec<Material>,
     /// Shared by the jobs of a file: they differ only in their transforms.
     pub instances: Arc<Vec<Instance>>,
     /// World transforms of the instances, by `Instance::transform`; an empty table holds the
     /// identity in slot 0.
     pub transforms: Vec<Transform>,
+    /// The names of the objects and composite paths, for diagnostics; shared by the jobs.
     pub names: Arc<Names>,
+    /// The point lights.
     pub lights: Vec<Light>,
+    /// The ambient light `I_ambient` of the shading model, per channel.
     pub ambient: Vec3,
+    /// The radiance of rays that hit nothing, per channel, tone-mapped like every other; black
+    /// unless the file says otherwise.
     pub background: Vec3,
     /// Composites kept once and drawn by their uses (see [`Instanced`]); shared by the jobs.
     pub instanced: Arc<Instanced>,
@@ -296,14 +319,20 @@ impl Scene {
 /// One image to make: the scene as it stands at a `render` statement.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderJob {
+    /// The scene as it stands at the `render` line.
     pub scene: Scene,
+    /// The camera the `render` line names, placed as it stands there.
     pub camera: Camera,
     /// As written in the file (after repairs such as `image . ppm`); relative paths are
     /// resolved by the renderer against the output directory (the SDF file's by default).
     pub output: PathBuf,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Samples per pixel asked for by the `render` line itself.
     pub samples: Option<u32>,
+    /// Where the `render` line is; `None` for the image of a file without one (its first
+    /// camera, or the default one, at the default size).
     pub loc: Option<Loc>,
 }

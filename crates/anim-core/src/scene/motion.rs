@@ -25,6 +25,7 @@ pub enum Own {
     /// The same at every instant: an object placed by transform statements only, listed in
     /// a composite that moves.
     Still(DMat4),
+    /// Keyed by the object's `motion` lines and interpolated between the keys.
     Keys(MotionKeys),
 }
 
@@ -44,6 +45,8 @@ pub struct SlotMotion {
     pub parent: Option<u32>,
     /// The world transform of the (still) slot it is listed in, when `parent` is `None`.
     pub base: DMat4,
+    /// The object's own transform over the exposure, into the frame of the slot it is listed
+    /// in.
     pub own: Own,
 }
 
@@ -51,8 +54,13 @@ pub struct SlotMotion {
 /// scene's `Light::position` put it when the motion was built.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightMotion {
+    /// The light's transform over the exposure, from its `motion` lines, about its own
+    /// position.
     pub keys: MotionKeys,
+    /// The position its statement gives it, before any transform.
     pub local: DVec3,
+    /// The scene's `Light::position` when the motion was built (world space); the light moves
+    /// by its offset from this.
     pub placed: DVec3,
 }
 
@@ -60,10 +68,16 @@ pub struct LightMotion {
 /// eye the job's `Camera` had when the motion was built.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CameraMotion {
+    /// The camera's transform over the exposure, from its `motion` lines, about its eye.
     pub keys: MotionKeys,
+    /// The eye its statement gives, before any transform.
     pub eye: DVec3,
+    /// The viewing direction its statement gives, before any transform.
     pub dir: DVec3,
+    /// The up vector its statement gives, before any transform.
     pub up: DVec3,
+    /// The job's `Camera::eye` when the motion was built (world space); the eye moves by its
+    /// offset from this.
     pub placed_eye: DVec3,
 }
 
@@ -74,6 +88,7 @@ pub struct Motion {
     pub slots: Vec<Option<SlotMotion>>,
     /// By light (`Scene::lights`).
     pub lights: Vec<Option<LightMotion>>,
+    /// How the job's camera moves; `None` when it stands still.
     pub camera: Option<CameraMotion>,
     /// The transforms `Scene::transform_all` applied since, composed.
     pub after: Transform,
