@@ -15,12 +15,16 @@ use std::sync::Arc;
 /// A name used to refer to something defined elsewhere, kept with where it was written.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NameRef {
+    /// The name as written.
     pub name: String,
+    /// Where the name is written.
     pub loc: Loc,
 }
 
+/// One statement in canonical form, with where it was read.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Statement {
+    /// What the statement says.
     pub kind: StatementKind,
     /// Where the statement starts (its first token).
     pub loc: Loc,
@@ -44,7 +48,9 @@ impl Statement {
 /// starts and how many characters it covers. Its file and line are the statement's.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Span {
+    /// The column the token starts at, in characters from 1.
     pub col: u32,
+    /// How many characters the token covers.
     pub width: u32,
 }
 
@@ -85,6 +91,7 @@ pub struct FlatShapes {
 /// characters, and its statement starts with `define` (else it is kept as a [`Statement`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct FlatShape {
+    /// The primitive as its statement writes it, in object space.
     pub geometry: Geometry,
     name_start: u32,
     name_len: u32,
@@ -100,14 +107,21 @@ pub struct FlatShape {
 
 /// A primitive shape as its line is written, for [`FlatShapes::push_fitting`].
 pub struct FlatShapeLine<'a> {
+    /// The file the line is in.
     pub file: &'a Arc<Path>,
+    /// The name the statement gives the shape.
     pub name: &'a str,
+    /// The primitive, in object space.
     pub geometry: Geometry,
+    /// The name of the material the shape is drawn with.
     pub material: &'a str,
     /// The line, and the columns of its first token, name and material.
     pub line: u32,
+    /// The column the statement's first token starts at.
     pub col: u32,
+    /// The column the shape's name starts at.
     pub name_col: u32,
+    /// The column the material's name starts at.
     pub material_col: u32,
     /// Statements (other than the shapes kept apart) read before it.
     pub pos: usize,
@@ -129,10 +143,12 @@ const DEFINED_BEFORE: u32 = 1 << 31;
 const FIRST_WIDTH: u32 = "define".len() as u32;
 
 impl FlatShapes {
+    /// How many shapes are held.
     pub fn len(&self) -> usize {
         self.len
     }
 
+    /// Whether no shape is held.
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }
@@ -270,6 +286,7 @@ impl FlatShapes {
         std::mem::take(&mut self.chunks)
     }
 
+    /// The name the statement of `s` gives it.
     pub fn name(&self, s: &FlatShape) -> &str {
         let start = s.name_start as usize;
         self.names
@@ -292,10 +309,12 @@ impl FlatShapes {
         (s.material & !DEFINED_BEFORE) as usize
     }
 
+    /// How many distinct material names the shapes use: their ids run from 0 below this.
     pub fn material_count(&self) -> usize {
         self.materials.len()
     }
 
+    /// The material name of id `id`; empty for an id that names none.
     pub fn material_name(&self, id: usize) -> &str {
         self.materials.get(id).map_or("", String::as_str)
     }
@@ -390,61 +409,98 @@ impl FlatShapes {
     }
 }
 
+/// What a statement says: one case per canonical statement.
 #[derive(Clone, Debug, PartialEq)]
 pub enum StatementKind {
+    /// `define material`: a named material.
     Material(MaterialDef),
+    /// `define shape` of a primitive or a mesh: a named shape drawn with a material.
     Shape {
+        /// The name it defines.
         name: String,
+        /// The primitive, in its object space.
         geometry: Geometry,
+        /// The material it is drawn with.
         material: NameRef,
     },
+    /// `define shape composite`: a named group of shapes and composites defined before it.
     Composite {
+        /// The name it defines.
         name: String,
+        /// The shapes and composites it groups, as listed.
         children: Vec<NameRef>,
     },
+    /// `define light`: a named point light.
     Light(LightDef),
     /// Sets the scene's ambient light.
     Ambient(Vec3),
     /// Adds to the scene's ambient light (the lecture form `light [pos] [La] [Ld]`).
     AmbientAdd(Vec3),
+    /// Sets the colour of rays that hit nothing.
     Background(Vec3),
+    /// `define camera`: a named camera.
     Camera(CameraDef),
+    /// `transform`: places a shape, composite, light or camera by further operations.
     Transform {
+        /// The shape, composite, light or camera placed.
         target: NameRef,
+        /// The operations, in the order written.
         ops: Vec<TransformOp>,
     },
+    /// `render`: one image to make.
     Render(RenderDef),
     /// A thing's motion while the shutter is open (docs/scene-language.md §10).
     Motion(MotionDef),
 }
 
+/// A material as its line defines it, its extras read by the material layout (each field as
+/// in `crate::scene::Material`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MaterialDef {
+    /// The name it defines.
     pub name: String,
+    /// Ka, the ambient reflection coefficient per channel.
     pub ka: Vec3,
+    /// Kd, the diffuse reflection coefficient per channel.
     pub kd: Vec3,
+    /// Ks, the specular reflection coefficient per channel.
     pub ks: Vec3,
+    /// The Phong exponent.
     pub m: f32,
+    /// ρ, the share of light reflected as by a mirror, in [0, 1].
     pub reflectivity: f32,
+    /// α, the share of light the surface stops, in [0, 1]; 1 is opaque.
     pub opacity: f32,
+    /// η, the index of refraction; 1 when the line gives none.
     pub ior: f32,
 }
 
 /// A point light; intensity = brightness · colour.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightDef {
+    /// The name it defines.
     pub name: String,
+    /// Where the light is, before its transforms.
     pub position: DVec3,
+    /// The colour, per channel.
     pub color: Vec3,
+    /// The factor the colour is scaled by.
     pub brightness: f32,
 }
 
+/// A camera as its line defines it, before its transforms (`crate::scene::Camera` is the
+/// placed one).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CameraDef {
+    /// The name it defines, by which `render` lines choose it.
     pub name: String,
+    /// Full horizontal field of view in degrees.
     pub fov_x_deg: f64,
+    /// The eye point.
     pub eye: DVec3,
+    /// The direction the camera looks in.
     pub dir: DVec3,
+    /// The direction that shows as up in the image.
     pub up: DVec3,
 }
 
@@ -462,14 +518,19 @@ impl CameraDef {
     }
 }
 
+/// One operation of a `transform` or `motion` line.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum TransformOp {
+    /// A move by the vector.
     Translate(DVec3),
     /// Degrees about an axis (any length but zero).
     Rotate {
+        /// The angle in degrees, right-handed about `axis`.
         degrees: f64,
+        /// The direction of the axis, which passes through the origin.
         axis: DVec3,
     },
+    /// A scale by a factor per axis, about the origin; the reader refuses a zero factor.
     Scale(DVec3),
 }
 
@@ -477,17 +538,28 @@ pub enum TransformOp {
 /// its transforms followed by `ops` (docs/scene-language.md §10).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MotionDef {
+    /// The shape, composite, light or camera that moves.
     pub target: NameRef,
+    /// The instant `u`: the fraction of the exposure, 0 at shutter open and 1 at close.
     pub at: f64,
+    /// The operations that follow the target's transforms at that instant; none for where
+    /// the rest of the file puts it.
     pub ops: Vec<TransformOp>,
 }
 
+/// `render <camera> <file> <width> <height> [<samples>]`: one image to make.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderDef {
+    /// The camera to look through.
     pub camera: NameRef,
+    /// The image file as written, after repairs such as `image . ppm`; a relative path is
+    /// taken from the output directory.
     pub output: String,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Samples per pixel the line asks for; `None` when it asks for none.
     pub samples: Option<u32>,
 }
 

@@ -20,10 +20,13 @@ use std::sync::Arc;
 /// Meaning of the numbers after `m` in a material line (`--material-fields`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MaterialField {
+    /// ρ, the share of light reflected as by a mirror.
     Reflectivity,
+    /// α, the share of light the surface stops; 1 is opaque.
     Opacity,
     /// 1 − opacity.
     Transparency,
+    /// η, the index of refraction.
     Ior,
     /// Accepted and ignored.
     Roughness,
@@ -82,10 +85,14 @@ impl MaterialLayout {
     }
 }
 
+/// How files are read: the reading options of the command line.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LoadOptions {
+    /// Whether every warning is reported as an error (`--strict`).
     pub strict: bool,
+    /// How the numbers after `m` in material lines are read (`--material-fields`).
     pub material_fields: MaterialLayout,
+    /// How a transform statement composes with the ones before it (`--transform-order`).
     pub transform_order: TransformOrder,
     /// Whether a file whose images would be blank in `transform_order` but not in the other
     /// order is read in the other one (`--transform-order auto`, docs/scene-language.md §7).

@@ -54,7 +54,9 @@ pub struct Parsed {
     /// The primitive shapes of a file in which nothing refers to a shape by name, when the
     /// reader was asked to keep them apart (`parse_source`); else empty.
     pub shapes: FlatShapes,
+    /// The problems met while reading, warnings and errors alike.
     pub diagnostics: Vec<Diagnostic>,
+    /// What the reader left out that the scene builder must account for.
     pub omissions: Omissions,
     /// Lines with more tokens than a line may hold: (line, tokens on it).
     pub(in crate::sdf) overlong: Vec<(u32, usize)>,
