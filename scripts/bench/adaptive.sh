@@ -39,19 +39,9 @@ read -r W H <<<"${SIZE:-640 360}"
 IFS=';' read -r -a LADDER <<<"${LADDER---error 2.5;--error 3;--error 4;--error 64;--spp 1}"
 mkdir -p "$OUT"
 
-# A held-out stand-in for the mirror-and-glass room, so that tuning is not to one file: the
-# same room with the spheres, box and cylinder moved, a second (flat) mirror on the right
-# wall, the key light moved and another camera. Written, not shipped as a scene.
+# The held-out stand-in for the mirror-and-glass room (see its script).
 moved=$OUT/mirror-glass-moved.sdf
-sed -e 's/^define shape sphere ball .*/define shape sphere ball 1.6 1.2 -9 1.2 mirror/' \
-  -e 's/^define shape sphere lens .*/define shape sphere lens -1.2 1.3 -6 1.3 glass/' \
-  -e 's/^define shape box crate .*/define shape box crate -4.5 0 -12 -2.5 1.6 -10 green/' \
-  -e 's/^define shape cylinder post .*/define shape cylinder post 3.8 0 -12 3.8 3.6 -12 0.5 gold/' \
-  -e 's/^define light key .*/define light key -1 5.6 -4 1 0.95 0.9 0.9\
-define shape box mirror2 5.9 0.5 -13 5.95 4.5 -7 mirror/' \
-  -e 's/^define camera eye .*/define camera eye 55 -1.5 3.2 2.8 0.15 -0.2 -1 0 1 0/' \
-  -e 's/^render eye mirror-glass.png .*/render eye mirror-glass-moved.png 1280 720/' \
-  scenes/bench/mirror-glass.sdf >"$moved"
+"$root/scripts/bench/mirror-glass-moved.sh" "$moved"
 read -r -a SCENES <<<"${SCENES:-scenes/bench/mirror-glass.sdf $moved scenes/showcase.sdf}"
 
 # cpu_of LOG: user + sys seconds from a /usr/bin/time -f '%U %S' line (the last line).

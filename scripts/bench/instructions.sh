@@ -8,12 +8,15 @@
 #   scripts/bench/instructions.sh NEW [BASE]     # binaries; BASE adds a ratio column
 #
 # Environment: OUT (work folder, default target/bench-instructions), CASES (space-separated
-# names to run a subset). The scene set covers each kind of scene the core treats apart:
-# a handful of shapes (flat), a room of mirrors and glass (flat, deep trees), the showcase
-# (transformed shapes and glass under a hierarchy), random spheres from a thousand to a
-# hundred thousand (image tiles), a deep grid (camera packets), a mesh, instanced
-# composites and a motion-blurred frame; at one sample per pixel and at the default
-# adaptive settings.
+# names to run a subset), SET (which cases, default `core`):
+# - `core`: each kind of scene the render core treats apart: a handful of shapes (flat), a
+#   room of mirrors and glass (flat, deep trees), the showcase (transformed shapes and glass
+#   under a hierarchy), random spheres from a thousand to a hundred thousand (image tiles), a
+#   deep grid (camera packets), a mesh, instanced composites and a motion-blurred frame; at
+#   one sample per pixel and at the default adaptive settings;
+# - `pov`: the scenes and settings of scripts/bench/pov.sh (speed against POV-Ray);
+# - `adaptive`: the default and `--spp 1` runs of scripts/bench/adaptive.sh (time against
+#   error) on its three scenes at 640×360.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 new=${1:?usage: scripts/bench/instructions.sh NEW [BASE]}
@@ -52,8 +55,29 @@ lines.append("define shape composite root " + " ".join(uses))
 open(sys.argv[1], "w").write("\n".join(lines) + "\n")
 PY
 
+scripts=$root/scripts/bench
+"$scripts/mirror-glass-moved.sh" "$out/scenes/mirror-glass-moved.sdf"
+mg=$root/scenes/bench/mirror-glass.sdf
+
 # name | scene | options
-cases=(
+case ${SET:-core} in
+pov) cases=(
+  "assignment|$root/scenes/assignment.sdf|--spp 1 --width 1920 --height 1080"
+  "grid10k|$out/scenes/grid10k.sdf|--spp 1 --width 1280 --height 720"
+  "random1k|$out/scenes/random1k.sdf|--spp 1 --width 640 --height 360"
+  "random100k|$out/scenes/random100k.sdf|--spp 1 --width 640 --height 360"
+  "mirror-glass|$mg|--spp 9 --width 1280 --height 720"
+  "random1m|$out/scenes/random1m.sdf|--spp 1 --width 640 --height 360"
+) ;;
+adaptive) cases=(
+  "mirror-glass|$mg|--width 640 --height 360"
+  "mirror-glass-1|$mg|--spp 1 --width 640 --height 360"
+  "moved|$out/scenes/mirror-glass-moved.sdf|--width 640 --height 360"
+  "moved-1|$out/scenes/mirror-glass-moved.sdf|--spp 1 --width 640 --height 360"
+  "showcase|$root/scenes/showcase.sdf|--width 640 --height 360"
+  "showcase-1|$root/scenes/showcase.sdf|--spp 1 --width 640 --height 360"
+) ;;
+*) cases=(
   "assignment|$root/scenes/assignment.sdf|--spp 1 --width 640 --height 360"
   "mirror-glass-1|$root/scenes/bench/mirror-glass.sdf|--spp 1 --width 640 --height 360"
   "mirror-glass|$root/scenes/bench/mirror-glass.sdf|--width 640 --height 360"
@@ -66,7 +90,8 @@ cases=(
   "bunny|$root/scenes/bunny.sdf|--width 320 --height 180"
   "instanced|$out/scenes/instances.sdf|--width 160 --height 90 --max-memory 64M"
   "blur72|$out/scenes/blur/frame_0072.sdf|--width 320 --height 180"
-)
+) ;;
+esac
 
 # count BINARY NAME SCENE OPTIONS...: instructions of one render into $out/NAME.<tag>.
 count() {

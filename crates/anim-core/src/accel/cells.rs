@@ -207,6 +207,7 @@ impl DirectionCells {
         self.cells.iter().filter(|&&c| c != TOO_MANY).count() as f32 / self.cells.len() as f32
     }
 
+    /// Bytes the cells and their lists hold.
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of::<Self>() + (self.cells.len() + self.lists.len()) * 4
     }

@@ -43,13 +43,17 @@ const AROUND_TAN_MAX: f32 = 2.0;
 /// image's top-left corner.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImageView {
+    /// Where the rays start.
     pub eye: Vec3A,
     /// Unit view direction times the image-plane distance, in pixels.
     pub forward: Vec3A,
-    /// Unit vectors along the image's rows (rightwards) and columns (upwards).
+    /// Unit vector along the image's rows (rightwards).
     pub right: Vec3A,
+    /// Unit vector along the image's columns (upwards).
     pub up: Vec3A,
+    /// Half the image's width, in pixels.
     pub half_w: f32,
+    /// Half the image's height, in pixels.
     pub half_h: f32,
 }
 
@@ -462,6 +466,7 @@ impl ImageTiles {
         (self.holds_all && (beyond(x, self.width) || beyond(y, self.height))).then_some((&[], &[]))
     }
 
+    /// Bytes the tiles and their lists hold.
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of::<Self>() + (self.starts.len() + self.ids.len() + self.near.len()) * 4
     }

@@ -42,6 +42,8 @@ struct Node {
 }
 
 #[derive(Clone, Debug, Default)]
+/// The 4-wide bounding volume hierarchy over a set of primitives' world bounds, which
+/// rays walk front to back (see the module doc).
 pub struct Bvh {
     /// Depth-first: a node's children follow it (the root is node 0).
     nodes: Vec<Node>,
@@ -128,10 +130,13 @@ impl Bvh {
         bvh
     }
 
+    /// Whether it holds no primitive.
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
     }
 
+    /// Nodes in the tree (a measure of its depth and width, for the policy that picks
+    /// camera packets).
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }

@@ -17,11 +17,14 @@ pub struct PinholeCamera {
 /// Why a camera cannot make rays.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum CameraError {
+    /// The field of view is not between 0° and 180°.
     Fov,
+    /// The viewing direction is zero or parallel to the up vector.
     Orientation,
 }
 
 impl PinholeCamera {
+    /// The camera `cam` for an image of `width` × `height` pixels.
     pub fn new(cam: &Camera, width: u32, height: u32) -> Result<Self, CameraError> {
         if !(cam.fov_x_deg > 0.0 && cam.fov_x_deg < 180.0) {
             return Err(CameraError::Fov);

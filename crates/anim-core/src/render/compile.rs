@@ -45,8 +45,11 @@ pub enum Occlusion {
 /// is shaded.
 #[derive(Clone, Debug)]
 pub struct RenderScene {
+    /// What rays meet: the primitives and their hierarchy (camera-free, shared).
     pub geometry: Arc<Geometry>,
+    /// Where the rays whose start is known look their candidates up.
     pub view: View,
+    /// How what rays meet is shaded.
     pub shading: Shading,
 }
 

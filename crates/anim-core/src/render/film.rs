@@ -9,8 +9,11 @@ use std::path::Path;
 /// Linear (HDR) radiance per pixel, row 0 at the top: what the samplers fill.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HdrImage {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
+    /// Row-major, `width × height`, linear radiance per channel.
     pub pixels: Vec<Vec3>,
 }
 
@@ -39,9 +42,13 @@ pub fn tone3(c: Vec3A) -> Vec3A {
 /// One channel as stored in an 8-bit image: `round(255·tone(c))`.
 #[inline]
 pub fn tone_map_u8(c: f32) -> u8 {
-    // Black (and NaN) without the rounding: much of many images is black background.
+    // The ends without the rounding (much of many images is black background), and so that
+    // the division in `tone` is all that is left for the rest.
     if c.is_nan() || c <= 0.0 {
         return 0;
+    }
+    if c == f32::INFINITY {
+        return 255;
     }
     round_level(255.0 * tone(c))
 }
@@ -66,10 +73,15 @@ pub fn to_rgb8(img: &HdrImage) -> Vec<u8> {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// How an image file is encoded, from its extension.
 pub enum ImageFormat {
+    /// PNG, fast compression.
     Png,
+    /// Binary PPM (P6).
     PpmBinary,
+    /// ASCII PPM (P3, `--ppm-ascii`).
     PpmAscii,
+    /// Another format the `image` crate writes (BMP, JPEG, TGA).
     Other(image::ImageFormat),
 }
 
@@ -137,7 +149,9 @@ fn encode(
 /// that a later run can tell the file is still the one this run wrote.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ImageBytes {
+    /// Its length in bytes.
     pub len: u64,
+    /// The FNV-1a hash of its bytes.
     pub hash: u64,
 }
 

@@ -63,6 +63,7 @@ impl LastShadows {
 /// scratch its scene queries keep. The caches only save work, never change a value, so
 /// images do not depend on which worker traced which pixel.
 pub struct TraceState {
+    /// Rays traced so far.
     pub counts: RayCounts,
     shadows: [LastShadows; CACHED_LIGHTS],
     /// A light's term whose share of the pixel, lit, is below this is added as lit without
@@ -101,6 +102,7 @@ impl PixelPrior {
 /// Radiance along a camera ray and what the integrator found on its way.
 #[derive(Clone, Copy, Debug)]
 pub struct CameraSample {
+    /// Radiance arriving along the ray.
     pub radiance: Vec3A,
     /// The primitive hit ([`NO_HIT`] for the background), which adaptive sampling compares
     /// between neighbouring pixels.
@@ -188,8 +190,11 @@ impl KnownLit {
     };
 }
 
+/// The Whitted integrator over a compiled scene (docs/shading.md).
 pub struct Integrator<'a> {
+    /// What rays meet, and how it is shaded.
     pub scene: &'a RenderScene,
+    /// Most reflected or refracted bounces of a camera ray.
     pub max_depth: u32,
 }
 

@@ -44,13 +44,18 @@ use view::Viewpoint;
 /// How many rays of each kind a render traced.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RayCounts {
+    /// Rays from the camera.
     pub primary: u64,
+    /// Rays towards lights.
     pub shadow: u64,
+    /// Mirror rays.
     pub reflected: u64,
+    /// Rays through transparent surfaces.
     pub refracted: u64,
 }
 
 impl RayCounts {
+    /// Rays of every kind.
     pub fn total(&self) -> u64 {
         self.primary + self.shadow + self.reflected + self.refracted
     }
@@ -74,7 +79,9 @@ impl std::ops::AddAssign for RayCounts {
 /// One rendered image and what it took.
 #[derive(Clone, Debug)]
 pub struct Rendered {
+    /// Linear radiance of every pixel.
     pub image: HdrImage,
+    /// The rays traced.
     pub rays: RayCounts,
     /// Camera samples traced per pixel, on average.
     pub mean_spp: f64,
@@ -93,6 +100,7 @@ pub struct Prepared<'j> {
     job: &'j RenderJob,
     /// The scene and camera moved, or `None` when the eye is at the origin already.
     rebased: Option<(Scene, Camera)>,
+    /// The camera-free geometry, shared by the probe and the render.
     pub geometry: Arc<Geometry>,
     /// Shapes that became degenerate once transformed (in f32) and were left out.
     pub dropped: Vec<Dropped>,

@@ -13,9 +13,13 @@ pub struct RenderSettings {
     pub error: Option<f32>,
     /// Adaptive sampling's most samples for one pixel.
     pub max_spp: Option<u32>,
+    /// Every image's width, overriding the render statements'.
     pub width: Option<u32>,
+    /// Every image's height, overriding the render statements'.
     pub height: Option<u32>,
+    /// Most reflected or refracted bounces of a camera ray.
     pub max_depth: u32,
+    /// Write `.ppm` images as ASCII (P3) rather than binary (P6).
     pub ppm_ascii: bool,
     /// Images go here instead of beside the scene file.
     pub out_dir: Option<PathBuf>,
@@ -52,7 +56,12 @@ pub enum Sampling {
     /// The same count everywhere: the centre for 1, a k×k grid for k², Hammersley otherwise.
     Uniform(u32),
     /// A centre sample everywhere, then scrambled Sobol samples where a pixel needs them.
-    Adaptive { error: f32, max_spp: u32 },
+    Adaptive {
+        /// The target error of a refined pixel, in 8-bit levels.
+        error: f32,
+        /// The most samples one pixel may take.
+        max_spp: u32,
+    },
 }
 
 impl Sampling {

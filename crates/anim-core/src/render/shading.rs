@@ -10,12 +10,19 @@ use std::sync::Arc;
 /// A material as the integrator reads it; reflectivity and opacity clamped to [0, 1].
 #[derive(Clone, Debug)]
 pub struct ShadeMaterial {
+    /// Ambient reflectance, per channel.
     pub ka: Vec3A,
+    /// Diffuse reflectance, per channel.
     pub kd: Vec3A,
+    /// Specular reflectance, per channel.
     pub ks: Vec3A,
+    /// Phong exponent of the highlight.
     pub m: f32,
+    /// Share of light mirrored, in [0, 1].
     pub reflectivity: f32,
+    /// Share of light the surface stops, in [0, 1] (1: opaque).
     pub opacity: f32,
+    /// Index of refraction of what the surface encloses.
     pub ior: f32,
 }
 
@@ -32,6 +39,7 @@ impl ShadeMaterial {
         }
     }
 
+    /// Whether light passes through it.
     pub fn is_transparent(&self) -> bool {
         self.opacity < 1.0
     }
@@ -40,16 +48,22 @@ impl ShadeMaterial {
 /// A point light: where it is (in the middle of the exposure, if it moves) and its intensity.
 #[derive(Clone, Debug)]
 pub struct PointLight {
+    /// Where it is (camera-relative).
     pub position: Vec3A,
+    /// Brightness times colour, per channel.
     pub intensity: Vec3A,
 }
 
 /// Materials, lights, ambient and background of a compiled scene.
 #[derive(Clone, Debug)]
 pub struct Shading {
+    /// Every material, by index.
     pub materials: Vec<ShadeMaterial>,
+    /// Every light.
     pub lights: Vec<PointLight>,
+    /// The ambient light, per channel.
     pub ambient: Vec3A,
+    /// What a ray that meets nothing sees.
     pub background: Vec3A,
     /// Whether a material some primitive draws with lets light through: if not, shadow rays
     /// stop at the first hit.

@@ -20,7 +20,9 @@ pub enum Candidates<'a> {
     /// distance no hit in it comes closer than, groups nearest first, and the groups past
     /// the closest hit so far (or past the ray's end) are not tested.
     Listed {
+        /// Bounded primitives (padded with a never-hit number to whole groups of four).
         ids: &'a [u32],
+        /// Per group of four, a distance none of them comes closer than (groups nearest first).
         near: Option<&'a [f32]>,
     },
 }

@@ -135,6 +135,7 @@ impl Instances {
             })
     }
 
+    /// Top-level uses of composites.
     pub fn uses(&self) -> usize {
         self.scene.instanced.uses.len()
     }

@@ -127,7 +127,9 @@ pub struct Geometry {
 /// A primitive that could not be placed (degenerate after transformation).
 #[derive(Clone, Debug)]
 pub struct Dropped {
+    /// The path of the shape through the composite tree.
     pub instance: String,
+    /// Where the shape is defined.
     pub loc: Option<crate::diag::Loc>,
 }
 
@@ -269,6 +271,7 @@ impl Geometry {
         self.material.len()
     }
 
+    /// Whether there is no primitive.
     pub fn is_empty(&self) -> bool {
         self.material.is_empty()
     }

@@ -559,6 +559,7 @@ impl Moving {
         })
     }
 
+    /// Bytes the moving part holds.
     pub fn memory_bytes(&self) -> usize {
         self.entries.capacity() * 4
             + self.sweep.capacity() * 4
@@ -659,6 +660,7 @@ fn reach_of(poses: &[Option<Pose>]) -> Option<Pose> {
 /// What [`swept_bounds`] finds of a moving box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Swept {
+    /// A box that holds the shape over the whole exposure.
     pub bounds: Aabb,
     /// The longest way a corner of the box travels over the exposure (through the instants).
     pub path: f64,

@@ -11,7 +11,9 @@ use glam::{Affine3A, DVec3, Mat3A, Vec3A};
 /// The kept hit of a closest-hit query, in world space.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceHit {
+    /// Distance along the ray (world units).
     pub t: f32,
+    /// The hit point, in world space.
     pub point: Vec3A,
     /// Unit geometric normal, outward for closed shapes (not flipped towards the ray).
     pub normal: Vec3A,
@@ -258,10 +260,15 @@ impl ObjectSpace {
 }
 
 #[derive(Clone, Debug)]
+/// A shape placed in the world: baked into world space, or kept in its own space with
+/// the transform that places it (see the module doc).
 pub struct Primitive {
+    /// The shape, in world space when baked, else in its own space.
     pub shape: Shape,
     object: Option<Box<ObjectSpace>>,
+    /// Index of its material in the compiled scene.
     pub material: u32,
+    /// World bounds (infinite for a plane).
     pub bounds: Aabb,
 }
 
@@ -468,6 +475,7 @@ impl Primitive {
         self.hit(ray, t_max).map(|h| self.surface(&h))
     }
 
+    /// Whether its bounds are finite (a plane's are not).
     pub fn is_bounded(&self) -> bool {
         self.bounds.is_finite()
     }

@@ -53,6 +53,7 @@ pub struct PixelPattern {
 }
 
 impl PixelPattern {
+    /// The pattern of pixel (`x`, `y`).
     pub fn new(x: u32, y: u32) -> Self {
         let base = mix64(((y as u64) << 32 | x as u64) ^ 0x5eed_a11a_5eed_a11a);
         PixelPattern {
@@ -231,7 +232,9 @@ const NET_DECAY: f32 = 0.594_603_56; // 2^(-3/4)
 /// consulted so that two halves agreeing by chance cannot stop a pixel alone.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Moments {
+    /// Samples added.
     pub n: u32,
+    /// Their sum (linear radiance).
     pub sum: Vec3A,
     tone_sum: Vec3A,
     /// `tone_sum` when `n` was last a power of two.
@@ -242,6 +245,7 @@ pub struct Moments {
 
 impl Moments {
     #[inline]
+    /// Adds sample `c` (linear radiance).
     pub fn add(&mut self, c: Vec3A) {
         self.n += 1;
         self.sum += c;
@@ -271,6 +275,7 @@ impl Moments {
         }
     }
 
+    /// The mean of the samples added (linear radiance).
     pub fn mean(&self) -> Vec3A {
         self.sum / self.n.max(1) as f32
     }
