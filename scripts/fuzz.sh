@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs the fuzz harness of tests/fuzz.rs (SDF reader and RON spec reader) in release mode.
+# Runs the fuzz harness of tests/hostile/fuzz.rs (SDF reader and RON spec reader) in release mode.
 #
 #   scripts/fuzz.sh [--execs N] [--seed S] [--corpus DIR] [--timeout-ms MS] [--out DIR]
 #
@@ -31,4 +31,4 @@ abs() { case "$1" in /*) echo "$1" ;; *) echo "$PWD/$1" ;; esac; }
 
 FUZZ_EXECS=$execs FUZZ_SEED=$seed FUZZ_CORPUS=$(abs "$corpus") \
 FUZZ_TIMEOUT_MS=$timeout_ms FUZZ_OUT=$(abs "$out") \
-    nice -n 10 cargo test --release --test fuzz -- --ignored --exact fuzz --nocapture
+    nice -n 10 cargo test --release --test hostile -- --ignored --exact fuzz::fuzz --nocapture

@@ -13,7 +13,7 @@
 # Environment: ANIM, READER. With READER=1, first the reader alone (the source tree's
 # `parse_source`, no scene building) and then the whole loader (`load_file`: reading the file,
 # parsing and building the scene) on a million-sphere file, in lines per CPU-second of the
-# reading thread: two ignored tests of tests/scale.rs, run with `cargo test --release` (so
+# reading thread: two ignored tests of tests/hostile/scale.rs, run with `cargo test --release` (so
 # READER=1 always builds from the source tree, whatever ANIM says).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -36,8 +36,8 @@ if [ -z "$bin" ]; then
     fi
 fi
 if [ "${READER:-0}" = 1 ]; then
-    cargo test --release --manifest-path "$root/Cargo.toml" --test scale -- --ignored --nocapture \
-        --test-threads 1 lines_a_second 2>&1 | grep -E "^(reader|loader):|panicked|FAILED" || true
+    cargo test --release --manifest-path "$root/Cargo.toml" --test hostile -- --ignored --nocapture \
+        --test-threads 1 scale::the_ 2>&1 | grep -E "^(reader|loader):|panicked|FAILED" || true
 fi
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT

@@ -4,6 +4,7 @@
 //! in the same depth-first order, so their images must be the same bytes.
 #![allow(dead_code)]
 
+use anim_core::util::SplitMix64;
 use std::fmt::Write;
 
 pub enum Kind {
@@ -99,19 +100,15 @@ impl Tree {
     }
 }
 
-struct Lcg(u64);
+/// Scene-text numbers drawn from the one test generator.
+trait SceneNumbers {
+    /// A number in [`lo`, `hi`), written with three decimals.
+    fn num(&mut self, lo: f64, hi: f64) -> String;
+}
 
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-
+impl SceneNumbers for SplitMix64 {
     fn num(&mut self, lo: f64, hi: f64) -> String {
-        format!("{:.3}", lo + (hi - lo) * self.next())
+        format!("{:.3}", self.range(lo, hi))
     }
 }
 
@@ -132,7 +129,7 @@ pub const MATERIALS: &str = "define material m0 0.1 0.1 0.1 0.8 0.8 0.8 0.3 0.3 
 /// at exactly the same distance twice, the first listed winning), one of them also listed
 /// alone; a plane and a loose sphere at the top.
 pub fn mixed(seed: u64) -> Tree {
-    let mut r = Lcg(seed);
+    let mut r = SplitMix64::new(seed);
     let mut t = Tree::default();
     let mut part = Vec::new();
     for k in 0..20 {
@@ -210,7 +207,7 @@ pub fn mixed(seed: u64) -> Tree {
 
 /// The line (`<kind> <numbers…> <material>`) and transform operations of shape `k` of
 /// `mixed`'s part: each kind of shape in turn, some moved.
-fn part_shape(r: &mut Lcg, k: usize) -> (String, Vec<String>) {
+fn part_shape(r: &mut SplitMix64, k: usize) -> (String, Vec<String>) {
     let m = format!("m{}", k % 6);
     let (x, y, z) = (r.num(0.0, 10.0), r.num(0.0, 10.0), r.num(0.0, 10.0));
     match k % 7 {

@@ -1,5 +1,10 @@
 //! Helpers shared by the integration tests: run the real `anim` binary on SDF text and read
 //! back the image it wrote.
+//!
+//! Each test binary (a folder of tests/ with its `main.rs`) compiles this module with
+//! `#[path = "../common/mod.rs"] mod common;` and uses only some of its helpers; the others
+//! would be dead code in that binary, hence the `allow` (here, so that it covers `hdr` too and
+//! no declaration has to repeat it).
 #![allow(dead_code)]
 
 use assert_cmd::Command;
@@ -118,16 +123,6 @@ pub fn shared_dir(test: &str) -> Option<PathBuf> {
     }
     eprintln!("{test}: skipped: {} is missing", dir.display());
     None
-}
-
-/// FNV-1a, 64 bits: a stable fingerprint of bytes for manifests.
-pub fn fnv1a64(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    h
 }
 
 /// Every file below `dir`, recursively (nothing when it cannot be read).

@@ -3,14 +3,14 @@
 use super::*;
 use anim_core::accel::Bvh;
 
-fn random_scene(rng: &mut Rng, n: usize) -> Vec<Primitive> {
+fn random_scene(rng: &mut SplitMix64, n: usize) -> Vec<Primitive> {
     let mut prims = Vec::new();
     while prims.len() < n {
         let c = rng.vec(50.0);
         let geometry = match prims.len() % 3 {
             0 => Geometry::Sphere {
                 center: c,
-                radius: 0.2 + rng.next() * 2.0,
+                radius: 0.2 + rng.unit_f64() * 2.0,
             },
             1 => Geometry::Box {
                 p1: c,
@@ -22,7 +22,7 @@ fn random_scene(rng: &mut Rng, n: usize) -> Vec<Primitive> {
         };
         // Every seventh primitive rotated, so it keeps its matrix.
         let transform = if prims.len() % 7 == 3 {
-            let turn = Transform::rotate(10.0 + rng.next() * 70.0, DVec3::Y).unwrap();
+            let turn = Transform::rotate(10.0 + rng.unit_f64() * 70.0, DVec3::Y).unwrap();
             Transform::translate(c).then_after(&turn.then_after(&Transform::translate(-c)))
         } else {
             Transform::IDENTITY
@@ -36,7 +36,7 @@ fn random_scene(rng: &mut Rng, n: usize) -> Vec<Primitive> {
 
 #[test]
 fn wide_bvh_equals_brute_force_on_random_scenes() {
-    let mut rng = Rng(0x853C49E6748FEA9B);
+    let mut rng = SplitMix64::new(0x853C49E6748FEA9B);
     for n in [1, 5, 60, 1500] {
         let prims = random_scene(&mut rng, n);
         let bounds: Vec<_> = prims.iter().map(|p| p.bounds).collect();

@@ -11,7 +11,7 @@ use super::*;
 /// nothing, and the whole scene is tested).
 #[test]
 fn rays_through_direction_cells_meet_what_brute_force_meets() {
-    let mut rng = Rng(0x9E3779B97F4A7C15);
+    let mut rng = SplitMix64::new(0x9E3779B97F4A7C15);
     let mut blocked = 0;
     let mut clear = 0;
     let mut seen_hits = 0;
@@ -114,7 +114,7 @@ fn check_seen(render: &Compiled, prims: &[Primitive], ray: &Ray, i: usize) -> bo
 /// A ray from a random point of the scenes' region towards `light`, its start lifted off at
 /// random by up to 10⁻³ (as `SurfaceHit::spawn_ray` moves it) for two rays in three, and its
 /// length to the light.
-fn shadow_ray(rng: &mut Rng, light: Vec3A, i: usize) -> (Ray, f32) {
+fn shadow_ray(rng: &mut SplitMix64, light: Vec3A, i: usize) -> (Ray, f32) {
     let from = Vec3A::from((rng.vec(80.0) - DVec3::splat(15.0)).as_vec3());
     let dir = (light - from).normalize();
     let lift = Vec3A::from((rng.vec(2e-3) - DVec3::splat(1e-3)).as_vec3());
@@ -177,7 +177,7 @@ fn tally_shadows(
 /// are blocked exactly when brute force finds a hit before the light.
 #[test]
 fn rays_through_image_tiles_meet_what_brute_force_meets() {
-    let mut rng = Rng(0xD1B54A32D192ED03);
+    let mut rng = SplitMix64::new(0xD1B54A32D192ED03);
     let (mut blocked, mut clear, mut seen_hits) = (0, 0, 0);
     // Enough shapes for tiles around the lights too (64 bounded, `LIGHT_TILES_MIN`).
     let (mixed, mixed_transforms) = mixed_instances(&mut rng, 120);
@@ -188,7 +188,7 @@ fn rays_through_image_tiles_meet_what_brute_force_meets() {
         .map(|k| {
             let geometry = Geometry::Sphere {
                 center: rng.vec(30.0) + DVec3::splat(10.0),
-                radius: 0.5 + rng.next() * 2.0,
+                radius: 0.5 + rng.unit_f64() * 2.0,
             };
             Instance::new(geometry, k)
         })
@@ -208,7 +208,7 @@ fn rays_through_image_tiles_meet_what_brute_force_meets() {
             })
             .collect();
         let (scene, prims) = lit_scene(instances, transforms, &lights);
-        let mut camera = Camera::default_with_fov("c", 40.0 + 60.0 * rng.next());
+        let mut camera = Camera::default_with_fov("c", 40.0 + 60.0 * rng.unit_f64());
         camera.eye = DVec3::new(25.0, 25.0, 110.0) + rng.vec(10.0);
         camera.dir = DVec3::splat(25.0) - camera.eye + rng.vec(20.0);
         let (width, height) = (96, 54);
@@ -220,10 +220,10 @@ fn rays_through_image_tiles_meet_what_brute_force_meets() {
         // traces them), and of a run of 8 pixels of a row: each ray's hit is its own.
         for i in 0..300 {
             let (bx, by) = (
-                (rng.next() * 24.0) as u32 * 4,
-                (rng.next() * 13.0) as u32 * 4,
+                (rng.unit_f64() * 24.0) as u32 * 4,
+                (rng.unit_f64() * 13.0) as u32 * 4,
             );
-            let (dx, dy) = (rng.next() as f32, rng.next() as f32);
+            let (dx, dy) = (rng.unit_f64() as f32, rng.unit_f64() as f32);
             let at = |k: u32, w: u32| (bx + k % w) as f32 + dx;
             let block: [Ray; 16] =
                 std::array::from_fn(|k| rays.ray(at(k as u32, 4), (by + k as u32 / 4) as f32 + dy));
@@ -248,8 +248,8 @@ fn rays_through_image_tiles_meet_what_brute_force_meets() {
         }
         for i in 0..4000 {
             let (x, y) = (
-                rng.next() as f32 * 100.0 - 2.0,
-                rng.next() as f32 * 58.0 - 2.0,
+                rng.unit_f64() as f32 * 100.0 - 2.0,
+                rng.unit_f64() as f32 * 58.0 - 2.0,
             );
             let ray = if i % 9 == 8 {
                 random_ray(&mut rng, i)
@@ -291,7 +291,7 @@ fn direction_cells_in_a_frame_with_motion_answer_as_the_hierarchy() {
         motion slide 0 translate -1 0 0\nmotion slide 0.5\nmotion slide 1 translate 6 0 0\n\
         motion blade 0 rotate -40 0 0 1\nmotion blade 0.5\nmotion blade 1 rotate 40 0 0 1\n\
         motion pair 0 translate 0 2 0\nmotion pair 0.5\nmotion pair 1 translate 0 -0.4 3\n";
-    let mut rng = Rng(0xA0761D6478BD642F);
+    let mut rng = SplitMix64::new(0xA0761D6478BD642F);
     let (mut moving_hits, mut blocked, mut clear) = (0, 0, 0);
     for light_moves in [false, true] {
         let motion = if light_moves {
@@ -306,7 +306,7 @@ fn direction_cells_in_a_frame_with_motion_answer_as_the_hierarchy() {
         let lights = if light_moves { 0 } else { 2 };
         assert_eq!(render.scene.view.kept(), (lights, true));
         for i in 0..4000 {
-            let time = rng.next() as f32;
+            let time = rng.unit_f64() as f32;
             // Mostly across the image, some anywhere.
             let spread = if i % 5 == 4 { 2.0 } else { 0.7 };
             let towards = rng.vec(spread) - DVec3::new(spread / 2.0, spread / 2.0, 1.0);

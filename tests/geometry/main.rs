@@ -22,6 +22,7 @@ use anim_core::render::shading::PointLight;
 use anim_core::render::view::Viewpoint;
 use anim_core::scene::{Camera, Instance, Material, Scene};
 use anim_core::shape::Geometry;
+use anim_core::util::SplitMix64;
 use glam::{DVec3, Vec3, Vec3A};
 
 /// A compiled scene with a scratch of its own, asked what the renderer asks it.
@@ -123,28 +124,25 @@ fn viewpoint_at(eye: Vec3A, motion: bool) -> Viewpoint {
     viewpoint(&camera, (64, 48), motion)
 }
 
-struct Rng(u64);
+/// Test points from the one test generator.
+trait Points {
+    /// A point in the cube [0, `scale`)³.
+    fn vec(&mut self, scale: f64) -> DVec3;
+}
 
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-
+impl Points for SplitMix64 {
     fn vec(&mut self, scale: f64) -> DVec3 {
-        DVec3::new(self.next(), self.next(), self.next()) * scale
+        DVec3::new(self.unit_f64(), self.unit_f64(), self.unit_f64()) * scale
     }
 }
 
-fn random_ray(rng: &mut Rng, i: usize) -> Ray {
+fn random_ray(rng: &mut SplitMix64, i: usize) -> Ray {
     let o = rng.vec(80.0) - DVec3::splat(15.0);
     let mut dir = (rng.vec(50.0) - o).normalize();
     if i.is_multiple_of(4) {
         // Axis-parallel: direction components of exactly zero.
         dir = DVec3::ZERO;
-        dir[i / 4 % 3] = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+        dir[i / 4 % 3] = if rng.unit_f64() < 0.5 { 1.0 } else { -1.0 };
     }
     Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(dir.as_vec3()))
 }
@@ -174,7 +172,7 @@ fn brute_closest(prims: &[Primitive], ray: &Ray, t_limit: f32) -> Option<(usize,
 /// kinds), with boxes, triangles, rotated and stretched shapes, an exact duplicate sphere (a
 /// tie) and a plane. Instance `i` has material `i`, which names it after renumbering.
 /// Each instance has its own transform slot, with the same index.
-fn mixed_instances(rng: &mut Rng, n: usize) -> (Vec<Instance>, Vec<Transform>) {
+fn mixed_instances(rng: &mut SplitMix64, n: usize) -> (Vec<Instance>, Vec<Transform>) {
     let mut transforms = Vec::new();
     let mut push = |out: &mut Vec<Instance>, geometry: Geometry, transform: Transform| {
         let material = out.len();
@@ -186,8 +184,8 @@ fn mixed_instances(rng: &mut Rng, n: usize) -> (Vec<Instance>, Vec<Transform>) {
     let mut out = Vec::new();
     for i in 0..n {
         let c = rng.vec(50.0);
-        let spin = |rng: &mut Rng| {
-            let turn = Transform::rotate(10.0 + rng.next() * 70.0, DVec3::Y).unwrap();
+        let spin = |rng: &mut SplitMix64| {
+            let turn = Transform::rotate(10.0 + rng.unit_f64() * 70.0, DVec3::Y).unwrap();
             Transform::translate(c).then_after(&turn.then_after(&Transform::translate(-c)))
         };
         match i % 10 {
@@ -212,7 +210,7 @@ fn mixed_instances(rng: &mut Rng, n: usize) -> (Vec<Instance>, Vec<Transform>) {
                     &mut out,
                     Geometry::Sphere {
                         center: DVec3::ZERO,
-                        radius: 0.5 + rng.next(),
+                        radius: 0.5 + rng.unit_f64(),
                     },
                     Transform::translate(c).then_after(&stretch),
                 )
@@ -221,7 +219,7 @@ fn mixed_instances(rng: &mut Rng, n: usize) -> (Vec<Instance>, Vec<Transform>) {
                 &mut out,
                 Geometry::Sphere {
                     center: c,
-                    radius: 0.2 + rng.next() * 2.0,
+                    radius: 0.2 + rng.unit_f64() * 2.0,
                 },
                 Transform::IDENTITY,
             ),
@@ -243,7 +241,7 @@ fn mixed_instances(rng: &mut Rng, n: usize) -> (Vec<Instance>, Vec<Transform>) {
 /// World-space axis-aligned boxes (tested by distance alone, the surface built for the
 /// winner): small ones, an exact duplicate (a tie), and rooms enclosing every ray origin,
 /// so that rays start inside boxes and leave through them.
-fn world_boxes(rng: &mut Rng, n: usize) -> (Vec<Instance>, Vec<Transform>) {
+fn world_boxes(rng: &mut SplitMix64, n: usize) -> (Vec<Instance>, Vec<Transform>) {
     let mut geometry: Vec<Geometry> = (0..n)
         .map(|_| {
             let c = rng.vec(50.0);

@@ -9,7 +9,7 @@ use anim_core::accel::Packet;
 /// rooms around every ray origin); `occluder` names a primitive that is really hit.
 #[test]
 fn render_scene_equals_brute_force_on_mixed_scenes() {
-    let mut rng = Rng(0x2545F4914F6CDD1D);
+    let mut rng = SplitMix64::new(0x2545F4914F6CDD1D);
     for (n, spheres_only) in [
         (4, false),
         (40, false),
@@ -33,7 +33,7 @@ fn render_scene_equals_brute_force_on_mixed_scenes() {
 
 /// `closest`, `intersect`, `occluded` and `occluder` of the render scene against brute force.
 fn check_render_scene(
-    rng: &mut Rng,
+    rng: &mut SplitMix64,
     n: usize,
     instances: Vec<Instance>,
     transforms: Vec<Transform>,
@@ -102,7 +102,7 @@ fn check_render_scene(
 /// some mixing octants, which go ray by ray): every ray's closest hit is `closest`'s to the
 /// bit, the same primitive included. Origins lie in `lo + [0, size)³`. Returns how many
 /// rays hit.
-fn check_packets(rng: &mut Rng, scene: &Compiled, lo: DVec3, size: DVec3) -> usize {
+fn check_packets(rng: &mut SplitMix64, scene: &Compiled, lo: DVec3, size: DVec3) -> usize {
     let (mut packets, mut hits) = (0, 0);
     for i in 0..1500 {
         let origin = lo + rng.vec(1.0) * size;
@@ -218,7 +218,7 @@ fn instanced_render_scene_equals_flattened_and_brute_force() {
         let (b, dropped_b) = Compiled::new(&flat, None);
         assert!(dropped_a.is_empty() && dropped_b.is_empty());
         assert!(a.scene.geometry.instance_uses() > 0);
-        let mut rng = Rng(seed.wrapping_mul(0x9E3779B97F4A7C15));
+        let mut rng = SplitMix64::new(seed.wrapping_mul(0x9E3779B97F4A7C15));
         let (mut hits, mut ties) = (0, 0);
         let mut same_id = std::collections::HashMap::new();
         let mut same_id_back = std::collections::HashMap::new();
@@ -228,7 +228,7 @@ fn instanced_render_scene_equals_flattened_and_brute_force() {
             let mut dir = (target - o).normalize();
             if i % 5 == 0 {
                 dir = DVec3::ZERO;
-                dir[i / 5 % 3] = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+                dir[i / 5 % 3] = if rng.unit_f64() < 0.5 { 1.0 } else { -1.0 };
             }
             let ray = Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(dir.as_vec3()));
             let t_limit = t_limit_of(i);

@@ -10,7 +10,7 @@ use super::*;
 fn proptest_primitives() -> &'static [(String, Primitive)] {
     static PRIMS: OnceLock<Vec<(String, Primitive)>> = OnceLock::new();
     PRIMS.get_or_init(|| {
-        let mut rng = Rng::new(0x9A9);
+        let mut rng = SplitMix64::new(0x9A9);
         let mut out = Vec::new();
         for kind in [
             Kind::Sphere,

@@ -18,9 +18,9 @@ fn sheared(factors: DVec3, before: (f64, DVec3), after: (f64, DVec3), shift: DVe
 /// Object-space points on the features of `obj` where spawning is hardest: vertices and edges
 /// exactly, points near them (log-uniformly 1e-7 … 1e-2 of the size away, along a face), and
 /// points on the faces.
-fn feature_points(obj: &Object, rng: &mut Rng) -> Vec<DVec3> {
+fn feature_points(obj: &Object, rng: &mut SplitMix64) -> Vec<DVec3> {
     let mut out = Vec::new();
-    let near = |rng: &mut Rng| rng.log_uniform(1e-7, 1e-2);
+    let near = |rng: &mut SplitMix64| rng.log_uniform(1e-7, 1e-2);
     match obj.geometry {
         Geometry::Cylinder { p1, p2, radius }
         | Geometry::Cone {
@@ -56,7 +56,7 @@ fn feature_points(obj: &Object, rng: &mut Rng) -> Vec<DVec3> {
                     };
                     out.push(rim + along_side * (axis.length() * near(rng)));
                     // On the cap and on the side, anywhere.
-                    out.push(end + radial * (radius * rng.unit()));
+                    out.push(end + radial * (radius * rng.unit_f64()));
                     let s = rng.range(0.05, 0.95);
                     out.push(if is_cone {
                         rim + (p2 - rim) * s
@@ -68,7 +68,7 @@ fn feature_points(obj: &Object, rng: &mut Rng) -> Vec<DVec3> {
         }
         Geometry::Box { p1, p2 } => {
             let (lo, hi) = (p1.min(p2), p1.max(p2));
-            let pick = |rng: &mut Rng, i: usize, mode: u64| match mode {
+            let pick = |rng: &mut SplitMix64, i: usize, mode: usize| match mode {
                 0 => lo[i],
                 1 => hi[i],
                 2 => lo[i] + (hi[i] - lo[i]) * near(rng),
@@ -77,7 +77,7 @@ fn feature_points(obj: &Object, rng: &mut Rng) -> Vec<DVec3> {
             };
             for _ in 0..16 {
                 // At least one coordinate on a face; the others anywhere, on or near an edge.
-                let on = rng.below(3) as usize;
+                let on = rng.below(3);
                 let mut p = DVec3::ZERO;
                 for i in 0..3 {
                     let mode = if i == on { rng.below(2) } else { rng.below(5) };
@@ -129,7 +129,7 @@ proptest! {
         after in (-180.0f64..180.0, axis()),
         shift in (axis(), 0.0f64..30.0),
     ) {
-        let mut rng = Rng::new(seed);
+        let mut rng = SplitMix64::new(seed);
         let obj = random_object(kind, &mut rng);
         let scale = 10f64.powf(log_scale);
         let factors = DVec3::new(log_factors.0.exp(), log_factors.1.exp(), log_factors.2.exp());

@@ -11,12 +11,13 @@
 //!   including rays along the axis and along a cone generator;
 //! - no primitive ever returns a NaN or infinite t, point or normal (proptest).
 //!
-//! Randomness is a seeded SplitMix64, so every failure message (kind, seed, object, ray)
+//! Randomness is the seeded `SplitMix64` of `anim_core::util`, so every failure message (kind, seed, object, ray)
 //! reproduces exactly.
 
 use anim_core::math::{Ray, Transform};
 use anim_core::render::geometry::{Primitive, SurfaceHit};
 use anim_core::scene::Geometry;
+use anim_core::util::SplitMix64;
 use glam::{DVec3, Vec3A};
 use proptest::prelude::*;
 use std::collections::HashMap;
@@ -35,40 +36,25 @@ mod watertight;
 // Deterministic randomness and helpers
 // ------------------------------------------------------------------------------------------
 
-/// SplitMix64 (Steele, Lea & Flood 2014): tiny, fast, and good enough to spread test cases.
-struct Rng(u64);
-
-impl Rng {
-    fn new(seed: u64) -> Self {
-        Rng(seed)
-    }
-
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-
-    fn log_uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        (lo.ln() + (hi.ln() - lo.ln()) * self.unit()).exp()
-    }
-
-    fn below(&mut self, n: u64) -> u64 {
-        self.next_u64() % n
-    }
-
+/// The draws these tests make, from the one test generator (SplitMix64, so a failure message
+/// that names its seed reproduces exactly).
+trait Draws {
+    /// Log-uniform in [`lo`, `hi`).
+    fn log_uniform(&mut self, lo: f64, hi: f64) -> f64;
     /// Uniform on the unit sphere.
+    fn direction(&mut self) -> DVec3;
+    /// Uniform in the unit ball.
+    fn in_ball(&mut self) -> DVec3;
+    /// A direction in the hemisphere around unit `axis`. Mostly uniform, but one in five is
+    /// grazing (cos θ log-uniform in 1e-6 … 0.1), where offsets are most likely to fail.
+    fn hemisphere(&mut self, axis: DVec3) -> DVec3;
+}
+
+impl Draws for SplitMix64 {
+    fn log_uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        (lo.ln() + (hi.ln() - lo.ln()) * self.unit_f64()).exp()
+    }
+
     fn direction(&mut self) -> DVec3 {
         let z = self.range(-1.0, 1.0);
         let phi = self.range(0.0, TAU);
@@ -76,18 +62,15 @@ impl Rng {
         DVec3::new(s * phi.cos(), s * phi.sin(), z)
     }
 
-    /// Uniform in the unit ball.
     fn in_ball(&mut self) -> DVec3 {
-        self.direction() * self.unit().cbrt()
+        self.direction() * self.unit_f64().cbrt()
     }
 
-    /// A direction in the hemisphere around unit `axis`. Mostly uniform, but one in five is
-    /// grazing (cos θ log-uniform in 1e-6 … 0.1), where offsets are most likely to fail.
     fn hemisphere(&mut self, axis: DVec3) -> DVec3 {
         let cos = if self.below(5) == 0 {
             self.log_uniform(1e-6, 0.1)
         } else {
-            self.unit()
+            self.unit_f64()
         };
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
         let phi = self.range(0.0, TAU);
@@ -142,9 +125,9 @@ struct Object {
     min_dim: f64,
 }
 
-fn random_object(kind: Kind, rng: &mut Rng) -> Object {
+fn random_object(kind: Kind, rng: &mut SplitMix64) -> Object {
     // Axis length and radius for cylinders and cones: slender to flat (ratio 1:20 … 5:1).
-    let axis = |rng: &mut Rng| {
+    let axis = |rng: &mut SplitMix64| {
         let len = rng.range(0.5, 2.0);
         let radius = len * rng.log_uniform(0.05, 5.0) * 0.5;
         let from = rng.in_ball() * 0.3;
@@ -213,7 +196,7 @@ fn random_object(kind: Kind, rng: &mut Rng) -> Object {
 }
 
 /// A point strictly inside a closed object (object space).
-fn interior_point(obj: &Object, rng: &mut Rng) -> DVec3 {
+fn interior_point(obj: &Object, rng: &mut SplitMix64) -> DVec3 {
     match obj.geometry {
         Geometry::Sphere { center, radius } => center + rng.in_ball() * (0.8 * radius),
         Geometry::Box { p1, p2 } => {
@@ -264,7 +247,7 @@ fn centre(obj: &Object) -> DVec3 {
 struct Placement {
     xf: Transform,
     /// Which of the four kinds of transform (see `random_placement`).
-    mode: u64,
+    mode: usize,
     /// Smallest per-axis scale factor (world units per object unit, at worst).
     s_min: f64,
 }
@@ -274,7 +257,12 @@ struct Placement {
 /// uniform scale and rotation: quadrics baked, box keeps its matrix; (2) non-uniform scale and
 /// rotation: every closed shape keeps its matrix; (3) non-uniform scale, no rotation: box
 /// baked, quadrics keep their matrix. Planes and triangles are always baked.
-fn random_placement(rng: &mut Rng, scale: f64, max_anisotropy: f64, max_shift: f64) -> Placement {
+fn random_placement(
+    rng: &mut SplitMix64,
+    scale: f64,
+    max_anisotropy: f64,
+    max_shift: f64,
+) -> Placement {
     let mode = rng.below(4);
     let factors = if mode < 2 {
         DVec3::ONE
@@ -493,7 +481,7 @@ impl Stats {
 }
 
 /// A ray from somewhere towards the object, so that its hit is a surface point on any part.
-fn aim(obj: &Object, xf: &Transform, rng: &mut Rng) -> Ray {
+fn aim(obj: &Object, xf: &Transform, rng: &mut SplitMix64) -> Ray {
     let (o, target) = match (&obj.geometry, obj.kind.is_closed()) {
         (_, true) => {
             if rng.below(2) == 0 {
@@ -517,7 +505,7 @@ fn aim(obj: &Object, xf: &Transform, rng: &mut Rng) -> Ray {
             },
             false,
         ) => {
-            let (mut s, mut t) = (rng.unit(), rng.unit());
+            let (mut s, mut t) = (rng.unit_f64(), rng.unit_f64());
             if s + t > 1.0 {
                 (s, t) = (1.0 - s, 1.0 - t);
             }

@@ -13,7 +13,7 @@ fn reintersection(
     points: usize,
     offset_factor: f32,
 ) -> Stats {
-    let mut rng = Rng::new(seed);
+    let mut rng = SplitMix64::new(seed);
     let mut stats = Stats {
         min_exit_ratio: f64::INFINITY,
         ..Stats::default()

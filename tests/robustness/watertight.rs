@@ -124,7 +124,7 @@ fn check_watertight(
     mesh: &Mesh,
     interior_radius: f64,
     xf: &Transform,
-    rng: &mut Rng,
+    rng: &mut SplitMix64,
 ) -> usize {
     let prims = placed_triangles(mesh, xf);
     // The vertices exactly as the baked triangles hold them.
@@ -166,7 +166,7 @@ fn check_watertight(
         for _ in 0..2 {
             // Uniform along the edge, or very close to one of its ends.
             let s = match rng.below(3) {
-                0 => rng.unit(),
+                0 => rng.unit_f64(),
                 1 => rng.log_uniform(1e-7, 1e-2),
                 _ => 1.0 - rng.log_uniform(1e-7, 1e-2),
             };
@@ -205,7 +205,7 @@ fn check_watertight(
 }
 
 fn watertight_placements() -> Vec<(String, Transform)> {
-    let mut rng = Rng::new(0x3A7E_0001 ^ soak());
+    let mut rng = SplitMix64::new(0x3A7E_0001 ^ soak());
     let mut out = vec![("identity".to_string(), Transform::IDENTITY)];
     for scale in [1e-3, 0.7, 1e2, 1e4] {
         let pl = random_placement(&mut rng, scale, 4.0, 10.0);
@@ -216,7 +216,7 @@ fn watertight_placements() -> Vec<(String, Transform)> {
 
 #[test]
 fn watertight_cube_mesh() {
-    let mut rng = Rng::new(0xC0BE ^ soak());
+    let mut rng = SplitMix64::new(0xC0BE ^ soak());
     let mesh = cube_mesh();
     let mut rays = 0;
     for (what, xf) in watertight_placements() {
@@ -230,7 +230,7 @@ fn watertight_cube_mesh() {
 #[test]
 fn watertight_uv_sphere_mesh() {
     let start = Instant::now();
-    let mut rng = Rng::new(0x5F3E ^ soak());
+    let mut rng = SplitMix64::new(0x5F3E ^ soak());
     let mesh = uv_sphere(64, 32);
     assert_eq!(mesh.triangles.len(), 2 * 64 * 31);
     let mut rays = 0;
@@ -257,7 +257,7 @@ fn watertight_uv_sphere_mesh() {
 /// normals, by the hit's own error bound over cos(θ/2) (`Primitive::surface`).
 #[test]
 fn quadric_apex_and_rims_are_watertight() {
-    let mut rng = Rng::new(0xED6E ^ soak());
+    let mut rng = SplitMix64::new(0xED6E ^ soak());
     let (mut rays, mut worst) = (0u64, 0.0f64);
     let mut spawned = Stats {
         min_exit_ratio: f64::INFINITY,
@@ -349,7 +349,7 @@ fn quadric_apex_and_rims_are_watertight() {
 
 /// The apex of `obj` (a cone's) and the points to aim at on it (object space): the apex and
 /// eight points at random angles around each rim.
-fn apex_and_rim_points(obj: &Object, rng: &mut Rng) -> (Option<DVec3>, Vec<DVec3>) {
+fn apex_and_rim_points(obj: &Object, rng: &mut SplitMix64) -> (Option<DVec3>, Vec<DVec3>) {
     let (ends, radius, apex) = match obj.geometry {
         Geometry::Cone { base, tip, radius } => (vec![base], radius, Some(tip)),
         Geometry::Cylinder { p1, p2, radius } => (vec![p1, p2], radius, None),

@@ -21,6 +21,7 @@ pub use report::{markdown, write_outputs};
 use anim_core::render::{self, film, RayCounts, RenderSettings};
 use anim_core::scene::RenderJob;
 use anim_core::sdf::LoadOptions;
+use anim_core::util::Fnv64;
 use cpu_time::ProcessTime;
 use metrics::ErrorStats;
 use std::fmt::Write as _;
@@ -287,20 +288,14 @@ pub fn load_scenes(dir: &Path, only: &[String]) -> Result<Vec<BenchScene>, Strin
     Ok(scenes)
 }
 
-/// FNV-1a, 64 bits: a stable content hash for cache keys (std's hasher may change between
-/// Rust releases, and the key only has to tell versions of a file apart, not resist attack).
-pub fn fnv1a64(parts: &[&[u8]]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+/// The cache key of `parts` (a file's bytes, a renderer's version, its settings): std's
+/// hasher may change between Rust releases, and the key only has to tell versions apart.
+pub fn cache_key(parts: &[&[u8]]) -> u64 {
+    let mut h = Fnv64::default();
     for part in parts {
-        for &b in *part {
-            h ^= u64::from(b);
-            h = h.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-        // Separate the parts so that ("ab", "c") and ("a", "bc") differ.
-        h ^= 0xff;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        h.write_part(part);
     }
-    h
+    h.finish()
 }
 
 /// An anim render's result with its cost.
@@ -360,7 +355,7 @@ fn anim_reference(
     progress: &mut dyn FnMut(&str),
 ) -> Result<(Vec<u8>, Reference), String> {
     let setting = Setting::Uniform(config.reference_spp);
-    let key = fnv1a64(&[
+    let key = cache_key(&[
         &scene.bytes,
         &config.width.to_le_bytes(),
         &config.height.to_le_bytes(),
@@ -508,9 +503,9 @@ mod tests {
     }
 
     #[test]
-    fn hash_separates_parts_and_is_stable() {
-        assert_ne!(fnv1a64(&[b"ab", b"c"]), fnv1a64(&[b"a", b"bc"]));
-        assert_eq!(fnv1a64(&[b"x"]), fnv1a64(&[b"x"]));
-        assert_ne!(fnv1a64(&[b"x"]), fnv1a64(&[b"y"]));
+    fn cache_keys_separate_parts_and_are_stable() {
+        assert_ne!(cache_key(&[b"ab", b"c"]), cache_key(&[b"a", b"bc"]));
+        assert_eq!(cache_key(&[b"x"]), cache_key(&[b"x"]));
+        assert_ne!(cache_key(&[b"x"]), cache_key(&[b"y"]));
     }
 }

@@ -7,7 +7,7 @@
 //! setting, merged with `c/(c+1)` by `povtonemap.py`, compared with the same merge of POV's
 //! own converged render (`+A0.0 +AM2 +R5`).
 
-use super::{fnv1a64, metrics, read_rgb8, BenchConfig, BenchScene, Reference, Renderer, Row};
+use super::{cache_key, metrics, read_rgb8, BenchConfig, BenchScene, Reference, Renderer, Row};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Instant;
@@ -258,7 +258,7 @@ fn measure_in(
 ) -> Result<(Reference, Vec<Row>), String> {
     let conv = convert(tools, scene, config, work)?;
     let script = std::fs::read(&tools.sdf2pov).unwrap_or_default();
-    let key = fnv1a64(&[
+    let key = cache_key(&[
         &scene.bytes,
         &script,
         tools.version.as_bytes(),

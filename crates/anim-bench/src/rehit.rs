@@ -25,6 +25,7 @@ use anim_core::render::geometry::{Scratch, SurfaceHit};
 use anim_core::render::integrator::fresnel;
 use anim_core::scene::RenderJob;
 use anim_core::shape::Shape;
+use anim_core::util::SplitMix64;
 use glam::Vec3A;
 use rayon::prelude::*;
 
@@ -63,27 +64,14 @@ impl RehitCount {
     }
 }
 
-/// SplitMix64: a fixed stream per pixel, so the count does not depend on the thread count.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
-    }
-
-    /// Uniform on the hemisphere around unit `axis`.
-    fn hemisphere(&mut self, axis: Vec3A) -> Vec3A {
-        let z = self.next();
-        let phi = std::f32::consts::TAU * self.next();
-        let s = (1.0 - z * z).max(0.0).sqrt();
-        let (u, v) = axis.any_orthonormal_pair();
-        (u * (s * phi.cos()) + v * (s * phi.sin()) + axis * z).normalize()
-    }
+/// Uniform on the hemisphere around unit `axis`, drawn from `rng`: each pixel has its own
+/// fixed stream, so the count does not depend on the thread count.
+fn hemisphere(rng: &mut SplitMix64, axis: Vec3A) -> Vec3A {
+    let z = rng.unit_f32();
+    let phi = std::f32::consts::TAU * rng.unit_f32();
+    let s = (1.0 - z * z).max(0.0).sqrt();
+    let (u, v) = axis.any_orthonormal_pair();
+    (u * (s * phi.cos()) + v * (s * phi.sin()) + axis * z).normalize()
 }
 
 struct Walk<'a> {
@@ -114,7 +102,7 @@ impl Walk<'_> {
         }
     }
 
-    fn trace(&self, ray: &Ray, depth: u32, rng: &mut Rng, out: &mut RehitCount) {
+    fn trace(&self, ray: &Ray, depth: u32, rng: &mut SplitMix64, out: &mut RehitCount) {
         let hint = RayHint::Secondary;
         let Some((prim, hit)) = self
             .scene
@@ -136,7 +124,7 @@ impl Walk<'_> {
             }
         }
         for side in [1.0, -1.0] {
-            let dir = rng.hemisphere(hit.normal * side);
+            let dir = hemisphere(rng, hit.normal * side);
             self.spawn(prim, &hit, dir, out);
         }
         let mirror = reflect(ray.dir, n);
@@ -181,7 +169,7 @@ pub fn count(
             };
             let mut out = RehitCount::default();
             for x in 0..width {
-                let mut rng = Rng(u64::from(y) << 32 | u64::from(x));
+                let mut rng = SplitMix64::new(u64::from(y) << 32 | u64::from(x));
                 let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
                 walk.trace(&ray, 0, &mut rng, &mut out);
             }

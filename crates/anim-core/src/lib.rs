@@ -5,6 +5,9 @@
 //! shading) → [`render`] image. [`load`] reads a file as its author meant it, looking
 //! through its cameras with the renderer where the transform order is in doubt.
 #![forbid(unsafe_code)]
+// The core's public items are its interface to the pipeline, the bench and the command: each
+// says what it is for (`cargo clippy -D warnings` makes a missing one an error).
+#![warn(missing_docs)]
 
 pub mod accel;
 pub mod diag;

@@ -582,13 +582,8 @@ mod tests {
     /// no split there.
     #[test]
     fn node_bounds_are_the_union_of_their_primitives() {
-        let mut state = 0x9E3779B97F4A7C15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = crate::util::SplitMix64::new(0x9E37_79B9_7F4A_7C15);
+        let mut next = || rng.unit_f32();
         let count = 3 * SAMPLED_MIN;
         let stride = count / SAMPLED_ITEMS;
         let far = (0..count)

@@ -471,19 +471,17 @@ mod tests {
     use super::*;
     use glam::Vec3A;
 
-    /// Test numbers (xorshift), shared with the packet tests.
-    pub(super) struct Rng(pub(super) u64);
+    pub(super) use crate::util::SplitMix64;
 
-    impl Rng {
-        pub(super) fn next(&mut self) -> f32 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 40) as f32 / (1u64 << 24) as f32
-        }
+    /// Test points from the one test generator, shared with the packet tests.
+    pub(super) trait Points {
+        /// A point in the cube [0, `scale`)³.
+        fn vec(&mut self, scale: f32) -> Vec3A;
+    }
 
-        pub(super) fn vec(&mut self, scale: f32) -> Vec3A {
-            Vec3A::new(self.next(), self.next(), self.next()) * scale
+    impl Points for SplitMix64 {
+        fn vec(&mut self, scale: f32) -> Vec3A {
+            Vec3A::new(self.unit_f32(), self.unit_f32(), self.unit_f32()) * scale
         }
     }
 
@@ -502,7 +500,7 @@ mod tests {
     }
 
     /// Boxes of many sizes, overlapping, some flat (zero extent on an axis).
-    fn random_boxes(rng: &mut Rng, n: usize) -> Vec<Aabb> {
+    fn random_boxes(rng: &mut SplitMix64, n: usize) -> Vec<Aabb> {
         (0..n)
             .map(|i| {
                 let p = rng.vec(40.0);
@@ -520,14 +518,14 @@ mod tests {
 
     /// Rays through the scene, a third of them axis-parallel (zero direction components),
     /// some starting exactly on box faces.
-    fn random_ray(rng: &mut Rng, boxes: &[Aabb], i: usize) -> Ray {
+    fn random_ray(rng: &mut SplitMix64, boxes: &[Aabb], i: usize) -> Ray {
         let o = rng.vec(60.0) - Vec3A::splat(10.0);
         let target = rng.vec(40.0);
         let mut dir = (target - o).normalize();
         if i.is_multiple_of(3) {
             let keep = i / 3 % 3;
             dir = Vec3A::ZERO;
-            dir[keep] = if rng.next() < 0.5 { 1.0 } else { -1.0 };
+            dir[keep] = if rng.unit_f32() < 0.5 { 1.0 } else { -1.0 };
         }
         let mut origin = o;
         if i.is_multiple_of(5) {
@@ -540,7 +538,7 @@ mod tests {
 
     #[test]
     fn closest_and_any_equal_brute_force() {
-        let mut rng = Rng(0x9E3779B97F4A7C15);
+        let mut rng = SplitMix64::new(0x9E3779B97F4A7C15);
         for boxes in [
             grid(6),
             random_boxes(&mut rng, 700),
@@ -569,7 +567,7 @@ mod tests {
     /// hits, and the sequence of primitives an any-hit query meets, are the same.
     #[test]
     fn offers_hits_in_the_binary_order() {
-        let mut rng = Rng(0xD1B54A32D192ED03);
+        let mut rng = SplitMix64::new(0xD1B54A32D192ED03);
         let boxes = random_boxes(&mut rng, 2000);
         let bin = BinaryBvh::build(&boxes, 0..boxes.len() as u32, usize::MAX);
         let wide = Bvh::from_binary(&bin);
@@ -623,7 +621,7 @@ mod tests {
 
     #[test]
     fn parallel_build_makes_the_same_tree() {
-        let mut rng = Rng(0x2545F4914F6CDD1D);
+        let mut rng = SplitMix64::new(0x2545F4914F6CDD1D);
         let boxes = random_boxes(&mut rng, 5000);
         let serial = BinaryBvh::build(&boxes, 0..boxes.len() as u32, usize::MAX);
         for threads in [1, 3] {
@@ -675,7 +673,7 @@ mod tests {
     /// new names) in the same order.
     #[test]
     fn renumbering_keeps_the_offer_order() {
-        let mut rng = Rng(0x94D049BB133111EB);
+        let mut rng = SplitMix64::new(0x94D049BB133111EB);
         let boxes = random_boxes(&mut rng, 1500);
         let bvh = Bvh::build(&boxes, 0..boxes.len() as u32);
         let mut renamed = bvh.clone();

@@ -63,7 +63,7 @@ pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnost
 /// Reads a whole text file of at most `limit` bytes. Larger files are refused from their
 /// size when the file system knows it, else after reading `limit + 1` bytes (pipes, devices),
 /// so memory never grows past the limit. A file with a NUL byte in its first
-/// [`TEXT_SNIFF_BYTES`] is "not a text file", found before the rest is read (`/dev/zero`
+/// `TEXT_SNIFF_BYTES` is "not a text file", found before the rest is read (`/dev/zero`
 /// fails at once). `what` names the file in messages ("file", "the spec").
 pub fn read_input(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Vec<Diagnostic>> {
     read_bounded(path, limit, what).map_err(|d| vec![*d])

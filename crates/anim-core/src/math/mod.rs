@@ -50,7 +50,7 @@ impl Ray {
 /// (Wächter & Binder, "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing
 /// Gems ch. 6). Transformed shapes add the error of the matrix product, hence the margin.
 ///
-/// Measured, not guessed (tests/robustness.rs; `offset_margin_sweep` spawns 2·10⁵ rays per
+/// Measured, not guessed (tests/robustness/; `offset_margin_sweep` spawns 2·10⁵ rays per
 /// shape kind with this offset scaled by 2⁻ᵏ, scales 1e-4…1e5, anisotropy ≤ 4, translations up
 /// to 30× the object size): the first self-intersections appear at 1/8 of this offset for
 /// spheres (so a 4× margin, the tightest), 1/16 for cylinders, 1/32 for boxes, planes and
@@ -259,14 +259,9 @@ mod tests {
         assert!(gamma(1) > UNIT_ROUNDOFF && gamma(1) < 1.000_001 * UNIT_ROUNDOFF);
         // The sum of 4 terms in f32 against the exact sum, at its worst over many draws.
         let mut worst = 0.0f64;
-        let mut x = 0x1234_5678u32;
+        let mut rng = crate::util::SplitMix64::new(0x1234_5678);
         for _ in 0..10_000 {
-            let mut next = || {
-                x ^= x << 13;
-                x ^= x >> 17;
-                x ^= x << 5;
-                (x as f32 / u32::MAX as f32 - 0.5) * 1e3
-            };
+            let mut next = || (rng.unit_f32() - 0.5) * 1e3;
             let t = [next(), next(), next(), next()];
             let sum32 = ((t[0] + t[1]) + t[2]) + t[3];
             let exact: f64 = t.iter().map(|&v| v as f64).sum();

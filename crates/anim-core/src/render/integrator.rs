@@ -59,7 +59,7 @@ impl LastShadows {
 }
 
 /// What one worker keeps between the rays it traces: its ray counts, per light the opaque
-/// primitive that last blocked a shadow ray (see [`Integrator::visibility`]), and the
+/// primitive that last blocked a shadow ray (see `Integrator::visibility`), and the
 /// scratch its scene queries keep. The caches only save work, never change a value, so
 /// images do not depend on which worker traced which pixel.
 pub struct TraceState {
@@ -162,7 +162,7 @@ impl TraceState {
     /// rays (most of them from deep inside glass and mirror trees, or for highlights of
     /// exponent 300 and more far from their peak) decide a term that could not move the
     /// pixel by half an 8-bit step even fully lit, the bound below which reflected and
-    /// refracted rays are not traced either ([`NEGLIGIBLE`]). Such a term is counted lit:
+    /// refracted rays are not traced either (`NEGLIGIBLE`). Such a term is counted lit:
     /// right for most of them, and off by less than that bound where it is not. Uniform
     /// sampling and adaptive sampling's first pass trace them all, so their images do not
     /// change.

@@ -299,13 +299,8 @@ fn shadow_through_glass_is_attenuated_per_surface_crossed() {
 /// share of the hierarchy included (a million spheres must fit a small process).
 #[test]
 fn a_world_space_sphere_costs_at_most_100_bytes() {
-    let mut state = 0x853C49E6748FEA9Bu64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = crate::util::SplitMix64::new(0x853C_49E6_748F_EA9B);
+    let mut next = move || rng.unit_f64();
     let n = 20_000;
     let instances: Vec<Instance> = (0..n)
         .map(|_| {

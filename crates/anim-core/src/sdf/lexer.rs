@@ -517,13 +517,8 @@ mod tests {
 
     #[test]
     fn short_decimals_read_as_the_standard_library_reads_them() {
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut rng = crate::util::SplitMix64::new(0x2545_F491_4F6C_DD1D);
+        let mut next = move || rng.next_u64();
         for _ in 0..200_000 {
             let r = next();
             let int = (r >> 20) % 10u64.pow((r % 9) as u32 + 1);
@@ -705,18 +700,11 @@ mod tests {
             "é",
             "sphere_name_long",
         ];
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut rng = crate::util::SplitMix64::new(0x2545_F491_4F6C_DD1D);
         for _ in 0..3000 {
             let mut text = String::new();
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let mut r = state;
-            for _ in 0..(r % 40) {
-                r = r
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                text.push_str(pieces[(r >> 33) as usize % pieces.len()]);
+            for _ in 0..rng.below(40) {
+                text.push_str(pieces[rng.below(pieces.len())]);
             }
             let mut seen = Vec::new();
             each_line(&text, |l| seen.push((l.number, l.text, l.tokens.clone())));

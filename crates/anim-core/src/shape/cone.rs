@@ -345,7 +345,7 @@ mod tests {
 
     #[test]
     fn pinned_apex_leak() {
-        // Found by tests/robustness.rs: a ray along the axis of a flat cone (slope 2.07) passes
+        // Found by tests/robustness/: a ray along the axis of a flat cone (slope 2.07) passes
         // the apex within f32 rounding; the side's near-double root had discriminant
         // −1.9e-6 against b² = 1.5e10, both roots were dropped, and the ray reported the base
         // cap from inside at t = 3.78 instead of the apex at t = 2.33.
@@ -366,7 +366,7 @@ mod tests {
 
     #[test]
     fn pinned_apex_root_rounded_below_zero() {
-        // Found by tests/robustness.rs: the double root at the apex was found but its height
+        // Found by tests/robustness/: the double root at the apex was found but its height
         // came out as z = −1.1e-16, just on the mirrored nappe, and was dropped: the ray
         // reported the base cap from inside at t = 3.85 instead of the apex at t = 2.52.
         let c = Cone::new(
@@ -386,7 +386,7 @@ mod tests {
 
     #[test]
     fn pinned_apex_double_root_below_zero() {
-        // Found by tests/robustness.rs: a ray aimed at the apex from off the axis (inside the
+        // Found by tests/robustness/: a ray aimed at the apex from off the axis (inside the
         // cone of entering directions). b² − 4ac rounded to exactly 0 and the merged root
         // landed at z = −8.1e-11, on the mirrored nappe: the ray entered unseen and reported
         // the base cap from inside at t = 1.67 instead of the apex at t = 0.247.

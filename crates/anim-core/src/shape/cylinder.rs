@@ -149,7 +149,7 @@ impl AxisFrame {
     /// face's normal only. At the cylinder's right-angled rims that leaves the origin as close
     /// to the other face as the point was, i.e. within rounding, so it can see itself enter
     /// through the other face at t ≈ 0; at the cone's acute base rim the offset even moves
-    /// it towards the other face (tests/robustness.rs `quadric_apex_and_rims_are_watertight`
+    /// it towards the other face (tests/robustness/ `quadric_apex_and_rims_are_watertight`
     /// found both, ~0.2 % of rays spawned from rim hits). A point exactly on the edge with a
     /// normal halfway between the faces' normals is safe both ways: that plane supports the
     /// convex solid, and the offset moves the origin off both faces. So hits within the band

@@ -215,13 +215,8 @@ mod tests {
     /// from near and far, inside and outside, grazing and non-unit.
     #[test]
     fn four_lanes_equal_the_scalar_test() {
-        let mut state = 0x9E3779B97F4A7C15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = crate::util::SplitMix64::new(0x9E37_79B9_7F4A_7C15);
+        let mut next = move || rng.unit_f32();
         let mut v = move || {
             let x = [next(), next(), next(), next()];
             (Vec3A::new(x[0], x[1], x[2]) * 2.0 - Vec3A::ONE, x[3])

@@ -1,6 +1,6 @@
-//! From scene files to image files: one scene file rendered and written ([`scene_file`]), and a
+//! From scene files to image files: one scene file rendered and written (`scene_file`), and a
 //! directory of animation frames rendered in parallel with unchanged frames skipped
-//! ([`dir`], records in [`cache`]). Nothing here prints: progress is reported through the
+//! (`dir`, records in `cache`). Nothing here prints: progress is reported through the
 //! [`ImageProgress`] and [`FrameObserver`] callbacks, and the command layer shows it.
 
 mod cache;

@@ -395,13 +395,13 @@ mod tests {
     use crate::math::Aabb;
     use glam::Vec3A;
 
-    use super::super::tests::{box_t, Rng};
+    use super::super::tests::{box_t, Points, SplitMix64};
 
     /// Packets of rays from one origin towards nearby targets (some axis-parallel, some with
     /// origins on box faces, some with limits): each ray is offered the same leaves in the
     /// same order, with the same `t_max`, as by its own walk, and any-hit answers agree.
     fn check<const N: usize>(seed: u64) {
-        let mut rng = Rng(seed);
+        let mut rng = SplitMix64::new(seed);
         let boxes: Vec<Aabb> = (0..1500)
             .map(|i| {
                 let p = rng.vec(40.0);

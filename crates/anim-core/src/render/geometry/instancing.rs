@@ -13,7 +13,7 @@
 //! does) and tested with the world ray as the flattened scene's primitive would be, so its
 //! hits are the same floats. Culling happens on a ray moved into the prototype's frame, whose
 //! rounding differs from the world ray's; boxes and distances are widened by
-//! [`CULL_MARGIN`] so that it never drops a shape the world test would hit.
+//! `CULL_MARGIN` so that it never drops a shape the world test would hit.
 
 use super::leaf::Best;
 use super::Primitive;

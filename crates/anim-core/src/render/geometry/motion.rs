@@ -128,7 +128,7 @@ impl Scratch {
 
     /// The largest angle (radians) swept, as the eye sees it, by the moving shapes that the
     /// queries may have met at some instant since [`Scratch::watch`] (see
-    /// [`Moving::met_by`]); 0 when they met none. Stops watching.
+    /// `Moving::met_by`); 0 when they met none. Stops watching.
     pub fn take_touched(&self) -> f32 {
         self.watched.replace(f32::NAN).max(0.0)
     }

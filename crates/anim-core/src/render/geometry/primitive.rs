@@ -569,13 +569,8 @@ mod tests {
         };
         let prim = Primitive::new(&geometry, &xf, 0).unwrap();
         let o = prim.object.as_deref().unwrap();
-        let mut x = 0x2545_F491_4F6C_DD1Du64;
-        let mut unit = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::util::SplitMix64::new(0x2545_F491_4F6C_DD1D);
+        let mut unit = || rng.unit_f64();
         let mut worst = 0.0f64;
         for _ in 0..20_000 {
             let p = Vec3A::new(

@@ -10,6 +10,7 @@
 //! The error of a pixel is estimated for its tone-mapped mean in 8-bit levels, the quantity
 //! the output is judged in, so the target `--error` means the same on dark and bright pixels.
 
+use crate::util::mix64;
 use glam::Vec3A;
 
 /// Fewest samples of a refined pixel: the first count at which two nested nets (2 and 4
@@ -37,14 +38,6 @@ pub const FLAT_CONTRAST: f32 = 2.0;
 const EDGE_ERROR_SHARE: f32 = 0.2;
 
 pub use crate::render::film::{tone, tone3};
-
-/// splitmix64's finaliser: a bijective mixer whose every output bit depends on every input bit.
-#[inline]
-fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
 
 /// The scramble of one pixel: one key per dimension, derived from the pixel position alone.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,6 +1,6 @@
-//! The RON keyframe spec: serde types as the user writes them ([`raw`]), the text with the
-//! position of every value ([`source`]), and the checks ([`validate`]) that turn them into an
-//! [`Animation`] ([`model`]) whose every problem is reported at its line and column.
+//! The RON keyframe spec: serde types as the user writes them (`raw`), the text with the
+//! position of every value (`source`), and the checks ([`validate`]) that turn them into an
+//! [`Animation`] (`model`) whose every problem is reported at its line and column.
 //!
 //! The format is documented for users in `README.md`.
 

@@ -3,7 +3,7 @@
 //! thousands of bad lines each end quickly with a clear message (or the right image), and
 //! nothing raw reaches the terminal.
 
-mod common;
+use crate::common;
 
 use common::{anim, compare, read_ppm};
 use std::path::{Path, PathBuf};

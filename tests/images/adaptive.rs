@@ -2,7 +2,7 @@
 //! ray count of the render summary), independence from the thread count, and the uniform
 //! modes left exactly as they were.
 
-mod common;
+use crate::common;
 use common::*;
 
 const W: usize = 40;

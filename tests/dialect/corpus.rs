@@ -1,7 +1,7 @@
 //! Every real-world scene file of `../shared/corpus/wild` either loads or is rejected with
 //! located errors, and none makes the reader panic.
 
-mod common;
+use crate::common;
 
 use anim_core::diag::Diagnostic;
 use anim_core::load::load_file;

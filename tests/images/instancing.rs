@@ -3,9 +3,9 @@
 //! memory budget its flattened tree would exceed a thousand times over; and a scene of shared
 //! composites renders to exactly the bytes of the same scene with every use written out.
 
-mod common;
+use crate::common;
 
-#[path = "common/composites.rs"]
+#[path = "../common/composites.rs"]
 mod composites;
 
 use common::{anim, read_ppm};

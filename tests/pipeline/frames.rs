@@ -351,7 +351,7 @@ fn generate_is_deterministic_atomic_and_trims_old_frames() {
     assert!(names.iter().all(|n| !n.contains(".tmp")), "{names:?}");
     // A shorter animation removes the frames it wrote past its end, so they are not rendered
     // by mistake; an image anim did not write is left alone (the renderer removes its own, see
-    // tests/hardening.rs).
+    // tests/hostile/hardening.rs).
     std::fs::write(frames_dir.join("frame_0011.png"), b"not anim's").expect("write");
     write_spec(8);
     let said = run();

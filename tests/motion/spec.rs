@@ -4,6 +4,7 @@
 use anim_core::math::Transform;
 use anim_core::sdf::ast::{Statement, StatementKind, TransformOp};
 use anim_core::sdf::LoadOptions;
+use anim_core::util::Fnv64;
 use assert_cmd::Command;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
@@ -20,14 +21,11 @@ fn frames_hash(dir: &Path) -> (usize, u64) {
         .filter(|p| p.extension().is_some_and(|e| e == "sdf"))
         .collect();
     names.sort();
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut h = Fnv64::default();
     for p in &names {
-        for &b in &std::fs::read(p).expect("frame") {
-            h ^= u64::from(b);
-            h = h.wrapping_mul(0x0000_0100_0000_01b3);
-        }
+        h.write(&std::fs::read(p).expect("frame"));
     }
-    (names.len(), h)
+    (names.len(), h.finish())
 }
 
 fn generate(spec: &Path, out: &Path) -> std::process::Output {

@@ -2,15 +2,19 @@
 //! from every spec in animations/) and every file of the shared corpus, rendered small by the
 //! real binary, with a fingerprint of each image's decoded pixels. Refactoring must not change
 //! a single pixel: the manifest is compared line by line, and it is rewritten only on purpose,
-//! with `ANIM_UPDATE_GOLDEN=1 cargo test --test golden` after a deliberate change of output.
+//! with `ANIM_UPDATE_GOLDEN=1 cargo test --test images golden` after a deliberate change of output.
 
-mod common;
+use crate::common;
 
-use common::{anim, fnv1a64, shared_dir};
+use anim_core::util::Fnv64;
+use common::{anim, shared_dir};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-const MANIFEST: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/golden/manifest.tsv");
+const MANIFEST: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/images/golden/manifest.tsv"
+);
 
 /// Small enough to keep the suite fast, big enough that every object covers pixels.
 const SIZE: [&str; 4] = ["--width", "48", "--height", "36"];
@@ -77,7 +81,7 @@ fn manifest_lines(label: &str, scene: &Path) -> String {
             image.file_name().unwrap().to_string_lossy(),
             decoded.width(),
             decoded.height(),
-            fnv1a64(decoded.as_raw())
+            Fnv64::of(decoded.as_raw())
         )
         .unwrap();
     }
@@ -172,7 +176,8 @@ fn every_scene_renders_the_pixels_of_the_golden_manifest() {
         eprintln!("wrote {MANIFEST}");
         return;
     }
-    let expected = std::fs::read_to_string(MANIFEST).expect("tests/golden/manifest.tsv exists");
+    let expected =
+        std::fs::read_to_string(MANIFEST).expect("tests/images/golden/manifest.tsv exists");
     let expected: Vec<&str> = expected
         .lines()
         .filter(|l| shared.is_some() || !l.starts_with("corpus/"))

@@ -2,7 +2,7 @@
 //! scenes/, animations/ and the shared corpus that loads is rendered small, and its HDR
 //! buffer (before tone mapping could hide a NaN as 0) is checked.
 
-mod common;
+use crate::common;
 
 use anim_core::load::load_file;
 use anim_core::render::{render_job, RenderSettings};

@@ -2,10 +2,10 @@
 //! 250 000 loads and renders, and a scene is refused only beyond the memory budget
 //! (`--max-memory`), with the memory it would need.
 
-mod common;
+use crate::common;
 
 use anim_core::limits::scene_memory;
-use anim_core::util::human_bytes;
+use anim_core::util::{human_bytes, SplitMix64};
 use common::{anim, read_ppm};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -95,13 +95,8 @@ fn random_spheres(n: usize) -> String {
     text.push_str(HEAD);
     text.push_str("define material blue 0 0 0.2 0.1 0.1 0.8 0.5 0.5 0.5 20\n");
     text.push_str("render eye out.png 640 360\n");
-    let mut state = 0x9E37_79B9_7F4A_7C15u64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = SplitMix64::new(0x9E37_79B9_7F4A_7C15);
+    let mut next = move || rng.unit_f64();
     for i in 0..n {
         let (x, y, z) = (
             next() * 200.0 - 100.0,
@@ -125,7 +120,7 @@ fn random_spheres(n: usize) -> String {
 /// CPU-second of the loading thread; it fails below 1.5 M lines/s (BENCHMARKS.md §10: about
 /// 2 M measured, 1 M before the reader took flat lines directly). A measurement, run by
 /// scripts/bench-scale.sh with `READER=1`:
-/// `cargo test --release --test scale -- --ignored --nocapture the_loader_loads`.
+/// `cargo test --release --test hostile -- --ignored --nocapture scale::the_loader_loads`.
 #[test]
 #[ignore]
 fn the_loader_loads_one_and_a_half_million_lines_a_second() {
@@ -160,7 +155,7 @@ fn the_loader_loads_one_and_a_half_million_lines_a_second() {
 /// The reader alone (`anim_core::sdf::parse_source`, no scene building) on a flat file of a million
 /// random spheres, in lines per CPU-second of the reading thread, against issue 8's target of
 /// 2 M lines/s. A measurement, run by scripts/bench-scale.sh:
-/// `cargo test --release --test scale -- --ignored --nocapture the_reader_reads`.
+/// `cargo test --release --test hostile -- --ignored --nocapture scale::the_reader_reads`.
 #[test]
 #[ignore]
 fn the_reader_reads_two_million_lines_a_second() {

@@ -2,7 +2,7 @@
 //! silent blank image. The corpus rows drive the real binary; the summary table classifies
 //! every public corpus file through the library (`load::probe::classify`).
 
-mod common;
+use crate::common;
 
 use anim_core::load::probe::{classify, Classification};
 use anim_core::sdf::LoadOptions;

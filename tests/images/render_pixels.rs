@@ -1,7 +1,7 @@
 //! Image tests: pixels compared with values derived here from the formulas of docs/shading.md, and
 //! transform equivalences, all through the real binary.
 
-mod common;
+use crate::common;
 use common::*;
 
 const SPHERE_SCENE: &str = "\

@@ -2,7 +2,7 @@
 //! corpus files that use them: each is accepted with a warning naming the reading, is an error
 //! under `--strict`, and the image it gives is not blank.
 
-mod common;
+use crate::common;
 
 use common::{anim, shared_dir};
 use std::path::{Path, PathBuf};

@@ -6,7 +6,7 @@
 //! medium outside every object air, recursion to `--max-depth`, and rays whose weight cannot
 //! change the 8-bit result not traced.
 
-mod common;
+use crate::common;
 
 use common::{render_ppm, Rgb8};
 

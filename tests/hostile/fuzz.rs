@@ -3,11 +3,11 @@
 //! small base scene). See FUZZING.md; `scripts/fuzz.sh` runs it.
 //!
 //! Deterministic: the inputs are mutations of seed files (the shared corpus, `scenes/`,
-//! `animations/`) drawn from a seeded xorshift generator, so a run is reproduced by its seed
+//! `animations/`) drawn from the seeded `SplitMix64` of `anim_core::util`, so a run is reproduced by its seed
 //! and execution count. Each input runs on a worker thread under `catch_unwind`; the main
 //! thread waits for it at most the per-input time limit and otherwise records a hang (and
 //! carries on with a fresh worker). Crashing and hanging inputs are saved to the findings
-//! directory, to become regression tests in tests/hostile.rs.
+//! directory, to become regression tests in tests/hostile/files.rs.
 //!
 //! Settings come from the environment (the test harness owns the command line):
 //! `FUZZ_EXECS` (default 100 000), `FUZZ_SEED` (1), `FUZZ_CORPUS` (`../shared/corpus`),
@@ -15,6 +15,7 @@
 
 use anim_core::load::load_str;
 use anim_core::sdf::{LoadOptions, MaterialField, TransformOrder};
+use anim_core::util::SplitMix64;
 use anim_pipeline::keyframe::generate::BaseScene;
 use anim_pipeline::keyframe::spec::{self, Source};
 use std::panic::{self, AssertUnwindSafe};
@@ -25,7 +26,7 @@ use std::thread;
 use std::time::{Duration, Instant};
 
 /// Inputs grown past this by mutation are cut: the harness looks for wrong behaviour, not
-/// for slowness proportional to size (tests/hostile.rs checks that with large inputs).
+/// for slowness proportional to size (tests/hostile/files.rs checks that with large inputs).
 const MAX_INPUT: usize = 64 << 10;
 
 /// Numbers a mutation writes in place of a number: the edges of what parsers get wrong.
@@ -118,25 +119,13 @@ const WORDS: &[&str] = &[
     "orbit",
 ];
 
-/// One generator state; xorshift64* (good enough to pick mutations, and reproducible).
-struct Rng(u64);
+/// Picks from the one test generator.
+trait Pick {
+    /// One of `items`, which must not be empty.
+    fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T;
+}
 
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        if n == 0 {
-            0
-        } else {
-            (self.next() % n as u64) as usize
-        }
-    }
-
+impl Pick for SplitMix64 {
     fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
         &items[self.below(items.len())]
     }
@@ -205,7 +194,7 @@ fn token_ranges(bytes: &[u8]) -> Vec<(usize, usize)> {
 }
 
 /// One mutation of `input`, using `other` (another seed) for splices.
-fn mutate_once(rng: &mut Rng, input: &mut Vec<u8>, other: &[u8]) {
+fn mutate_once(rng: &mut SplitMix64, input: &mut Vec<u8>, other: &[u8]) {
     match rng.below(12) {
         // Flip one bit.
         0 if !input.is_empty() => {
@@ -274,7 +263,7 @@ fn mutate_once(rng: &mut Rng, input: &mut Vec<u8>, other: &[u8]) {
 }
 
 /// Inserts a line, from `input` or from `other`, at the start of a line of `input`.
-fn insert_line(rng: &mut Rng, input: &mut Vec<u8>, other: &[u8]) {
+fn insert_line(rng: &mut SplitMix64, input: &mut Vec<u8>, other: &[u8]) {
     let source = if rng.below(2) == 0 { &input[..] } else { other };
     let lines = lines_of(source);
     if lines.is_empty() {
@@ -286,7 +275,7 @@ fn insert_line(rng: &mut Rng, input: &mut Vec<u8>, other: &[u8]) {
 }
 
 /// Repeats a line of `input` after itself, a few or many times.
-fn duplicate_line(rng: &mut Rng, input: &mut Vec<u8>) {
+fn duplicate_line(rng: &mut SplitMix64, input: &mut Vec<u8>) {
     let ranges = line_ranges(input);
     if !ranges.is_empty() {
         let (a, b) = *rng.pick(&ranges);
@@ -303,7 +292,7 @@ fn duplicate_line(rng: &mut Rng, input: &mut Vec<u8>) {
 }
 
 /// Replaces a number of `input` by an extreme one.
-fn replace_number(rng: &mut Rng, input: &mut Vec<u8>) {
+fn replace_number(rng: &mut SplitMix64, input: &mut Vec<u8>) {
     let numbers: Vec<(usize, usize)> = token_ranges(input)
         .into_iter()
         .filter(|&(a, _)| {
@@ -328,7 +317,7 @@ fn line_ranges(bytes: &[u8]) -> Vec<(usize, usize)> {
     out
 }
 
-fn line_start(bytes: &[u8], rng: &mut Rng) -> usize {
+fn line_start(bytes: &[u8], rng: &mut SplitMix64) -> usize {
     let ranges = line_ranges(bytes);
     if ranges.is_empty() {
         0
@@ -520,7 +509,7 @@ fn record_panics() -> Arc<Mutex<String>> {
 }
 
 /// The next input: a seed of the target chosen, mutated a few times with another seed.
-fn next_input(rng: &mut Rng, sdf_seeds: &Seeds, spec_seeds: &Seeds) -> (Target, Vec<u8>) {
+fn next_input(rng: &mut SplitMix64, sdf_seeds: &Seeds, spec_seeds: &Seeds) -> (Target, Vec<u8>) {
     // Four in five inputs are scenes: the SDF reader has far more paths than the spec's.
     let (target, seeds) = if rng.below(5) == 0 {
         (Target::Spec, spec_seeds)
@@ -542,14 +531,14 @@ fn run(settings: &Settings) -> Report {
     let base = Arc::new(base_scene(repo));
     let last_panic = record_panics();
     let mut worker = spawn_worker(base.clone(), last_panic.clone());
-    let mut rng = Rng(settings.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1);
+    let mut rng = SplitMix64::new(settings.seed);
     let start = Instant::now();
     let (mut crashes, mut hangs) = (0u64, 0u64);
     let mut slowest = (Duration::ZERO, 0u64);
     let report_every = (settings.execs / 20).max(1);
     for exec in 0..settings.execs {
         let (target, input) = next_input(&mut rng, &sdf_seeds, &spec_seeds);
-        let variant = rng.next();
+        let variant = rng.next_u64();
         let began = Instant::now();
         worker
             .jobs

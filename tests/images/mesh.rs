@@ -2,7 +2,7 @@
 //! of docs/shading.md for flat and smooth normals, meshes under transforms and in composites
 //! drawn like the equivalent boxes, errors located in the OBJ file, and the bunny scene.
 
-mod common;
+use crate::common;
 use common::*;
 use std::path::Path;
 

@@ -7,7 +7,7 @@
 //! - A short blurred animation becomes an MP4 whose frames are smeared where things move and
 //!   untouched where nothing does.
 
-mod common;
+use crate::common;
 
 use common::hdr::{mean, read_pfm, read_png, rmse, Pfm};
 use common::{anim, Rgb8};

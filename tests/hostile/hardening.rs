@@ -2,7 +2,7 @@
 //! recursion, huge images, render lines that point outside the scene's folder, corrupted or
 //! half-written images and two runs on one frame directory.
 
-mod common;
+use crate::common;
 
 use common::anim;
 use std::path::Path;

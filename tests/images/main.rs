@@ -1,0 +1,25 @@
+//! The image contract: what the renderer draws, through the real binary, checked against
+//! pixels derived from the formulas of docs/shading.md, against equivalent scenes, against the
+//! golden manifest of every scene we ship, or for being finite at all. A test belongs here
+//! when its claim is about the pixels of a still image (motion blur has tests/motion/).
+//!
+//! - `render_pixels`: Phong values, shadows, thread independence and transform equivalences.
+//! - `golden`: every shipped scene, generated frame and corpus file, rendered small, against
+//!   the fingerprints of `golden/manifest.tsv` (not one pixel may change by accident).
+//! - `glass_edges`: glass where surfaces meet, and rays grazing faces and edges.
+//! - `finite_pixels`: no scene we ship or our users have renders a NaN or infinite pixel.
+//! - `adaptive`: where adaptive anti-aliasing puts its samples; the uniform modes unchanged.
+//! - `mesh`: OBJ meshes drawn like the formulas and like the equivalent boxes; OBJ errors.
+//! - `instancing`: shared composites kept once, and drawn to the bytes of their flattened
+//!   rewrite.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod adaptive;
+mod finite_pixels;
+mod glass_edges;
+mod golden;
+mod instancing;
+mod mesh;
+mod render_pixels;

@@ -1,0 +1,17 @@
+//! The pipeline contract: the keyframe spec and the commands around the renderer, through the
+//! real binary. A test belongs here when its claim is about `anim generate`, `anim render DIR`,
+//! `scripts/encode.sh` or `anim bench` rather than about one image (tests/images/) or what a
+//! scene file may say (tests/dialect/).
+//!
+//! - `keyframe_spec`: parsing, located errors, interpolation, the orbit camera and how keyed
+//!   transforms compose with the base scene's own.
+//! - `frames`: generate → render a directory → encode, with skipping of unchanged frames,
+//!   resuming, shards and failures.
+//! - `bench`: `anim bench` at its tiny size, and the files it writes.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod bench;
+mod frames;
+mod keyframe_spec;
