@@ -5,6 +5,7 @@ use anim_bench::{BenchConfig, PovMode, Preset};
 use anim_core::limits;
 use anim_core::render::RenderSettings;
 use anim_core::sdf::{LoadOptions, MaterialField, MaterialLayout, TransformOrder};
+use anim_core::shape::MeshCache;
 use anim_pipeline::frames::{FrameOptions, Shard};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::{Path, PathBuf};
@@ -398,6 +399,8 @@ impl SceneArgs {
             infer_transform_order: self.transform_order == TransformOrderArg::Auto,
             max_input: self.max_input,
             max_memory: self.max_memory(),
+            // One cache for the whole command: every frame it renders shares the meshes.
+            meshes: MeshCache::default(),
         }
     }
 

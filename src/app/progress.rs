@@ -114,6 +114,10 @@ impl FrameObserver for FrameLog {
                 "[{n:>width$}/{total}] rendered {name} in {:.2} s",
                 took.as_secs_f64()
             ),
+            FrameOutcome::Copied { from, .. } => format!(
+                "[{n:>width$}/{total}] copied {name} from {from} (same scene) in {:.2} s",
+                took.as_secs_f64()
+            ),
             FrameOutcome::Failed(diags) => {
                 let first = diags
                     .iter()

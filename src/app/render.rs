@@ -140,8 +140,12 @@ fn print_summary(dir: &Path, s: &Summary, quiet: bool) {
     } else {
         String::new()
     };
+    let copied = match s.copied.len() {
+        0 => String::new(),
+        n => format!(", {n} copied (same scene as an earlier frame)"),
+    };
     eprintln!(
-        "{}: {shard}{} rendered, {} skipped (unchanged), {} failed in {:.2} s{rates}",
+        "{}: {shard}{} rendered{copied}, {} skipped (unchanged), {} failed in {:.2} s{rates}",
         dir.display(),
         s.rendered.len(),
         s.skipped.len(),

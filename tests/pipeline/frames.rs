@@ -158,7 +158,8 @@ fn frames_are_taken_in_natural_order() {
         let name = format!("f_{n}");
         std::fs::write(
             dir.path().join(format!("{name}.sdf")),
-            frame_text(0.0, &name),
+            // Each its own scene, so that none is a copy of another.
+            frame_text(n as f64 * 0.1, &name),
         )
         .expect("write");
     }

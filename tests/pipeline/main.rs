@@ -7,6 +7,7 @@
 //!   transforms compose with the base scene's own.
 //! - `frames`: generate → render a directory → encode, with skipping of unchanged frames,
 //!   resuming, shards and failures.
+//! - `holds`: frames of one scene rendered once and copied, byte for byte.
 //! - `bench`: `anim bench` at its tiny size, and the files it writes.
 
 #[path = "../common/mod.rs"]
@@ -14,4 +15,5 @@ mod common;
 
 mod bench;
 mod frames;
+mod holds;
 mod keyframe_spec;

@@ -202,6 +202,44 @@ pub fn line_text(text: &str, number: u32) -> Option<&str> {
     raw_lines(text).nth(index)
 }
 
+/// A fingerprint of what a scene file says apart from the names of its images: its tokens,
+/// comments and spacing left out, with the file name of each render line replaced by its
+/// extension (the format decides the bytes written). Two files of one folder with the same
+/// key render the same images. `None` when a render line is not in the canonical form
+/// `render <camera> <file> <width> <height> [<samples>]`: in the shorter variants, which token
+/// names the image is settled only with the whole file read, and such files are never taken
+/// for one another.
+pub fn scene_key(text: &str) -> Option<u64> {
+    let mut h = crate::util::Fnv64::default();
+    let mut canonical = true;
+    each_line(text, |line| {
+        let tokens = &line.tokens;
+        let is_render = tokens.first().is_some_and(|t| t.text == "render");
+        let image_at = if is_render {
+            let sized =
+                tokens.len() >= 5 && looks_numeric(tokens[3].text) && looks_numeric(tokens[4].text);
+            canonical &= sized && !looks_numeric(tokens[2].text);
+            Some(2)
+        } else {
+            None
+        };
+        for (i, token) in tokens.iter().enumerate() {
+            if Some(i) == image_at {
+                let format = std::path::Path::new(token.text)
+                    .extension()
+                    .map(|e| e.to_string_lossy().to_ascii_lowercase());
+                h.write_part(b"render-image");
+                h.write_part(format.unwrap_or_default().as_bytes());
+            } else {
+                h.write_part(token.text.as_bytes());
+            }
+        }
+        // Lines apart: `a b` then `c` is not `a` then `b c`.
+        h.write(b"\n");
+    });
+    canonical.then(|| h.finish())
+}
+
 /// The lines of a file without their line endings, without tokenizing them.
 pub fn raw_lines(text: &str) -> impl Iterator<Item = &str> {
     let mut rest = text.strip_prefix('\u{feff}').unwrap_or(text);
@@ -497,6 +535,30 @@ pub fn looks_numeric(s: &str) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn scene_keys_see_the_scene_and_the_image_format_only() {
+        let frame = |comment: &str, image: &str| {
+            format!("# {comment}\ndefine shape sphere s 0 0 0 1 m\n  render eye {image} 32 24\n")
+        };
+        let key = |t: &str| scene_key(t).expect("canonical render lines");
+        let a = key(&frame("frame 1", "frame_1.png"));
+        assert_eq!(a, key(&frame("frame 2 of 9", "out/frame_2.PNG")));
+        assert_ne!(a, key(&frame("frame 1", "frame_1.ppm")));
+        assert_ne!(
+            a,
+            key(&frame("frame 1", "frame_1.png").replace("32 24", "32 25"))
+        );
+        assert_ne!(
+            a,
+            key(&frame("frame 1", "frame_1.png").replace("s 0 0 0", "s 0 0 0.5"))
+        );
+        // Tokens split across lines differently are different statements.
+        assert_ne!(key("a b\nc\n"), key("a\nb c\n"));
+        // The short variants name their image only once the whole file is read.
+        assert_eq!(scene_key("render eye frame.png\n"), None);
+        assert_eq!(scene_key("render frame.png 32 24\n"), None);
+    }
 
     #[test]
     fn accepts_every_documented_number_form() {

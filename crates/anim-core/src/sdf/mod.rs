@@ -10,10 +10,11 @@ mod lexer;
 mod parse;
 pub mod repair;
 
-pub use lexer::raw_lines;
+pub use lexer::{raw_lines, scene_key};
 pub use parse::{default_output, Omissions, Parsed};
 
 use crate::diag::{Diagnostic, Loc, Severity};
+use crate::shape::MeshCache;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -103,6 +104,9 @@ pub struct LoadOptions {
     /// Memory the scene may take, in bytes (`--max-memory`): a scene whose shapes would need
     /// more (`limits::scene_memory`) is refused before it is built.
     pub max_memory: u64,
+    /// Meshes already read, shared by every clone of these options: the frames of one
+    /// `anim render DIR` read each OBJ file once (`MeshCache`).
+    pub meshes: MeshCache,
 }
 
 impl Default for LoadOptions {
@@ -116,6 +120,7 @@ impl Default for LoadOptions {
             infer_transform_order: false,
             max_input: crate::limits::DEFAULT_MAX_INPUT,
             max_memory: crate::limits::default_memory_budget(),
+            meshes: MeshCache::default(),
         }
     }
 }

@@ -22,7 +22,7 @@ pub use aabox::{AaBox, BoxRay, Slabs4};
 pub use cone::Cone;
 pub use cylinder::Cylinder;
 pub use geometry::{degeneracy, Degenerate, Geometry};
-pub use mesh::{Mesh, MeshFile};
+pub use mesh::{Mesh, MeshCache, MeshFile};
 pub use plane::Plane;
 pub use sphere::{Sphere, SphereRay};
 pub use triangle::Triangle;

@@ -76,6 +76,9 @@ pub(super) fn prune_orphan_records(frames_dir: &Path, out_dir: &Path) -> std::io
     Ok(())
 }
 
+/// How a record names the frame its images were copied from.
+const COPIED_FROM: &str = "from ";
+
 /// An image line of a record: `image <len> <hash> <path relative to the images>`.
 struct RecordedImage<'a> {
     len: u64,
@@ -106,9 +109,13 @@ impl RecordedImage<'_> {
     }
 }
 
-/// The record's text: a header, the hash, and each image with its length and byte hash.
-fn record_text(hash: u64, out_dir: &Path, outputs: &[Output]) -> String {
+/// The record's text: a header, the hash, the frame its images were copied from (when they
+/// were: `from <name>`), and each image with its length and byte hash.
+fn record_text(hash: u64, from: Option<&str>, out_dir: &Path, outputs: &[Output]) -> String {
     let mut text = format!("anim-render-record {RECORD_VERSION}\nhash {hash:016x}\n");
+    if let Some(from) = from {
+        text.push_str(&format!("{COPIED_FROM}{from}\n"));
+    }
     for out in outputs {
         let rel = out.path.strip_prefix(out_dir).unwrap_or(&out.path);
         text.push_str(&format!(
@@ -125,12 +132,13 @@ pub(super) fn write_record(
     record: &Path,
     out_dir: &Path,
     hash: u64,
+    from: Option<&str>,
     outputs: &[Output],
 ) -> std::io::Result<()> {
     if let Some(parent) = record.parent() {
         std::fs::create_dir_all(parent)?;
     }
-    let text = record_text(hash, out_dir, outputs);
+    let text = record_text(hash, from, out_dir, outputs);
     write_atomically(record, |w| w.write_all(text.as_bytes()))
 }
 
@@ -148,7 +156,7 @@ pub(super) fn is_up_to_date(out_dir: &Path, name: &str, hash: u64) -> bool {
         return false;
     }
     let mut images = 0;
-    for line in lines {
+    for line in lines.skip_while(|l| l.starts_with(COPIED_FROM)) {
         let Some(image) = RecordedImage::parse(line) else {
             return false;
         };
@@ -264,6 +272,8 @@ mod tests {
             // The memory budget decides whether a scene is built at all, never what it
             // renders.
             max_memory: _,
+            // The mesh cache decides how often a mesh file is read, never what it renders.
+            meshes: _,
         } = load.clone();
         vec![
             LoadOptions {

@@ -6,15 +6,15 @@ use super::cache::{
     frame_hash, is_up_to_date, prune_orphan_records, record_path, settings_fingerprint,
     write_record, CACHE_DIR,
 };
-use super::scene_file::{render_scene_file, NoProgress};
+use super::scene_file::{copy_scene_file, render_scene_file, FileOutcome, NoProgress};
 use super::Shard;
 use anim_core::diag::Diagnostic;
 use anim_core::render::RenderSettings;
-use anim_core::sdf::LoadOptions;
+use anim_core::sdf::{scene_key, LoadOptions};
 use anim_core::util::remove_stale_temp_files;
 use rayon::prelude::*;
 use std::cmp::Ordering;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Read as _, Seek as _, SeekFrom, Write as _};
 use std::path::{Path, PathBuf};
@@ -40,6 +40,9 @@ pub struct Summary {
     pub rendered: Vec<String>,
     pub skipped: Vec<String>,
     pub failed: Vec<(String, Vec<Diagnostic>)>,
+    /// Frames whose scene is an earlier frame's but for the names of its images (a hold):
+    /// their images are copies of that frame's, with the earlier frame's name.
+    pub copied: Vec<(String, String)>,
     /// Warnings, one per distinct message, with the number of frames that had it.
     pub warnings: Vec<(Diagnostic, usize)>,
     pub rays: u64,
@@ -50,7 +53,7 @@ pub struct Summary {
 impl Summary {
     /// Frames this run was responsible for (its shard).
     pub fn selected(&self) -> usize {
-        self.rendered.len() + self.skipped.len() + self.failed.len()
+        self.rendered.len() + self.skipped.len() + self.failed.len() + self.copied.len()
     }
 }
 
@@ -58,6 +61,11 @@ impl Summary {
 pub enum FrameOutcome {
     Rendered {
         rays: u64,
+        warnings: Vec<Diagnostic>,
+    },
+    /// Its images are copies of those of frame `from`, whose scene is the same.
+    Copied {
+        from: String,
         warnings: Vec<Diagnostic>,
     },
     Failed(Vec<Diagnostic>),
@@ -168,16 +176,44 @@ pub fn render_dir(
         shard: options.shard,
         ..Summary::default()
     };
-    // Decide what to render first: checking a record is cheap, and progress should count only
-    // real work.
-    let mut todo = Vec::new();
+    let todo = plan_frames(&frames, &fingerprint, &out_dir, options, &mut summary);
+    observer.planned(todo.len(), summary.skipped.len());
+    let outcomes = render_planned(&todo, &out_dir, settings, load, observer);
+    observer.end();
+
+    summary.add_outcomes(outcomes);
+    summary.wall = start.elapsed();
+    Ok(summary)
+}
+
+/// A frame to render: its file, name, record hash, and the earlier frame of the same scene
+/// (by index into the plan) when there is one.
+struct Planned {
+    path: PathBuf,
+    name: String,
+    hash: u64,
+    same_as: Option<usize>,
+}
+
+/// Decides what to render before rendering anything: checking a record is cheap, and progress
+/// should count only real work. Frames skipped as unchanged, and those that cannot be read,
+/// go into `summary`; the others come back in natural order.
+fn plan_frames(
+    frames: &[PathBuf],
+    fingerprint: &str,
+    out_dir: &Path,
+    options: &FrameOptions,
+    summary: &mut Summary,
+) -> Vec<Planned> {
+    let mut todo: Vec<Planned> = Vec::new();
+    let mut first_of_scene: HashMap<u64, usize> = HashMap::new();
     for (i, path) in frames.iter().enumerate() {
         if options.shard.is_some_and(|s| !s.contains(i)) {
             continue;
         }
         let name = file_name(path);
-        let hash = match std::fs::read(path) {
-            Ok(bytes) => frame_hash(&bytes, &fingerprint),
+        let bytes = match std::fs::read(path) {
+            Ok(bytes) => bytes,
             Err(e) => {
                 summary.failed.push((
                     name,
@@ -189,56 +225,132 @@ pub fn render_dir(
                 continue;
             }
         };
-        if !options.force && is_up_to_date(&out_dir, &name, hash) {
+        let hash = frame_hash(&bytes, fingerprint);
+        if !options.force && is_up_to_date(out_dir, &name, hash) {
             summary.skipped.push(name);
-        } else {
-            todo.push((path.clone(), name, hash));
+            continue;
         }
+        let scene = std::str::from_utf8(&bytes).ok().and_then(scene_key);
+        let same_as = scene.and_then(|key| match first_of_scene.get(&key) {
+            Some(&first) => Some(first),
+            None => {
+                first_of_scene.insert(key, todo.len());
+                None
+            }
+        });
+        todo.push(Planned {
+            path: path.clone(),
+            name,
+            hash,
+            same_as,
+        });
     }
-
-    observer.planned(todo.len(), summary.skipped.len());
-    let results: Mutex<Vec<(String, FrameOutcome)>> = Mutex::new(Vec::new());
-    // Frames are taken in natural order as threads free up (rather than rayon splitting the
-    // list in halves), so an interrupted run leaves a playable prefix behind.
-    todo.iter().par_bridge().for_each(|(path, name, hash)| {
-        let t0 = Instant::now();
-        let outcome = render_frame(path, name, *hash, &out_dir, settings, load);
-        observer.finished(name, &outcome, t0.elapsed());
-        if let Ok(mut r) = results.lock() {
-            r.push((name.clone(), outcome));
-        }
-    });
-    observer.end();
-
-    summary.add_outcomes(results.into_inner().unwrap_or_else(|e| e.into_inner()));
-    summary.wall = start.elapsed();
-    Ok(summary)
+    todo
 }
 
-/// Renders frame `path` (file `name`, of hash `hash`) and records it under `out_dir`.
-fn render_frame(
-    path: &Path,
-    name: &str,
-    hash: u64,
+/// Renders the planned frames on the current rayon pool: first every frame whose scene is not
+/// an earlier one's, then the copies of those (a copy whose original failed is rendered).
+/// Frames are taken in natural order as threads free up (rather than rayon splitting the
+/// list in halves), so an interrupted run leaves a playable prefix behind.
+fn render_planned(
+    todo: &[Planned],
     out_dir: &Path,
     settings: &RenderSettings,
     load: &LoadOptions,
-) -> FrameOutcome {
-    let record = record_path(out_dir, name);
+    observer: &dyn FrameObserver,
+) -> Vec<(String, FrameOutcome)> {
+    let results: Mutex<Vec<(String, FrameOutcome)>> = Mutex::new(Vec::new());
+    let originals: HashSet<usize> = todo.iter().filter_map(|f| f.same_as).collect();
+    let rendered: Mutex<HashMap<usize, FileOutcome>> = Mutex::new(HashMap::new());
+    let finish = |frame: &Planned, outcome: FrameOutcome, t0: Instant| {
+        observer.finished(&frame.name, &outcome, t0.elapsed());
+        if let Ok(mut r) = results.lock() {
+            r.push((frame.name.clone(), outcome));
+        }
+    };
+    let first = todo.iter().enumerate().filter(|(_, f)| f.same_as.is_none());
+    first.par_bridge().for_each(|(i, frame)| {
+        let t0 = Instant::now();
+        let (outcome, file) = render_frame(frame, out_dir, settings, load);
+        if let (Some(file), true) = (file, originals.contains(&i)) {
+            if let Ok(mut r) = rendered.lock() {
+                r.insert(i, file);
+            }
+        }
+        finish(frame, outcome, t0);
+    });
+    let rendered = rendered.into_inner().unwrap_or_else(|e| e.into_inner());
+    let copies = todo.iter().filter_map(|f| f.same_as.map(|i| (f, i)));
+    copies.par_bridge().for_each(|(frame, original)| {
+        let t0 = Instant::now();
+        let copied = rendered.get(&original).and_then(|source| {
+            copy_frame(frame, &todo[original].name, source, out_dir, settings, load)
+        });
+        let outcome = copied.unwrap_or_else(|| render_frame(frame, out_dir, settings, load).0);
+        finish(frame, outcome, t0);
+    });
+    results.into_inner().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Writes frame `frame`'s images as copies of `source`, the outcome of frame `from`, and
+/// records them; `None` when the copies cannot stand for a render.
+fn copy_frame(
+    frame: &Planned,
+    from: &str,
+    source: &FileOutcome,
+    out_dir: &Path,
+    settings: &RenderSettings,
+    load: &LoadOptions,
+) -> Option<FrameOutcome> {
+    let record = record_path(out_dir, &frame.name);
+    let _ = std::fs::remove_file(&record);
+    Some(
+        match copy_scene_file(&frame.path, source, load, settings)? {
+            Ok(file) => match write_record(&record, out_dir, frame.hash, Some(from), &file.outputs)
+            {
+                Ok(()) => FrameOutcome::Copied {
+                    from: from.to_string(),
+                    warnings: file.warnings,
+                },
+                Err(e) => FrameOutcome::Failed(vec![Diagnostic::file_error(
+                    &record,
+                    format!("copied, but cannot record it: {e}"),
+                )]),
+            },
+            Err(diags) => FrameOutcome::Failed(diags),
+        },
+    )
+}
+
+/// Renders frame `frame` and records it under `out_dir`; the file's outcome comes back too
+/// when it rendered, for frames of the same scene to copy.
+fn render_frame(
+    frame: &Planned,
+    out_dir: &Path,
+    settings: &RenderSettings,
+    load: &LoadOptions,
+) -> (FrameOutcome, Option<FileOutcome>) {
+    let record = record_path(out_dir, &frame.name);
     // A stale record must not outlive an attempt to replace its images.
     let _ = std::fs::remove_file(&record);
-    match render_scene_file(path, load, settings, &NoProgress) {
-        Ok(file) => match write_record(&record, out_dir, hash, &file.outputs) {
-            Ok(()) => FrameOutcome::Rendered {
-                rays: file.rays.total(),
-                warnings: file.warnings,
-            },
-            Err(e) => FrameOutcome::Failed(vec![Diagnostic::file_error(
-                &record,
-                format!("rendered, but cannot record it: {e}"),
-            )]),
+    match render_scene_file(&frame.path, load, settings, &NoProgress) {
+        Ok(file) => match write_record(&record, out_dir, frame.hash, None, &file.outputs) {
+            Ok(()) => (
+                FrameOutcome::Rendered {
+                    rays: file.rays.total(),
+                    warnings: file.warnings.clone(),
+                },
+                Some(file),
+            ),
+            Err(e) => (
+                FrameOutcome::Failed(vec![Diagnostic::file_error(
+                    &record,
+                    format!("rendered, but cannot record it: {e}"),
+                )]),
+                None,
+            ),
         },
-        Err(diags) => FrameOutcome::Failed(diags),
+        Err(diags) => (FrameOutcome::Failed(diags), None),
     }
 }
 
@@ -249,20 +361,28 @@ impl Summary {
         results.sort_by(|a, b| natural_cmp(&a.0, &b.0));
         let mut warnings: BTreeMap<String, (Diagnostic, usize)> = BTreeMap::new();
         for (name, outcome) in results {
-            match outcome {
-                FrameOutcome::Rendered { rays, warnings: w } => {
+            let frame_warnings = match outcome {
+                FrameOutcome::Rendered { rays, warnings } => {
                     self.rays += rays;
                     self.rendered.push(name);
-                    for d in w {
-                        // Frames of one animation repeat the same warning: show it once, with
-                        // the first frame's location and a count.
-                        warnings
-                            .entry(d.message.clone())
-                            .and_modify(|e| e.1 += 1)
-                            .or_insert((d, 1));
-                    }
+                    warnings
                 }
-                FrameOutcome::Failed(diags) => self.failed.push((name, diags)),
+                FrameOutcome::Copied { from, warnings } => {
+                    self.copied.push((name, from));
+                    warnings
+                }
+                FrameOutcome::Failed(diags) => {
+                    self.failed.push((name, diags));
+                    continue;
+                }
+            };
+            for d in frame_warnings {
+                // Frames of one animation repeat the same warning: show it once, with the
+                // first frame's location and a count.
+                warnings
+                    .entry(d.message.clone())
+                    .and_modify(|e| e.1 += 1)
+                    .or_insert((d, 1));
             }
         }
         self.failed.sort_by(|a, b| natural_cmp(&a.0, &b.0));

@@ -9,6 +9,8 @@ use anim_core::render::film::{self, ImageBytes, ImageFormat};
 use anim_core::render::{render_prepared, Prepared, RayCounts, RenderSettings, Rendered};
 use anim_core::scene::RenderJob;
 use anim_core::sdf::LoadOptions;
+use anim_core::util::{write_atomically, Fnv64};
+use std::io::Write as _;
 use std::path::{Component, Path, PathBuf};
 
 /// An image file written, with what was written to it.
@@ -170,6 +172,68 @@ pub fn render_scene_file(
         }),
         Err(()) => Err(warnings),
     }
+}
+
+/// Writes the images of scene file `path` as copies of `source`'s, the outcome of a file whose
+/// scene is the same but for the names of its images (`sdf::scene_key`): the file is loaded
+/// and checked as for a render (its own warnings, its own output paths) and nothing is traced.
+/// `None` when the copies cannot stand for a render: the two files turn out to ask for a
+/// different number of images, or an image of `source` no longer holds what was written.
+pub fn copy_scene_file(
+    path: &Path,
+    source: &FileOutcome,
+    load: &LoadOptions,
+    settings: &RenderSettings,
+) -> Option<Result<FileOutcome, Vec<Diagnostic>>> {
+    let loaded = match anim_core::load::load_file(path, load) {
+        Ok(loaded) => loaded,
+        Err(diags) => return Some(Err(diags)),
+    };
+    let mut warnings = loaded.diagnostics;
+    let blank_at = warnings.len();
+    let targets = resolve_targets(path, &loaded.jobs, settings, load.strict, &mut warnings);
+    let blanks = probe::blank_image_warnings(&loaded.jobs, path);
+    warnings.splice(blank_at..blank_at, blanks);
+    let targets = match targets {
+        Ok(targets) => targets,
+        Err(errors) => {
+            warnings.extend(errors);
+            return Some(Err(warnings));
+        }
+    };
+    let paths: Vec<PathBuf> = targets
+        .into_iter()
+        .flat_map(|(out, _)| {
+            let hdr = settings.hdr.then(|| film::hdr_path(&out));
+            std::iter::once(out).chain(hdr)
+        })
+        .collect();
+    if paths.len() != source.outputs.len() {
+        return None;
+    }
+    let mut outputs = Vec::with_capacity(paths.len());
+    for (to, from) in paths.into_iter().zip(&source.outputs) {
+        let bytes = std::fs::read(&from.path).ok()?;
+        if bytes.len() as u64 != from.bytes.len || Fnv64::of(&bytes) != from.bytes.hash {
+            return None;
+        }
+        if let Err(e) = write_atomically(&to, |w| w.write_all(&bytes)) {
+            warnings.push(Diagnostic::file_error(
+                path,
+                format!("cannot write '{}': {e}", to.display()),
+            ));
+            return Some(Err(warnings));
+        }
+        outputs.push(Output {
+            path: to,
+            bytes: from.bytes,
+        });
+    }
+    Some(Ok(FileOutcome {
+        outputs,
+        warnings,
+        rays: RayCounts::default(),
+    }))
 }
 
 /// Where each of `jobs` writes its image, and in which format. A path confined to its folder

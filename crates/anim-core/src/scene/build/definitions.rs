@@ -277,8 +277,11 @@ impl Builder<'_> {
             return;
         }
         let dir = self.path.parent().unwrap_or(Path::new(""));
-        match crate::shape::mesh::load(&dir.join(&m.file)) {
-            Ok(mesh) => m.set(Arc::new(mesh)),
+        let loaded = self.opts.meshes.load(&dir.join(&m.file), |path| {
+            crate::shape::mesh::load(path).map(Arc::new)
+        });
+        match loaded {
+            Ok(mesh) => m.set(mesh),
             Err(d) if d.loc.is_none() => {
                 let message = format!("mesh file `{}` {}", m.file, d.message);
                 self.error(At::Statement(stmt), message, None);

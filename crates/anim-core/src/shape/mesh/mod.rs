@@ -8,8 +8,10 @@
 //! lists); `Mesh::bytes` adds it up. BENCHMARKS.md records what a million-triangle mesh
 //! costs a whole render.
 
+mod cache;
 mod obj;
 
+pub use cache::MeshCache;
 pub use obj::load;
 
 use super::triangle::RaySpace;
