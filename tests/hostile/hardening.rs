@@ -1,6 +1,6 @@
 //! Hostile and unlucky inputs end quickly with a clear message or a correct result: deep mirror
 //! recursion, huge images, render lines that point outside the scene's folder, corrupted or
-//! half-written images and two runs on one frame directory.
+//! half-written images, two runs on one frame directory, and frames that are links or empty.
 
 use crate::common;
 
@@ -327,4 +327,49 @@ fn generate_and_render_remove_only_the_files_they_wrote() {
     assert!(!photos.join("IMG_0001.jpg").exists());
     assert!(photos.join("IMG_0000.jpg").is_file());
     untouched();
+}
+
+/// A frame of a directory that is a symbolic link is rendered (or fails, when it leads
+/// nowhere) rather than left out, and an empty frame fails instead of rendering a blank view.
+#[test]
+fn linked_and_empty_frames_are_not_passed_over() {
+    let dir = tempfile::tempdir().unwrap();
+    let elsewhere = tempfile::tempdir().unwrap();
+    let scene = "define material red 0.2 0 0 0.8 0.1 0.1 0.5 0.5 0.5 20\n\
+        define shape sphere ball 0 0 -5 1 red\n\
+        define light sun 5 5 5 1 1 1 1\n\
+        define camera cam 60\n";
+    std::fs::write(
+        dir.path().join("f_1.sdf"),
+        format!("{scene}render cam f_1.png 8 6\n"),
+    )
+    .unwrap();
+    let target = elsewhere.path().join("kept.sdf");
+    // Another scene than f_1's, so that it is rendered rather than copied.
+    let moved = scene.replace("ball 0 0 -5", "ball 1 0 -5");
+    std::fs::write(&target, format!("{moved}render cam f_2.png 8 6\n")).unwrap();
+    std::os::unix::fs::symlink(&target, dir.path().join("f_2.sdf")).unwrap();
+    std::os::unix::fs::symlink(
+        elsewhere.path().join("gone.sdf"),
+        dir.path().join("f_3.sdf"),
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("f_4.sdf"), " \n\n").unwrap();
+    let out = anim().arg("render").arg(dir.path()).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("2 rendered, 0 skipped (unchanged), 2 failed"),
+        "{stderr}"
+    );
+    assert!(dir.path().join("f_2.png").is_file(), "{stderr}");
+    assert!(
+        stderr.contains("f_3.sdf") && stderr.contains("cannot read file"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("f_4.sdf") && stderr.contains("the frame file is empty"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("f_4.png").exists() && !dir.path().join("image.ppm").exists());
 }

@@ -225,6 +225,18 @@ fn plan_frames(
                 continue;
             }
         };
+        if bytes.iter().all(u8::is_ascii_whitespace) {
+            // An empty frame would render the default view of nothing: a blank image that
+            // looks like a rendered frame.
+            summary.failed.push((
+                name,
+                vec![Diagnostic::file_error(
+                    path,
+                    "the frame file is empty: a frame must say what to render",
+                )],
+            ));
+            continue;
+        }
         let hash = frame_hash(&bytes, fingerprint);
         if !options.force && is_up_to_date(out_dir, &name, hash) {
             summary.skipped.push(name);
@@ -396,7 +408,9 @@ fn file_name(path: &Path) -> String {
         .unwrap_or_default()
 }
 
-/// The `.sdf` files of `dir` (not hidden, not in subdirectories), in natural order.
+/// The `.sdf` files of `dir` (not hidden, not in subdirectories), in natural order. A symbolic
+/// link is a frame when it leads to a file, and when it leads nowhere (reading it then fails
+/// the frame with the reason, rather than leaving it out in silence).
 pub fn list_frames(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
     let mut frames: Vec<(String, PathBuf)> = Vec::new();
     for entry in std::fs::read_dir(dir)? {
@@ -405,7 +419,11 @@ pub fn list_frames(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
         let is_sdf = Path::new(&name)
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("sdf"));
-        if is_sdf && !name.starts_with('.') && entry.file_type()?.is_file() {
+        let is_frame = match std::fs::metadata(entry.path()) {
+            Ok(meta) => meta.is_file(),
+            Err(_) => entry.file_type()?.is_symlink(),
+        };
+        if is_sdf && !name.starts_with('.') && is_frame {
             frames.push((name, entry.path()));
         }
     }
