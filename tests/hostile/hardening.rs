@@ -373,3 +373,54 @@ fn linked_and_empty_frames_are_not_passed_over() {
     );
     assert!(!dir.path().join("f_4.png").exists() && !dir.path().join("image.ppm").exists());
 }
+
+/// What lies in a frame directory's records folder is read with care: a pipe where a record
+/// should be does not block the run, a record of gigabytes is not read, and a frame file over
+/// `--max-input` is refused unread.
+#[test]
+fn records_and_frames_that_are_pipes_or_huge_do_not_stall_a_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let frame = |image: &str, x: f64| {
+        format!("{SPHERE}render cam {image} 8 6\n")
+            .replace("ball 0 0 -5", &format!("ball {x} 0 -5"))
+    };
+    std::fs::write(dir.path().join("f_1.sdf"), frame("f_1.png", 0.0)).unwrap();
+    std::fs::write(dir.path().join("f_2.sdf"), frame("f_2.png", 0.5)).unwrap();
+    let records = dir.path().join(".anim-cache");
+    std::fs::create_dir_all(&records).unwrap();
+    let made = std::process::Command::new("mkfifo")
+        .arg(records.join("f_1.sdf.hash"))
+        .status()
+        .unwrap();
+    assert!(made.success());
+    std::fs::File::create(records.join("f_2.sdf.hash"))
+        .unwrap()
+        .set_len(3 << 30)
+        .unwrap();
+    let big = std::fs::File::create(dir.path().join("f_3.sdf")).unwrap();
+    big.set_len(2 << 20).unwrap();
+    let start = Instant::now();
+    let out = anim()
+        .args(["render", "--max-input", "1048576"])
+        .arg(dir.path())
+        .timeout(Duration::from_secs(20))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(start.elapsed() < Duration::from_secs(10), "{stderr}");
+    assert!(
+        stderr.contains("2 rendered, 0 skipped (unchanged), 1 failed"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("f_3.sdf") && stderr.contains("too large to read"),
+        "{stderr}"
+    );
+    let again = anim()
+        .args(["render", "--max-input", "1048576"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&again.stderr);
+    assert!(stderr.contains("0 rendered, 2 skipped"), "{stderr}");
+}

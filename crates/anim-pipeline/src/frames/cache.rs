@@ -15,7 +15,7 @@ use super::scene_file::Output;
 use anim_core::render::RenderSettings;
 use anim_core::sdf::LoadOptions;
 use anim_core::util::{write_atomically, Fnv64};
-use std::io::Write as _;
+use std::io::{Read as _, Write as _};
 use std::path::{Path, PathBuf};
 
 /// Directory of render records, beside the images.
@@ -64,7 +64,7 @@ pub(super) fn prune_orphan_records(frames_dir: &Path, out_dir: &Path) -> std::io
         if frames_dir.join(sdf).exists() {
             continue;
         }
-        let text = std::fs::read_to_string(entry.path()).unwrap_or_default();
+        let text = read_record(&entry.path()).unwrap_or_default();
         for image in text.lines().skip(2).filter_map(RecordedImage::parse) {
             let path = out_dir.join(image.rel);
             if image.still_holds_what_was_written(&path) {
@@ -74,6 +74,27 @@ pub(super) fn prune_orphan_records(frames_dir: &Path, out_dir: &Path) -> std::io
         std::fs::remove_file(entry.path())?;
     }
     Ok(())
+}
+
+/// Largest record read: a header and a line of about a hundred bytes per image, so ten
+/// thousand images. Anything larger was not written by anim.
+const MAX_RECORD_BYTES: u64 = 1 << 20;
+
+/// The text of the record at `path`; `None` (the frame renders again, and its record is
+/// replaced) when it is missing, not a regular file (a pipe would block the run), larger than
+/// any record anim writes, or not text.
+fn read_record(path: &Path) -> Option<String> {
+    let meta = std::fs::metadata(path).ok()?;
+    if !meta.is_file() || meta.len() > MAX_RECORD_BYTES {
+        return None;
+    }
+    let mut text = String::new();
+    std::fs::File::open(path)
+        .ok()?
+        .take(MAX_RECORD_BYTES)
+        .read_to_string(&mut text)
+        .ok()?;
+    Some(text)
 }
 
 /// How a record names the frame its images were copied from.
@@ -145,7 +166,7 @@ pub(super) fn write_record(
 /// Whether frame `name`'s record matches `hash` and every image it lists still holds exactly
 /// the bytes that were written (a truncated, corrupted or replaced image is rendered again).
 pub(super) fn is_up_to_date(out_dir: &Path, name: &str, hash: u64) -> bool {
-    let Ok(text) = std::fs::read_to_string(record_path(out_dir, name)) else {
+    let Some(text) = read_record(&record_path(out_dir, name)) else {
         return false;
     };
     let mut lines = text.lines();

@@ -9,6 +9,7 @@ use super::cache::{
 use super::scene_file::{copy_scene_file, render_scene_file, FileOutcome, NoProgress};
 use super::Shard;
 use anim_core::diag::Diagnostic;
+use anim_core::load::read_input;
 use anim_core::render::RenderSettings;
 use anim_core::sdf::{scene_key, LoadOptions};
 use anim_core::util::remove_stale_temp_files;
@@ -176,7 +177,14 @@ pub fn render_dir(
         shard: options.shard,
         ..Summary::default()
     };
-    let todo = plan_frames(&frames, &fingerprint, &out_dir, options, &mut summary);
+    let todo = plan_frames(
+        &frames,
+        load.max_input,
+        &fingerprint,
+        &out_dir,
+        options,
+        &mut summary,
+    );
     observer.planned(todo.len(), summary.skipped.len());
     let outcomes = render_planned(&todo, &out_dir, settings, load, observer);
     observer.end();
@@ -200,6 +208,7 @@ struct Planned {
 /// go into `summary`; the others come back in natural order.
 fn plan_frames(
     frames: &[PathBuf],
+    max_input: u64,
     fingerprint: &str,
     out_dir: &Path,
     options: &FrameOptions,
@@ -212,16 +221,11 @@ fn plan_frames(
             continue;
         }
         let name = file_name(path);
-        let bytes = match std::fs::read(path) {
+        // Read as the loader reads it: a frame larger than `--max-input` is refused unread.
+        let bytes = match read_input(path, max_input, "file") {
             Ok(bytes) => bytes,
-            Err(e) => {
-                summary.failed.push((
-                    name,
-                    vec![Diagnostic::file_error(
-                        path,
-                        format!("cannot read file: {e}"),
-                    )],
-                ));
+            Err(diags) => {
+                summary.failed.push((name, diags));
                 continue;
             }
         };
