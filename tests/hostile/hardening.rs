@@ -424,3 +424,32 @@ fn records_and_frames_that_are_pipes_or_huge_do_not_stall_a_run() {
     let stderr = String::from_utf8_lossy(&again.stderr);
     assert!(stderr.contains("0 rendered, 2 skipped"), "{stderr}");
 }
+
+/// Two frames of a directory that name one image: the later fails, located at its image name,
+/// before anything renders, and stays failed on every run instead of overwriting the other.
+#[test]
+fn two_frames_naming_one_image_is_an_error_at_the_later() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, x) in [("f_1", 0.0), ("f_2", 0.5)] {
+        let text = format!("{SPHERE}render cam same.png 8 6\n")
+            .replace("ball 0 0 -5", &format!("ball {x} 0 -5"));
+        std::fs::write(dir.path().join(format!("{name}.sdf")), text).unwrap();
+    }
+    let line = SPHERE.lines().count() + 1;
+    for run in ["first", "second"] {
+        let out = anim().arg("render").arg(dir.path()).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{run}: {stderr}");
+        let at = format!("f_2.sdf:{line}:12: error: image 'same.png' is also written by f_1.sdf");
+        assert!(stderr.contains(&at), "{run}: {stderr}");
+        let rendered = if run == "first" {
+            "1 rendered, 0 skipped"
+        } else {
+            "0 rendered, 1 skipped"
+        };
+        assert!(
+            stderr.contains(&format!("{rendered} (unchanged), 1 failed")),
+            "{run}: {stderr}"
+        );
+    }
+}

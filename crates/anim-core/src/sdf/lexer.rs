@@ -216,9 +216,7 @@ pub fn scene_key(text: &str) -> Option<u64> {
         let tokens = &line.tokens;
         let is_render = tokens.first().is_some_and(|t| t.text == "render");
         let image_at = if is_render {
-            let sized =
-                tokens.len() >= 5 && looks_numeric(tokens[3].text) && looks_numeric(tokens[4].text);
-            canonical &= sized && !looks_numeric(tokens[2].text);
+            canonical &= canonical_render_image(tokens).is_some();
             Some(2)
         } else {
             None
@@ -238,6 +236,51 @@ pub fn scene_key(text: &str) -> Option<u64> {
         h.write(b"\n");
     });
     canonical.then(|| h.finish())
+}
+
+/// An image a render line names, and where.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ImageName {
+    /// The file name as written.
+    pub name: String,
+    /// The line, counted from 1.
+    pub line: u32,
+    /// The column of the name, counted from 1 in characters.
+    pub col: u32,
+    /// The name's width in characters.
+    pub width: u32,
+    /// The whole line, for quoting.
+    pub text: String,
+}
+
+/// The image each render line of a scene file names, where it names it. `None` when a render
+/// line is not in the canonical form, as for [`scene_key`].
+pub fn image_names(text: &str) -> Option<Vec<ImageName>> {
+    let mut names = Vec::new();
+    let mut canonical = true;
+    each_line(text, |line| {
+        let tokens = &line.tokens;
+        if tokens.first().is_some_and(|t| t.text == "render") {
+            match canonical_render_image(tokens) {
+                Some(image) => names.push(ImageName {
+                    name: image.text.to_string(),
+                    line: line.number,
+                    col: image.col,
+                    width: image.width,
+                    text: line.text.to_string(),
+                }),
+                None => canonical = false,
+            }
+        }
+    });
+    canonical.then_some(names)
+}
+
+/// The image token of a render line in the form `render <camera> <file> <width> <height>
+/// [<samples>]`; `None` for the shorter variants.
+fn canonical_render_image<'t, 'a>(tokens: &'t [Token<'a>]) -> Option<&'t Token<'a>> {
+    let sized = tokens.len() >= 5 && looks_numeric(tokens[3].text) && looks_numeric(tokens[4].text);
+    (sized && !looks_numeric(tokens[2].text)).then(|| &tokens[2])
 }
 
 /// The lines of a file without their line endings, without tokenizing them.

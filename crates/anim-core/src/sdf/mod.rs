@@ -10,7 +10,7 @@ mod lexer;
 mod parse;
 pub mod repair;
 
-pub use lexer::{raw_lines, scene_key};
+pub use lexer::{image_names, raw_lines, scene_key, ImageName};
 pub use parse::{default_output, Omissions, Parsed};
 
 use crate::diag::{Diagnostic, Loc, Severity};

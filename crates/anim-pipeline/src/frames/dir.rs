@@ -8,10 +8,10 @@ use super::cache::{
 };
 use super::scene_file::{copy_scene_file, render_scene_file, FileOutcome, NoProgress};
 use super::Shard;
-use anim_core::diag::Diagnostic;
+use anim_core::diag::{Diagnostic, Loc, Severity};
 use anim_core::load::read_input;
 use anim_core::render::RenderSettings;
-use anim_core::sdf::{scene_key, LoadOptions};
+use anim_core::sdf::{image_names, scene_key, LoadOptions};
 use anim_core::util::remove_stale_temp_files;
 use rayon::prelude::*;
 use std::cmp::Ordering;
@@ -19,7 +19,7 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Read as _, Seek as _, SeekFrom, Write as _};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// Which frames of a directory to render.
@@ -216,31 +216,20 @@ fn plan_frames(
 ) -> Vec<Planned> {
     let mut todo: Vec<Planned> = Vec::new();
     let mut first_of_scene: HashMap<u64, usize> = HashMap::new();
+    let mut images: HashMap<PathBuf, String> = HashMap::new();
     for (i, path) in frames.iter().enumerate() {
         if options.shard.is_some_and(|s| !s.contains(i)) {
             continue;
         }
         let name = file_name(path);
         // Read as the loader reads it: a frame larger than `--max-input` is refused unread.
-        let bytes = match read_input(path, max_input, "file") {
+        let bytes = match read_frame(path, max_input, &name, out_dir, &mut images) {
             Ok(bytes) => bytes,
             Err(diags) => {
                 summary.failed.push((name, diags));
                 continue;
             }
         };
-        if bytes.iter().all(u8::is_ascii_whitespace) {
-            // An empty frame would render the default view of nothing: a blank image that
-            // looks like a rendered frame.
-            summary.failed.push((
-                name,
-                vec![Diagnostic::file_error(
-                    path,
-                    "the frame file is empty: a frame must say what to render",
-                )],
-            ));
-            continue;
-        }
         let hash = frame_hash(&bytes, fingerprint);
         if !options.force && is_up_to_date(out_dir, &name, hash) {
             summary.skipped.push(name);
@@ -262,6 +251,55 @@ fn plan_frames(
         });
     }
     todo
+}
+
+/// The bytes of frame `path` (file `name`), read as the loader reads it: a frame larger than
+/// `--max-input` is refused unread. An empty frame fails (it would render the default view of
+/// nothing, a blank image that looks like a frame), and so does a frame that names an image
+/// an earlier frame of the run writes (`images`: image path → frame): the two would overwrite
+/// each other, and every later run would render one of them again.
+fn read_frame(
+    path: &Path,
+    max_input: u64,
+    name: &str,
+    out_dir: &Path,
+    images: &mut HashMap<PathBuf, String>,
+) -> Result<Vec<u8>, Vec<Diagnostic>> {
+    let bytes = read_input(path, max_input, "file")?;
+    if bytes.iter().all(u8::is_ascii_whitespace) {
+        return Err(vec![Diagnostic::file_error(
+            path,
+            "the frame file is empty: a frame must say what to render",
+        )]);
+    }
+    let names = std::str::from_utf8(&bytes).ok().and_then(image_names);
+    let mut clashes = Vec::new();
+    for image in names.unwrap_or_default() {
+        let writer = images
+            .entry(out_dir.join(&image.name))
+            .or_insert_with(|| name.to_string());
+        if writer != name {
+            let loc = Loc {
+                file: Arc::from(path),
+                line: image.line,
+                col: image.col,
+            };
+            let message = format!(
+                "image '{}' is also written by {writer}, an earlier frame of this directory",
+                image.name
+            );
+            clashes.push(
+                Diagnostic::new(Severity::Error, loc, message)
+                    .with_source(&image.text, image.width)
+                    .with_help("each frame must write its own images (name them by frame, as `output: \"frame_{frame}.png\"` does)"),
+            );
+        }
+    }
+    if clashes.is_empty() {
+        Ok(bytes)
+    } else {
+        Err(clashes)
+    }
 }
 
 /// Renders the planned frames on the current rayon pool: first every frame whose scene is not
