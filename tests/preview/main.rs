@@ -7,9 +7,11 @@
 //!   HTTP requests to it.
 //! - `http`: the routes, refusals (traversal, encoded traversal, foreign `Host`) and pixels,
 //!   through plain HTTP requests.
+//! - `browser`: the page in headless Chromium, driven by `scripts/preview-browser.py`.
 
 #[path = "../common/mod.rs"]
 mod common;
 
+mod browser;
 mod http;
 mod session;
