@@ -9,6 +9,11 @@ disk, breaks it, fixes it. tests/preview/browser.rs runs it and compares the pix
 
 Writes into DIR: first.ppm, last.ppm (frames 0 and N-1 at full quality), edited.ppm (frame
 0 after the edit), screenshot.png, and result.json (what was seen, with timings).
+
+    preview-browser.py --url URL --frames N --screenshot OUT.png [--at FRAME]
+
+only waits until every frame is drawn small, scrubs to FRAME and takes the page's picture
+(the README's, of `anim preview` on a keyed copy of animations/orbit.ron).
 """
 
 import argparse
@@ -55,16 +60,37 @@ def scrub(page, frame):
     page.locator("#scrub").fill(str(frame))
 
 
+def screenshot(a):
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=a.chromium, headless=True,
+                                    args=["--no-sandbox"])
+        page = browser.new_page(viewport={"width": 1000, "height": 760})
+        page.goto(a.url)
+        page.wait_for_function(f"() => Number(document.body.dataset.small) === {a.frames}",
+                               timeout=30000)
+        scrub(page, a.at)
+        shown(page, a.at, "full", timeout=60000)
+        page.screenshot(path=a.screenshot)
+        browser.close()
+    return 0
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--url", required=True)
-    ap.add_argument("--spec", required=True, type=pathlib.Path)
-    ap.add_argument("--edited", required=True, type=pathlib.Path)
-    ap.add_argument("--broken", required=True, type=pathlib.Path)
+    ap.add_argument("--spec", type=pathlib.Path)
+    ap.add_argument("--edited", type=pathlib.Path)
+    ap.add_argument("--broken", type=pathlib.Path)
     ap.add_argument("--frames", required=True, type=int)
-    ap.add_argument("--out", required=True, type=pathlib.Path)
+    ap.add_argument("--out", type=pathlib.Path)
     ap.add_argument("--chromium", default="/usr/bin/chromium")
+    ap.add_argument("--screenshot")
+    ap.add_argument("--at", type=int, default=0)
     a = ap.parse_args()
+    if a.screenshot:
+        return screenshot(a)
+    if not (a.spec and a.edited and a.broken and a.out):
+        ap.error("--spec, --edited, --broken and --out are needed without --screenshot")
     result = {}
     last = a.frames - 1
     with sync_playwright() as p:
@@ -102,6 +128,18 @@ def main():
         a.spec.write_text(a.edited.read_text())
         page.wait_for_selector("#diagnostics", state="hidden", timeout=10000)
         result["fixed"] = True
+
+        page.click("#export")
+        page.wait_for_function(
+            "() => !['', 'encoding…'].includes(document.getElementById('export-status').textContent)",
+            timeout=30000)
+        link = page.query_selector("#export-status a")
+        if link:
+            video = page.request.get(a.url + link.get_attribute("href").lstrip("/"))
+            result["export"] = {"status": video.status, "bytes": len(video.body()),
+                                "mp4": video.body()[4:8] == b"ftyp"}
+        else:
+            result["export"] = {"message": page.inner_text("#export-status")}
 
         refused = {}
         for path in ["../../../etc/passwd", "%2e%2e/%2e%2e/etc/passwd", "frame/..%2f..%2fsmall.ron",

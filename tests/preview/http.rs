@@ -100,5 +100,7 @@ fn serves_the_frames_anim_render_draws_and_follows_an_edit() {
     });
     assert!(state.contains("small.ron:10:"), "{state}");
     assert_eq!(preview.get("/frame/0.png").0, 200);
+    assert_eq!(preview.temporary_files(), 1);
     assert!(preview.stop(), "Ctrl-C did not end the preview cleanly");
+    assert_eq!(preview.temporary_files(), 0, "Ctrl-C left temporary files");
 }

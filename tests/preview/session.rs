@@ -48,9 +48,11 @@ impl Preview {
         )
         .unwrap();
         std::fs::write(dir.path().join("small.ron"), spec(FIRST_KEY)).unwrap();
+        std::fs::create_dir(dir.path().join("tmp")).unwrap();
         let mut child = Command::new(env!("CARGO_BIN_EXE_anim"))
             .args(["preview", "small.ron", "--port", "0"])
             .current_dir(dir.path())
+            .env("TMPDIR", dir.path().join("tmp"))
             .stdin(Stdio::null())
             .stdout(Stdio::null())
             .stderr(Stdio::piped())
@@ -66,6 +68,13 @@ impl Preview {
             .and_then(|p| p.trim_end_matches('/').parse().ok())
             .unwrap_or_else(|| panic!("no address in {first:?}"));
         Preview { dir, port, child }
+    }
+
+    /// The entries of the preview's `TMPDIR`: its temporary folder while it runs.
+    pub fn temporary_files(&self) -> usize {
+        std::fs::read_dir(self.dir.path().join("tmp"))
+            .unwrap()
+            .count()
     }
 
     pub fn spec_path(&self) -> PathBuf {
@@ -114,8 +123,11 @@ impl Preview {
 
 impl Drop for Preview {
     fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+        // As a user stops it, so it removes its temporary folder; killed only if it hangs.
+        if !matches!(self.child.try_wait(), Ok(Some(_))) && !self.stop() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
     }
 }
 

@@ -75,6 +75,8 @@ impl Project {
         }
         let deps = deps.finish();
         if !self.is_spec() {
+            // Checked here, so that an error shows as the build's, with the last good frame.
+            let loaded = anim_core::load::load_file(&self.input, &self.load).map_err(text)?;
             let bytes = std::fs::read(&self.input)
                 .map_err(|e| vec![format!("{}: error: {e}", self.input.display())])?;
             let key = frame_key(&bytes, deps);
@@ -85,7 +87,7 @@ impl Project {
                 }],
                 fps: 1.0,
                 keys: Vec::new(),
-                warnings: Vec::new(),
+                warnings: text(loaded.diagnostics),
             });
         }
         let report = run_generate(&GenerateConfig {

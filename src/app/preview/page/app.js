@@ -79,9 +79,14 @@ function drawTimeline() {
 function update(next) {
   state = next;
   drawTimeline();
-  const diag = $("diagnostics");
-  diag.hidden = state.diagnostics.length === 0;
-  $("diag-text").textContent = state.diagnostics.join("\n\n");
+  // A build that failed, else the frames that did not render (each error once).
+  const frameErrors = [...new Set(state.frames.map((f) => f.error).filter((e) => e))];
+  const shownErrors = state.diagnostics.length ? state.diagnostics : frameErrors;
+  $("diagnostics").hidden = shownErrors.length === 0;
+  $("diag-text").textContent = shownErrors.join("\n\n");
+  $("diag-title").textContent = state.diagnostics.length
+    ? "The last edit does not build; the frames shown are from the last good one"
+    : "Some frames do not render";
   $("warnings").hidden = state.warnings.length === 0;
   $("warn-text").textContent = state.warnings.join("\n\n");
   document.body.dataset.version = String(state.version);
