@@ -14,6 +14,7 @@
 """
 
 import json
+import resource
 import os
 import pathlib
 import shutil
@@ -89,26 +90,37 @@ def stop(p):
     p.wait(timeout=30)
 
 
+def cpu():
+    """CPU seconds (user + system) of the children waited for so far."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def orbit_round(anim, work):
     shutil.rmtree(work / "base", ignore_errors=True)
+    c = cpu()
     t = time.monotonic()
     subprocess.run([anim, "generate", "orbit.ron", "-o", "base", "-q"], cwd=work, check=True)
     t_gen = time.monotonic() - t
     t = time.monotonic()
     subprocess.run([anim, "render", "base", "--quiet", "--force"], cwd=work, check=True)
     t_render = time.monotonic() - t
+    c_base = cpu() - c
     print(f"  anim generate: {t_gen:.2f} s, anim render DIR: {t_render:.2f} s "
-          f"(together {t_gen + t_render:.2f} s)")
+          f"(together {t_gen + t_render:.2f} s, {c_base:.2f} CPU s)")
 
+    c = cpu()
     p, port, t0 = start(anim, "orbit.ron", work)
     t_small, _ = wait(port, shown)
     t_full, s = wait(port, full)
     stop(p)
+    c_preview = cpu() - c
     renders = sorted({f["renders"] for f in s["frames"]})
     print(f"  anim preview orbit.ron: every frame small after {t_small - t0:.2f} s, "
           f"every frame full after {t_full - t0:.2f} s "
           f"= {(t_full - t0) / (t_gen + t_render):.2f} x generate + render "
-          f"({(t_full - t0) / t_render:.2f} x render alone); renders per frame {renders}")
+          f"({(t_full - t0) / t_render:.2f} x render alone); renders per frame {renders}; "
+          f"{c_preview:.2f} CPU s until stopped = {c_preview / c_base:.2f} x")
 
 
 def main():

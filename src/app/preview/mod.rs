@@ -104,8 +104,7 @@ fn serve(config: &PreviewConfig, shared: &Arc<Shared>, export: Export) -> ExitCo
         eprintln!("error: the server has no IP address");
         return ExitCode::FAILURE;
     };
-    let authority = addr.to_string();
-    let url = format!("http://{authority}/");
+    let url = format!("http://{addr}/");
     eprintln!("previewing {} at {url}", config.input.display());
     if !addr.ip().is_loopback() {
         eprintln!(
@@ -117,7 +116,7 @@ fn serve(config: &PreviewConfig, shared: &Arc<Shared>, export: Export) -> ExitCo
     if config.open {
         open_browser(&url);
     }
-    let ctx = server::Context::new(shared.clone(), authority, addr.ip().is_loopback(), export);
+    let ctx = server::Context::new(shared.clone(), addr, export);
     let result = server::serve(&server, &ctx);
     eprintln!("stopped");
     match result {

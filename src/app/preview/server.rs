@@ -6,6 +6,7 @@
 use super::export::{self, Export};
 use super::state::Shared;
 use std::io::Write as _;
+use std::net::SocketAddr;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
@@ -81,35 +82,44 @@ fn query_number(query: &str, name: &str) -> Option<usize> {
         .and_then(|v| v.parse().ok())
 }
 
-/// Whether `host` (the `Host` header) names the bound address `authority` (`ip:port`).
-/// `localhost` stands for a loopback address, which no other site can make resolve to it.
-pub fn host_ok(host: Option<&str>, authority: &str, loopback: bool) -> bool {
-    let Some(host) = host else {
+/// Whether `host` (the `Host` header) names the address the server bound. A page of another
+/// site that reaches this port through a name it controls (DNS rebinding) sends that name, so
+/// only IP literals are taken (any of the machine's, when bound to all of them), and
+/// `localhost`, which no other site can make resolve here.
+pub fn host_ok(host: Option<&str>, bound: SocketAddr) -> bool {
+    let Some(host) = host.map(str::trim) else {
         return false;
     };
-    let host = host.trim();
-    if host.eq_ignore_ascii_case(authority) {
-        return true;
+    let with_port = if host.ends_with(']') || !host.contains(':') {
+        format!("{host}:80")
+    } else {
+        host.to_string()
+    };
+    let any = bound.ip().is_unspecified();
+    if let Some(name) = with_port.strip_suffix(&format!(":{}", bound.port())) {
+        if name.eq_ignore_ascii_case("localhost") {
+            return bound.ip().is_loopback() || any;
+        }
     }
-    let port = authority.rsplit(':').next().unwrap_or("");
-    loopback && host.eq_ignore_ascii_case(&format!("localhost:{port}"))
+    match with_port.parse::<SocketAddr>() {
+        Ok(addr) => addr.port() == bound.port() && (addr.ip() == bound.ip() || any),
+        Err(_) => false,
+    }
 }
 
 /// What every request handler needs.
 pub struct Context {
     pub shared: Arc<Shared>,
-    pub authority: String,
-    pub loopback: bool,
+    pub bound: SocketAddr,
     pub export: Arc<Export>,
     streams: Arc<AtomicUsize>,
 }
 
 impl Context {
-    pub fn new(shared: Arc<Shared>, authority: String, loopback: bool, export: Export) -> Self {
+    pub fn new(shared: Arc<Shared>, bound: SocketAddr, export: Export) -> Self {
         Context {
             shared,
-            authority,
-            loopback,
+            bound,
             export: Arc::new(export),
             streams: Arc::default(),
         }
@@ -171,7 +181,7 @@ fn handle(request: Request, ctx: &Context) {
         .iter()
         .find(|h| h.field.equiv("Host"))
         .map(|h| h.value.as_str().to_string());
-    if !host_ok(host.as_deref(), &ctx.authority, ctx.loopback) {
+    if !host_ok(host.as_deref(), ctx.bound) {
         return refuse(request, 421, "unknown host");
     }
     let route = match route(request.method(), request.url()) {
@@ -301,11 +311,21 @@ mod tests {
 
     #[test]
     fn only_the_bound_host_is_answered() {
-        assert!(host_ok(Some("127.0.0.1:8000"), "127.0.0.1:8000", true));
-        assert!(host_ok(Some("localhost:8000"), "127.0.0.1:8000", true));
-        assert!(!host_ok(Some("evil.example:8000"), "127.0.0.1:8000", true));
-        assert!(!host_ok(Some("127.0.0.1:8001"), "127.0.0.1:8000", true));
-        assert!(!host_ok(None, "127.0.0.1:8000", true));
-        assert!(!host_ok(Some("localhost:8000"), "10.0.0.2:8000", false));
+        let local: SocketAddr = "127.0.0.1:8000".parse().unwrap();
+        assert!(host_ok(Some("127.0.0.1:8000"), local));
+        assert!(host_ok(Some("localhost:8000"), local));
+        assert!(host_ok(Some("LOCALHOST:8000"), local));
+        assert!(!host_ok(Some("evil.example:8000"), local));
+        assert!(!host_ok(Some("evil.example"), local));
+        assert!(!host_ok(Some("127.0.0.1:8001"), local));
+        assert!(!host_ok(Some("127.0.0.2:8000"), local));
+        assert!(!host_ok(None, local));
+        let lan: SocketAddr = "10.0.0.2:8000".parse().unwrap();
+        assert!(!host_ok(Some("localhost:8000"), lan));
+        assert!(host_ok(Some("10.0.0.2:8000"), lan));
+        let all: SocketAddr = "0.0.0.0:80".parse().unwrap();
+        assert!(host_ok(Some("192.168.1.5"), all));
+        assert!(host_ok(Some("[::1]:80"), "[::]:80".parse().unwrap()));
+        assert!(!host_ok(Some("rebind.example"), all));
     }
 }
