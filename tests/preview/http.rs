@@ -2,8 +2,8 @@
 //! are the pixels `anim render` writes, before and after an edit.
 
 use crate::session::{
-    all_full, per_frame, rendered_by_anim_render, request, spec, Preview, EDITED_KEY, FIRST_KEY,
-    FRAMES,
+    all_full, per_frame, rendered_by_anim_render, request, request_with, spec, Preview, EDITED_KEY,
+    FIRST_KEY, FRAMES,
 };
 use std::time::Duration;
 
@@ -64,6 +64,13 @@ fn refuses_what_is_not_its_own() {
     ] {
         assert!((400..500).contains(&request(port, method, path, &own).0));
     }
+    // A page of another site posting to this address names its own origin.
+    let posted = |origin: &str| {
+        let headers = format!("Host: {own}\r\nOrigin: {origin}\r\n");
+        request_with(port, "POST", "/api/focus?frame=1", &headers).0
+    };
+    assert_eq!(posted("http://evil.example"), 403);
+    assert_eq!(posted(&format!("http://{own}")), 200);
 }
 
 #[test]
@@ -103,4 +110,33 @@ fn serves_the_frames_anim_render_draws_and_follows_an_edit() {
     assert_eq!(preview.temporary_files(), 1);
     assert!(preview.stop(), "Ctrl-C did not end the preview cleanly");
     assert_eq!(preview.temporary_files(), 0, "Ctrl-C left temporary files");
+}
+
+#[test]
+fn a_scene_file_is_one_frame_and_its_errors_are_located() {
+    let preview = Preview::start_scene();
+    let state = preview.wait_for(Duration::from_secs(60), |s| {
+        per_frame(s, "state") == ["full"]
+    });
+    assert!(state.contains("\"diagnostics\":[]"), "{state}");
+    let png = preview.get("/frame/0.png").1;
+    let shown = image::load_from_memory(&png).unwrap().to_rgb8();
+    assert_eq!(shown.dimensions(), (96, 54));
+    let scene = preview.dir.path().join("scene.sdf");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let broken = text.replace("sphere lens 0 0.2 0 1.2 glass", "sphere lens 0 0.2 0 glass");
+    std::fs::write(&scene, broken).unwrap();
+    let state = preview.wait_for(Duration::from_secs(20), |s| {
+        !s.contains("\"diagnostics\":[]")
+    });
+    let line = 1 + text
+        .lines()
+        .position(|l| l.contains("sphere lens"))
+        .unwrap();
+    assert!(state.contains(&format!("scene.sdf:{line}:")), "{state}");
+    assert_eq!(
+        preview.get("/frame/0.png").1,
+        png,
+        "the last good frame stays"
+    );
 }

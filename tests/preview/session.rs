@@ -27,6 +27,12 @@ pub fn spec(first_key: &str) -> String {
     )
 }
 
+/// `animations/showcase.sdf`, the orbit's base scene.
+pub fn showcase() -> String {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::read_to_string(root.join("animations/showcase.sdf")).unwrap()
+}
+
 pub const FIRST_KEY: &str = "(0, 0, 0)";
 pub const EDITED_KEY: &str = "(0, 1.5, 0)";
 pub const FRAMES: usize = 6;
@@ -41,16 +47,23 @@ impl Preview {
     /// Starts `anim preview` on the test animation; returns once it prints its address.
     pub fn start() -> Preview {
         let dir = tempfile::tempdir().unwrap();
-        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-        std::fs::copy(
-            root.join("animations/showcase.sdf"),
-            dir.path().join("showcase.sdf"),
-        )
-        .unwrap();
+        std::fs::write(dir.path().join("showcase.sdf"), showcase()).unwrap();
         std::fs::write(dir.path().join("small.ron"), spec(FIRST_KEY)).unwrap();
+        Preview::launch(dir, "small.ron")
+    }
+
+    /// Starts `anim preview` on one scene file, `scene.sdf`: the showcase, small.
+    pub fn start_scene() -> Preview {
+        let dir = tempfile::tempdir().unwrap();
+        let scene = showcase().replace("render cam showcase.png 640 360", "render cam s.png 96 54");
+        std::fs::write(dir.path().join("scene.sdf"), scene).unwrap();
+        Preview::launch(dir, "scene.sdf")
+    }
+
+    fn launch(dir: tempfile::TempDir, input: &str) -> Preview {
         std::fs::create_dir(dir.path().join("tmp")).unwrap();
         let mut child = Command::new(env!("CARGO_BIN_EXE_anim"))
-            .args(["preview", "small.ron", "--port", "0"])
+            .args(["preview", input, "--port", "0"])
             .current_dir(dir.path())
             .env("TMPDIR", dir.path().join("tmp"))
             .stdin(Stdio::null())
@@ -152,13 +165,18 @@ pub fn all_full(state: &str) -> bool {
 
 /// One HTTP/1.1 request with the given `Host`; the status and body of the answer.
 pub fn request(port: u16, method: &str, path: &str, host: &str) -> (u16, Vec<u8>) {
+    request_with(port, method, path, &format!("Host: {host}\r\n"))
+}
+
+/// One HTTP/1.1 request with the given header lines; the status and body of the answer.
+pub fn request_with(port: u16, method: &str, path: &str, headers: &str) -> (u16, Vec<u8>) {
     let mut stream = TcpStream::connect(("127.0.0.1", port)).unwrap();
     stream
         .set_read_timeout(Some(Duration::from_secs(10)))
         .unwrap();
     write!(
         stream,
-        "{method} {path} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\nContent-Length: 0\r\n\r\n"
+        "{method} {path} HTTP/1.1\r\n{headers}Connection: close\r\nContent-Length: 0\r\n\r\n"
     )
     .unwrap();
     let mut answer = Vec::new();
@@ -179,12 +197,7 @@ pub fn request(port: u16, method: &str, path: &str, host: &str) -> (u16, Vec<u8>
 /// The frames `anim render` writes for the test animation as `spec_text` says, decoded.
 pub fn rendered_by_anim_render(spec_text: &str) -> Vec<image::RgbImage> {
     let dir = tempfile::tempdir().unwrap();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    std::fs::copy(
-        root.join("animations/showcase.sdf"),
-        dir.path().join("showcase.sdf"),
-    )
-    .unwrap();
+    std::fs::write(dir.path().join("showcase.sdf"), showcase()).unwrap();
     std::fs::write(dir.path().join("small.ron"), spec_text).unwrap();
     let anim = env!("CARGO_BIN_EXE_anim");
     let frames = dir.path().join("frames");

@@ -175,12 +175,17 @@ fn refuse(request: Request, status: u16, why: &str) {
     );
 }
 
-fn handle(request: Request, ctx: &Context) {
-    let host = request
+/// The value of header `name`, if the request has it.
+fn header_value(request: &Request, name: &'static str) -> Option<String> {
+    request
         .headers()
         .iter()
-        .find(|h| h.field.equiv("Host"))
-        .map(|h| h.value.as_str().to_string());
+        .find(|h| h.field.equiv(name))
+        .map(|h| h.value.as_str().to_string())
+}
+
+fn handle(request: Request, ctx: &Context) {
+    let host = header_value(&request, "Host");
     if !host_ok(host.as_deref(), ctx.bound) {
         return refuse(request, 421, "unknown host");
     }
@@ -188,6 +193,15 @@ fn handle(request: Request, ctx: &Context) {
         Ok(route) => route,
         Err(status) => return refuse(request, status, "not served"),
     };
+    // Another site's page may post to this address directly (its Host is then right): a
+    // browser names that page's origin, which must be this one.
+    let foreign = header_value(&request, "Origin").is_some_and(|origin| {
+        host.as_deref()
+            .is_none_or(|h| !origin.eq_ignore_ascii_case(&format!("http://{}", h.trim())))
+    });
+    if *request.method() == Method::Post && foreign {
+        return refuse(request, 403, "posted from another site");
+    }
     let text = |request, kind: &str, body: &str| respond(request, 200, kind, body.into());
     match route {
         Route::Page => text(request, "text/html; charset=utf-8", INDEX),
