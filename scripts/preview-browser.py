@@ -110,6 +110,18 @@ def main():
         shown(page, 2, "full")
         result["position"] = page.inner_text("#position")
         result["key_marks"] = page.locator("#keys span").count()
+        page.click("#play")
+        page.wait_for_function("() => document.getElementById('frame').dataset.frame !== '2'",
+                               timeout=5000)
+        page.click("#play")
+        result["played"] = True
+        page.click("#next")
+        after_step = page.eval_on_selector("#scrub", "s => Number(s.value)")
+        page.click("#prev")
+        result["stepped"] = page.eval_on_selector("#scrub", "s => Number(s.value)") == after_step - 1 \
+            or after_step == 0
+        scrub(page, 2)
+        shown(page, 2, "full")
         page.screenshot(path=str(a.out / "screenshot.png"))
 
         scrub(page, 0)

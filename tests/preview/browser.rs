@@ -96,6 +96,8 @@ fn the_page_plays_scrubs_and_follows_edits_in_chromium() {
     let result = std::fs::read_to_string(dir.join("result.json")).unwrap();
     assert!(result.contains("frame 2 / 5 · 0.25 s"), "{result}");
     assert!(result.contains("\"key_marks\": 2"), "{result}");
+    assert!(result.contains("\"played\": true"), "{result}");
+    assert!(result.contains("\"stepped\": true"), "{result}");
     // The diagnostic as the terminal prints it: file:line:col, the quoted line, the caret.
     assert!(result.contains("small.ron:10:"), "{result}");
     assert!(
