@@ -44,7 +44,10 @@ function setPlaying(on) {
   playing = on;
   $("play").textContent = on ? "❚❚" : "▶︎";
   clearInterval(timer);
-  if (on) timer = setInterval(() => show(current + 1), 1000 / ((state && state.fps) || 24));
+  const fps = (state && state.fps) || 24;
+  // While playing, the server renders ahead of the playhead: it hears where it is each second.
+  const tick = () => { show(current + 1); if (current % Math.max(1, Math.round(fps)) === 0) focus(current); };
+  if (on) timer = setInterval(tick, 1000 / fps);
   else focus(current);
 }
 
