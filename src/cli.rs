@@ -1,6 +1,6 @@
 //! Command-line definitions (clap derive), resolved into configuration before any work starts.
 
-use crate::app::{CheckConfig, GenerateConfig, RenderConfig};
+use crate::app::{CheckConfig, GenerateConfig, PreviewConfig, RenderConfig};
 use anim_bench::{BenchConfig, PovMode, Preset};
 use anim_core::limits;
 use anim_core::render::RenderSettings;
@@ -31,6 +31,9 @@ pub enum Command {
     Generate(GenerateArgs),
     /// Measure render time against image error on built-in scenes.
     Bench(BenchArgs),
+    /// Show a keyframe spec (or one scene) in the browser: every frame small at once, then at
+    /// full quality, following every edit of its files.
+    Preview(PreviewArgs),
 }
 
 #[derive(Args, Debug, Clone)]
@@ -141,6 +144,31 @@ pub struct GenerateArgs {
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct PreviewArgs {
+    /// The RON keyframe spec, or one SDF scene file.
+    #[arg(value_name = "SPEC.ron|SCENE.sdf")]
+    pub input: PathBuf,
+    /// The port to listen on (default: a free one, printed at start).
+    #[arg(long, default_value_t = 0)]
+    pub port: u16,
+    /// The address to listen on. Anything but 127.0.0.1 lets other machines see the preview.
+    #[arg(long, value_name = "IP", default_value = "127.0.0.1")]
+    pub host: std::net::IpAddr,
+    /// Open the page in the system's browser.
+    #[arg(long)]
+    pub open: bool,
+    /// Render every frame at full quality, encode them into this MP4 with ffmpeg and stop
+    /// (no server).
+    #[arg(long, value_name = "OUT.mp4")]
+    pub export: Option<PathBuf>,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    #[command(flatten)]
+    pub scene: SceneArgs,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -366,6 +394,23 @@ impl GenerateArgs {
         GenerateConfig {
             spec: self.spec.clone(),
             out: self.out.clone(),
+        }
+    }
+}
+
+impl PreviewArgs {
+    /// What the command line asks `anim preview` to do.
+    pub fn config(&self) -> PreviewConfig {
+        PreviewConfig {
+            input: self.input.clone(),
+            addr: std::net::SocketAddr::new(self.host, self.port),
+            open: self.open,
+            export: self.export.clone(),
+            load: self.scene.load_options(),
+            settings: RenderSettings {
+                max_memory: self.scene.max_memory(),
+                ..RenderSettings::default()
+            },
         }
     }
 }

@@ -23,5 +23,6 @@ fn main() -> ExitCode {
             },
             args.threads,
         ),
+        Command::Preview(args) => app::run(app::Command::Preview(args.config()), args.threads),
     }
 }

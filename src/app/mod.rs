@@ -5,12 +5,14 @@
 mod bench;
 mod check;
 mod generate;
+mod preview;
 mod progress;
 mod render;
 
 pub use anim_bench::BenchConfig;
 pub use anim_pipeline::keyframe::GenerateConfig;
 pub use check::CheckConfig;
+pub use preview::PreviewConfig;
 pub use render::RenderConfig;
 
 use anim_core::limits;
@@ -33,6 +35,7 @@ pub enum Command {
         stress: bool,
         out: Option<PathBuf>,
     },
+    Preview(PreviewConfig),
 }
 
 /// Runs `command` on a rayon pool of `threads` workers (default: one per core), the one pool
@@ -50,6 +53,10 @@ pub fn run(command: Command, threads: Option<u32>) -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
+    // The preview serves pages from this thread while the pool renders.
+    if let Command::Preview(config) = &command {
+        return preview::run(config, &pool);
+    }
     pool.install(|| match &command {
         Command::Render(config) => render::run(config),
         Command::Check(config) => check::run(config),
@@ -59,5 +66,6 @@ pub fn run(command: Command, threads: Option<u32>) -> ExitCode {
             stress,
             out,
         } => bench::run(config, *stress, out.as_deref()),
+        Command::Preview(config) => preview::run(config, &pool),
     })
 }

@@ -1,0 +1,195 @@
+//! `anim preview SPEC.ron|SCENE.sdf`: a local web page that plays the animation while it is
+//! rendered, every frame small first and then in full, and follows every edit of its files.
+//!
+//! The parts, each importing only those after it: `server` (routes, the page, event
+//! streams) → `export` (ffmpeg) → `watch` (notify, builds again) → `render` (the workers)
+//! → `state` (what is shared) → `project` (the spec's frames, via the pipeline).
+
+mod export;
+mod project;
+mod render;
+mod server;
+mod state;
+mod watch;
+
+use anim_core::render::RenderSettings;
+use anim_core::sdf::LoadOptions;
+use export::Export;
+use project::Project;
+use rayon::ThreadPool;
+use state::Shared;
+use std::net::SocketAddr;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::{Arc, Barrier};
+use std::time::{Duration, Instant};
+
+/// Everything `anim preview` was asked to do.
+#[derive(Clone, Debug)]
+pub struct PreviewConfig {
+    pub input: PathBuf,
+    pub addr: SocketAddr,
+    pub open: bool,
+    /// Render everything, encode it here and stop, without a server.
+    pub export: Option<PathBuf>,
+    pub load: LoadOptions,
+    /// The full-quality settings, those of `anim render` by default.
+    pub settings: RenderSettings,
+}
+
+pub fn run(config: &PreviewConfig, pool: &ThreadPool) -> ExitCode {
+    let temp = match tempfile::Builder::new().prefix("anim-preview-").tempdir() {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("error: cannot make the preview's temporary folder: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    if !config.input.is_file() {
+        eprintln!("{}: error: no such file", config.input.display());
+        return ExitCode::FAILURE;
+    }
+    let project = Project {
+        input: config.input.clone(),
+        frames_dir: temp.path().join("frames"),
+        load: config.load.clone(),
+    };
+    let shared = Arc::new(Shared::default());
+    {
+        let shared = shared.clone();
+        // A second Ctrl-C while stopping is the same request.
+        let _ = ctrlc::set_handler(move || shared.stop());
+    }
+    let export = Export::new(temp.path().join("export"));
+    let threads = pool.current_num_threads();
+    // Every worker holds its pool thread before any renders, so none can start inside
+    // another's wait for its rows.
+    let all_in = Barrier::new(threads);
+    let code = pool.in_place_scope(|scope| {
+        for _ in 0..threads {
+            let (shared, all_in) = (&shared, &all_in);
+            let (load, settings) = (&config.load, &config.settings);
+            // The pool's threads have the stack deep recursion needs.
+            scope.spawn(move |_| {
+                all_in.wait();
+                render::worker(shared, load, settings);
+            });
+        }
+        let watcher = {
+            let (project, shared) = (project.clone(), shared.clone());
+            std::thread::spawn(move || watch::follow(&project, &shared))
+        };
+        let code = match &config.export {
+            Some(out) => export_only(&shared, &export, out),
+            None => serve(config, &shared, export),
+        };
+        shared.stop();
+        let _ = watcher.join();
+        code
+    });
+    drop(temp);
+    code
+}
+
+/// Serves the page until Ctrl-C.
+fn serve(config: &PreviewConfig, shared: &Arc<Shared>, export: Export) -> ExitCode {
+    let server = match tiny_http::Server::http(config.addr) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: cannot listen on {}: {e}", config.addr);
+            return ExitCode::FAILURE;
+        }
+    };
+    let Some(addr) = server.server_addr().to_ip() else {
+        eprintln!("error: the server has no IP address");
+        return ExitCode::FAILURE;
+    };
+    let url = format!("http://{addr}/");
+    eprintln!("previewing {} at {url}", config.input.display());
+    if !addr.ip().is_loopback() {
+        eprintln!(
+            "warning: listening on {}: other machines can see this preview",
+            addr.ip()
+        );
+    }
+    eprintln!("press Ctrl-C to stop");
+    if config.open {
+        open_browser(&url);
+    }
+    let ctx = server::Context::new(shared.clone(), addr, export);
+    let result = server::serve(&server, &ctx);
+    eprintln!("stopped");
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: the server failed: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// `--export`: waits until every frame is drawn in full, then encodes them into `out`.
+fn export_only(shared: &Shared, export: &Export, out: &Path) -> ExitCode {
+    let start = Instant::now();
+    loop {
+        let state = shared.lock();
+        if state.stop {
+            return ExitCode::FAILURE;
+        }
+        if !state.diagnostics.is_empty() {
+            for d in &state.diagnostics {
+                eprintln!("{d}");
+            }
+            return ExitCode::FAILURE;
+        }
+        if state.all_full() {
+            break;
+        }
+        drop(shared.wait(&shared.changed, state, Duration::from_millis(200)));
+    }
+    let failed: Vec<String> = shared
+        .lock()
+        .frames
+        .iter()
+        .filter_map(|f| f.error.clone())
+        .collect();
+    if !failed.is_empty() {
+        for e in failed {
+            eprintln!("{e}");
+        }
+        return ExitCode::FAILURE;
+    }
+    let copied = export::encode(shared, export).and_then(|()| {
+        std::fs::copy(export.video(), out)
+            .map(|_| ())
+            .map_err(|e| format!("{}: {e}", out.display()))
+    });
+    match copied {
+        Ok(()) => {
+            eprintln!(
+                "wrote {} in {:.2} s",
+                out.display(),
+                start.elapsed().as_secs_f64()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Opens `url` in the system's browser, when there is one.
+fn open_browser(url: &str) {
+    let opener = if cfg!(target_os = "macos") {
+        "open"
+    } else if cfg!(windows) {
+        "explorer"
+    } else {
+        "xdg-open"
+    };
+    if let Err(e) = std::process::Command::new(opener).arg(url).spawn() {
+        eprintln!("note: cannot open a browser ({opener}: {e}); open {url} yourself");
+    }
+}

@@ -1,0 +1,170 @@
+//! What is previewed: a keyframe spec turned into frame files by the pipeline's own
+//! `run_generate` (into the preview's temporary folder), or one scene file; with the files an
+//! edit of which changes the picture, and a fingerprint of each frame's content.
+
+use anim_core::diag::Diagnostic;
+use anim_core::scene::Geometry;
+use anim_core::sdf::ast::StatementKind;
+use anim_core::sdf::LoadOptions;
+use anim_core::util::Fnv64;
+use anim_pipeline::frames::list_frames;
+use anim_pipeline::keyframe::spec::{self, KeySpec, SceneSource, Source, SpecFile};
+use anim_pipeline::keyframe::{run_generate, GenerateConfig};
+use std::path::{Path, PathBuf};
+
+/// One frame to render: its scene file and a fingerprint of everything that draws it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FrameSource {
+    pub path: PathBuf,
+    pub key: u64,
+}
+
+/// A successful build of the animation.
+#[derive(Clone, Debug)]
+pub struct Built {
+    pub frames: Vec<FrameSource>,
+    pub fps: f64,
+    /// Times (seconds) of the spec's keys, for the timeline.
+    pub keys: Vec<f64>,
+    /// Warnings met on the way, as the terminal shows them.
+    pub warnings: Vec<String>,
+}
+
+/// The previewed file and where its frames are generated.
+#[derive(Clone, Debug)]
+pub struct Project {
+    pub input: PathBuf,
+    pub frames_dir: PathBuf,
+    pub load: LoadOptions,
+}
+
+impl Project {
+    /// Whether the input is a keyframe spec (else a scene file).
+    pub fn is_spec(&self) -> bool {
+        self.input.extension().is_some_and(|e| e == "ron")
+    }
+
+    /// The files whose edits change the frames: the input, its base scene and their meshes.
+    /// Files that cannot be read are still listed, so that creating them is seen.
+    pub fn watched(&self) -> Vec<PathBuf> {
+        let mut files = vec![self.input.clone()];
+        let scene = if self.is_spec() {
+            spec_scene(&self.input)
+        } else {
+            Some(self.input.clone())
+        };
+        if let Some(scene) = scene {
+            files.extend(mesh_files(&scene, &self.load));
+            files.push(scene);
+        }
+        files.sort();
+        files.dedup();
+        files
+    }
+
+    /// Generates the frames (for a spec) and fingerprints them. `Err` holds every diagnostic
+    /// as the terminal prints it.
+    pub fn build(&self) -> Result<Built, Vec<String>> {
+        let text = |ds: Vec<Diagnostic>| ds.iter().map(ToString::to_string).collect();
+        // Meshes change the pictures of every frame that draws them, whatever the frame text.
+        let mut deps = Fnv64::default();
+        // The spec itself is not one: the frame texts say all it means.
+        for f in self.watched().iter().filter(|f| **f != self.input) {
+            deps.write(&std::fs::read(f).unwrap_or_default());
+            deps.write(&[0]);
+        }
+        let deps = deps.finish();
+        if !self.is_spec() {
+            // Checked here, so that an error shows as the build's, with the last good frame.
+            let loaded = anim_core::load::load_file(&self.input, &self.load).map_err(text)?;
+            let bytes = std::fs::read(&self.input)
+                .map_err(|e| vec![format!("{}: error: {e}", self.input.display())])?;
+            let key = frame_key(&bytes, deps);
+            return Ok(Built {
+                frames: vec![FrameSource {
+                    path: self.input.clone(),
+                    key,
+                }],
+                fps: 1.0,
+                keys: Vec::new(),
+                warnings: text(loaded.diagnostics),
+            });
+        }
+        let report = run_generate(&GenerateConfig {
+            spec: self.input.clone(),
+            out: Some(self.frames_dir.clone()),
+        })
+        .map_err(text)?;
+        let paths = list_frames(&report.dir)
+            .map_err(|e| vec![format!("{}: error: {e}", report.dir.display())])?;
+        let frames = paths
+            .into_iter()
+            .map(|path| {
+                let key = frame_key(&std::fs::read(&path).unwrap_or_default(), deps);
+                FrameSource { path, key }
+            })
+            .collect();
+        let spec = read_spec(&self.input);
+        Ok(Built {
+            frames,
+            fps: f64::from(report.fps),
+            keys: spec.as_ref().map(key_times).unwrap_or_default(),
+            warnings: text(report.warnings),
+        })
+    }
+}
+
+fn frame_key(sdf: &[u8], deps: u64) -> u64 {
+    let mut h = Fnv64::default();
+    h.write(&deps.to_le_bytes());
+    h.write(sdf);
+    h.finish()
+}
+
+fn read_spec(path: &Path) -> Option<SpecFile> {
+    let src = Source::read(path, Source::MAX_BYTES).ok()?;
+    spec::parse(&src).ok()
+}
+
+/// The base scene file a spec names, if it names one.
+fn spec_scene(path: &Path) -> Option<PathBuf> {
+    match read_spec(path)?.scene {
+        SceneSource::File(rel) => Some(path.parent().unwrap_or(Path::new("")).join(rel)),
+        SceneSource::Inline(_) => None,
+    }
+}
+
+/// The OBJ files a scene file reads, relative to its folder.
+fn mesh_files(scene: &Path, load: &LoadOptions) -> Vec<PathBuf> {
+    let Ok(text) = std::fs::read_to_string(scene) else {
+        return Vec::new();
+    };
+    let dir = scene.parent().unwrap_or(Path::new(""));
+    let (statements, _) = anim_core::sdf::parse(&text, scene, load);
+    statements
+        .iter()
+        .filter_map(|s| match &s.kind {
+            StatementKind::Shape {
+                geometry: Geometry::Mesh(m),
+                ..
+            } => Some(dir.join(&m.file)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Every key time of the spec, sorted, once each.
+fn key_times(spec: &SpecFile) -> Vec<f64> {
+    fn at<T>(keys: &[KeySpec<T>]) -> impl Iterator<Item = f64> + '_ {
+        keys.iter().map(|k| k.at)
+    }
+    let mut times: Vec<f64> = at(&spec.ambient).chain(at(&spec.background)).collect();
+    for t in &spec.tracks {
+        times.extend(at(&t.translate).chain(at(&t.rotate)).chain(at(&t.scale)));
+        times.extend(at(&t.brightness).chain(at(&t.color)).chain(at(&t.fov)));
+    }
+    times.retain(|t| t.is_finite());
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    times
+}

@@ -1,0 +1,306 @@
+//! What the preview knows, shared by the server, the render workers and the watcher: each
+//! frame's source and images, the diagnostics of the last build, and where the playhead is.
+//! Images are whole PNG files in memory, swapped in only once complete.
+
+use super::project::Built;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::time::Duration;
+
+/// How well a frame is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Quality {
+    /// A quarter of the size, one sample per pixel.
+    Small,
+    /// The spec's size and the default sampling, as `anim render` draws it.
+    Full,
+}
+
+/// One image of a frame, and the content fingerprint it was drawn from.
+#[derive(Clone, Debug)]
+pub struct Image {
+    pub png: Arc<Vec<u8>>,
+    pub key: u64,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Frame {
+    pub path: PathBuf,
+    pub key: u64,
+    pub small: Option<Image>,
+    pub full: Option<Image>,
+    /// The job a worker is on, if any.
+    pub busy: Option<Quality>,
+    /// Bumped whenever the image served for this frame changes.
+    pub version: u64,
+    /// Images rendered for this frame since the preview started.
+    pub renders: u64,
+    /// Why the last render of this content failed.
+    pub error: Option<String>,
+    error_key: Option<u64>,
+}
+
+impl Frame {
+    /// The image to show: the full one of the current content, else the small one, else
+    /// whatever is left from before an edit.
+    pub fn best(&self) -> Option<(&Image, Quality)> {
+        let key = self.key;
+        let full = self.full.as_ref().filter(|i| i.key == key);
+        let small = self.small.as_ref().filter(|i| i.key == key);
+        full.map(|i| (i, Quality::Full))
+            .or_else(|| small.map(|i| (i, Quality::Small)))
+            .or_else(|| self.full.as_ref().map(|i| (i, Quality::Full)))
+            .or_else(|| self.small.as_ref().map(|i| (i, Quality::Small)))
+    }
+
+    fn needs(&self, q: Quality) -> bool {
+        let image = match q {
+            Quality::Small => &self.small,
+            Quality::Full => &self.full,
+        };
+        self.busy.is_none()
+            && self.error_key != Some(self.key)
+            && image.as_ref().is_none_or(|i| i.key != self.key)
+    }
+
+    fn state(&self) -> &'static str {
+        match self.best() {
+            _ if self.error_key == Some(self.key) => "error",
+            Some((i, q)) if i.key == self.key => match q {
+                Quality::Full => "full",
+                Quality::Small => "small",
+            },
+            Some(_) => "stale",
+            None => "none",
+        }
+    }
+}
+
+/// A frame to render.
+#[derive(Clone, Debug)]
+pub struct Job {
+    pub index: usize,
+    pub quality: Quality,
+    pub path: PathBuf,
+    pub key: u64,
+}
+
+#[derive(Debug, Default)]
+pub struct State {
+    pub frames: Vec<Frame>,
+    pub fps: f64,
+    pub keys: Vec<f64>,
+    /// The errors of the last build (the frames shown are from the last good one).
+    pub diagnostics: Vec<String>,
+    pub warnings: Vec<String>,
+    pub playhead: usize,
+    /// Bumped on every change the page should hear of.
+    pub version: u64,
+    pub stop: bool,
+    /// Builds applied so far (0 until the first one ends).
+    pub builds: u64,
+}
+
+/// The state with the two wake-ups: `changed` for the page's event streams, `work` for the
+/// render workers.
+#[derive(Default)]
+pub struct Shared {
+    state: Mutex<State>,
+    pub changed: Condvar,
+    pub work: Condvar,
+}
+
+impl Shared {
+    pub fn lock(&self) -> MutexGuard<'_, State> {
+        // A worker that panicked left the data whole (every change is one assignment).
+        self.state.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Wakes everyone after a change made under `state`.
+    pub fn touch(&self, state: &mut State) {
+        state.version += 1;
+        self.changed.notify_all();
+        self.work.notify_all();
+    }
+
+    /// Waits on `cv` for at most `timeout`.
+    pub fn wait<'a>(
+        &self,
+        cv: &Condvar,
+        guard: MutexGuard<'a, State>,
+        timeout: Duration,
+    ) -> MutexGuard<'a, State> {
+        match cv.wait_timeout(guard, timeout) {
+            Ok((g, _)) => g,
+            Err(e) => e.into_inner().0,
+        }
+    }
+
+    pub fn stop(&self) {
+        let mut s = self.lock();
+        s.stop = true;
+        self.touch(&mut s);
+    }
+}
+
+impl State {
+    /// Takes in a new build: frames whose content is unchanged keep their images and are not
+    /// rendered again.
+    pub fn apply(&mut self, built: Built) {
+        let old = std::mem::take(&mut self.frames);
+        self.frames = built
+            .frames
+            .into_iter()
+            .enumerate()
+            .map(|(i, src)| {
+                let mut frame = old.get(i).cloned().unwrap_or_default();
+                if frame.path != src.path || frame.key != src.key {
+                    frame.version += 1;
+                }
+                frame.path = src.path;
+                frame.key = src.key;
+                frame
+            })
+            .collect();
+        self.fps = built.fps;
+        self.keys = built.keys;
+        self.warnings = built.warnings;
+        self.diagnostics.clear();
+        self.playhead = self.playhead.min(self.frames.len().saturating_sub(1));
+        self.builds += 1;
+    }
+
+    /// The next frame to render: every frame small first, then full, nearest the playhead
+    /// first (round the loop, as the player wraps).
+    pub fn next_job(&mut self) -> Option<Job> {
+        let n = self.frames.len();
+        let playhead = self.playhead;
+        let order = (0..n).map(|d| (playhead + d) % n);
+        let mut by_distance: Vec<usize> = order.collect();
+        by_distance.sort_by_key(|&i| {
+            let d = i.abs_diff(playhead);
+            d.min(n - d)
+        });
+        let (index, quality) = [Quality::Small, Quality::Full].into_iter().find_map(|q| {
+            by_distance
+                .iter()
+                .find(|&&i| self.frames[i].needs(q))
+                .map(|&i| (i, q))
+        })?;
+        let frame = &mut self.frames[index];
+        frame.busy = Some(quality);
+        Some(Job {
+            index,
+            quality,
+            path: frame.path.clone(),
+            key: frame.key,
+        })
+    }
+
+    /// Stores what a worker made of `job` (dropped if the frame changed meanwhile).
+    pub fn finish(&mut self, job: &Job, result: Result<Vec<u8>, String>) {
+        let Some(frame) = self.frames.get_mut(job.index) else {
+            return;
+        };
+        frame.busy = None;
+        if frame.key != job.key || frame.path != job.path {
+            return;
+        }
+        frame.renders += 1;
+        match result {
+            Ok(png) => {
+                let image = Some(Image {
+                    png: Arc::new(png),
+                    key: job.key,
+                });
+                match job.quality {
+                    Quality::Small => frame.small = image,
+                    Quality::Full => frame.full = image,
+                }
+                frame.error = None;
+                frame.version += 1;
+            }
+            Err(e) => {
+                frame.error = Some(e);
+                frame.error_key = Some(job.key);
+            }
+        }
+    }
+
+    /// Whether every frame is drawn at full quality (or failed).
+    pub fn all_full(&self) -> bool {
+        self.builds > 0
+            && self
+                .frames
+                .iter()
+                .all(|f| f.state() == "full" || f.state() == "error")
+    }
+
+    /// The state as the page reads it (JSON).
+    pub fn to_json(&self) -> String {
+        let mut out = format!(
+            "{{\"version\":{},\"builds\":{},\"fps\":{},\"playhead\":{},\"keys\":[",
+            self.version,
+            self.builds,
+            json_number(self.fps),
+            self.playhead
+        );
+        let keys: Vec<String> = self.keys.iter().map(|&k| json_number(k)).collect();
+        out.push_str(&keys.join(","));
+        out.push_str("],\"frames\":[");
+        for (i, f) in self.frames.iter().enumerate() {
+            if i > 0 {
+                out.push(',');
+            }
+            let _ = write!(
+                out,
+                "{{\"state\":\"{}\",\"v\":{},\"renders\":{},\"error\":{}}}",
+                f.state(),
+                f.version,
+                f.renders,
+                f.error.as_deref().map_or("null".to_string(), json_string)
+            );
+        }
+        out.push_str("],\"diagnostics\":");
+        out.push_str(&json_list(&self.diagnostics));
+        out.push_str(",\"warnings\":");
+        out.push_str(&json_list(&self.warnings));
+        out.push('}');
+        out
+    }
+}
+
+fn json_number(x: f64) -> String {
+    if x.is_finite() {
+        x.to_string()
+    } else {
+        "0".to_string()
+    }
+}
+
+fn json_list(items: &[String]) -> String {
+    let items: Vec<String> = items.iter().map(|s| json_string(s)).collect();
+    format!("[{}]", items.join(","))
+}
+
+/// `s` as a JSON string literal.
+pub fn json_string(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            '\t' => out.push_str("\\t"),
+            c if (c as u32) < 0x20 || c == '<' || c == '>' || c == '&' => {
+                let _ = write!(out, "\\u{:04x}", c as u32);
+            }
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
