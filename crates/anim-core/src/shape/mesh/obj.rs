@@ -11,7 +11,7 @@ use crate::diag::{Diagnostic, Loc, Severity};
 use crate::limits::MAX_MESH_TRIANGLES;
 use glam::Vec3;
 use std::fs::File;
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -43,10 +43,19 @@ pub fn load(path: &Path) -> Result<Mesh, Box<Diagnostic>> {
         ignore_lines: true,
     };
     // Materials are the scene file's business: `mtllib` lines are not followed.
-    let (models, _) = tobj::load_obj_buf(&mut open()?, &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    })
-    .map_err(|e| {
+    // `tobj` reads a polyline of three or more points as a face; a polyline is a curve, and
+    // draws nothing, so those lines never reach it.
+    let loaded = if scan.polylines {
+        let mut faces_only = BufReader::new(WithoutPolylines::new(open()?));
+        tobj::load_obj_buf(&mut faces_only, &options, |_| {
+            Err(tobj::LoadError::OpenFileFailed)
+        })
+    } else {
+        tobj::load_obj_buf(&mut open()?, &options, |_| {
+            Err(tobj::LoadError::OpenFileFailed)
+        })
+    };
+    let (models, _) = loaded.map_err(|e| {
         Box::new(Diagnostic::file_error(
             path,
             format!("cannot be read as OBJ: {e}"),
@@ -84,6 +93,46 @@ pub fn load(path: &Path) -> Result<Mesh, Box<Diagnostic>> {
     normals.shrink_to_fit();
     Mesh::new(positions, normals, triangles)
         .map_err(|e| Box::new(Diagnostic::file_error(path, e.to_string())))
+}
+
+/// An OBJ file with its polyline (`l`) lines turned into comments, line by line.
+struct WithoutPolylines<R> {
+    lines: R,
+    line: Vec<u8>,
+    served: usize,
+}
+
+impl<R: BufRead> WithoutPolylines<R> {
+    fn new(lines: R) -> Self {
+        WithoutPolylines {
+            lines,
+            line: Vec::new(),
+            served: 0,
+        }
+    }
+}
+
+impl<R: BufRead> Read for WithoutPolylines<R> {
+    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+        if self.served == self.line.len() {
+            self.line.clear();
+            self.served = 0;
+            if self.lines.read_until(b'\n', &mut self.line)? == 0 {
+                return Ok(0);
+            }
+            let start = self.line.iter().position(|b| !b.is_ascii_whitespace());
+            if let Some(at) = start {
+                let next = self.line.get(at + 1).copied();
+                if self.line[at] == b'l' && next.is_none_or(|b| b.is_ascii_whitespace()) {
+                    self.line[at] = b'#';
+                }
+            }
+        }
+        let n = out.len().min(self.line.len() - self.served);
+        out[..n].copy_from_slice(&self.line[self.served..self.served + n]);
+        self.served += n;
+        Ok(n)
+    }
 }
 
 /// A problem found on one line: byte range of the culprit and the message.
@@ -153,6 +202,8 @@ struct Scan {
     /// Positions, texture coordinates and normals defined.
     counts: [u64; 3],
     triangles: usize,
+    /// Whether the file has polylines (`l`), which draw nothing.
+    polylines: bool,
     farthest: [Farthest; 3],
 }
 
@@ -271,7 +322,9 @@ fn scan_line(s: &mut Scan, line: &str, line_no: u64) -> Result<(), LineProblem> 
                 face_vertex(s, at, word, line_no)?;
                 corners += 1;
             }
-            if corners >= 3 {
+            if keyword == "l" {
+                s.polylines = true;
+            } else if corners >= 3 {
                 s.triangles += corners - 2;
                 if s.triangles > MAX_MESH_TRIANGLES {
                     return Err((
@@ -503,6 +556,26 @@ mod tests {
         let (line, start, msg) = problem("v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n");
         assert_eq!((line, start), (5, 10));
         assert!(msg.contains("normal 2"), "{msg}");
+    }
+
+    /// A polyline (`l`) draws nothing, however many points it has: a file with a face and
+    /// polylines holds the face alone, and a file of polylines holds no triangles.
+    #[test]
+    fn polylines_draw_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let points = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+        let with_face = dir.path().join("face.obj");
+        std::fs::write(
+            &with_face,
+            format!("{points}l 2 3 4\nf 1 2 3\n  l 1 2 3 4\nl 1 2\n"),
+        )
+        .unwrap();
+        let mesh = load(&with_face).unwrap();
+        assert_eq!(mesh.triangle_count(), 1);
+        let lines_only = dir.path().join("lines.obj");
+        std::fs::write(&lines_only, format!("{points}l 1 2 3\n")).unwrap();
+        let d = load(&lines_only).unwrap_err();
+        assert!(d.message.contains("no triangles"), "{d:?}");
     }
 
     #[test]
