@@ -28,7 +28,7 @@ pub fn run(config: &BenchConfig, stress_table: bool, out: Option<&Path>) -> Exit
     match result {
         Ok(written) => {
             for path in written {
-                eprintln!("wrote {}", path.display());
+                eprintln!("wrote {}", super::shown(&path));
             }
             eprintln!("bench took {:.1} s", start.elapsed().as_secs_f64());
             ExitCode::SUCCESS

@@ -129,7 +129,7 @@ fn print_summary_table(table: &[(&PathBuf, &str, String)]) {
     for (file, result, why) in table {
         println!(
             "| {} | {result} | {} |",
-            file.display(),
+            super::shown(file),
             why.replace('|', "\\|")
         );
     }

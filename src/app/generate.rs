@@ -20,14 +20,14 @@ pub fn run(config: &GenerateConfig, quiet: bool) -> ExitCode {
                     format!(
                         "wrote {} frames ({length}) to {}",
                         report.frames,
-                        report.dir.display()
+                        super::shown(&report.dir)
                     )
                 } else {
                     format!(
                         "wrote {} of {} frames ({length}) to {}; the others were unchanged",
                         report.written,
                         report.frames,
-                        report.dir.display()
+                        super::shown(&report.dir)
                     )
                 };
                 if report.removed > 0 {
@@ -50,7 +50,7 @@ pub fn run(config: &GenerateConfig, quiet: bool) -> ExitCode {
             }
             eprintln!(
                 "error: {} not generated: {errors} error{}",
-                config.spec.display(),
+                super::shown(&config.spec),
                 if errors == 1 { "" } else { "s" }
             );
             ExitCode::FAILURE

@@ -16,7 +16,8 @@ pub use preview::PreviewConfig;
 pub use render::RenderConfig;
 
 use anim_core::limits;
-use std::path::PathBuf;
+use std::borrow::Cow;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// A command with its configuration.
@@ -68,4 +69,11 @@ pub fn run(command: Command, threads: Option<u32>) -> ExitCode {
         } => bench::run(config, *stress, out.as_deref()),
         Command::Preview(config) => preview::run(config, &pool),
     })
+}
+
+/// A path or name as printed: control characters written as escapes (`\u{1b}`), as
+/// diagnostics write them, so that no file name can move the cursor or ring the terminal.
+fn shown(name: &(impl AsRef<Path> + ?Sized)) -> Cow<'static, str> {
+    let text = name.as_ref().to_string_lossy();
+    Cow::Owned(anim_core::diag::escape(&text).into_owned())
 }

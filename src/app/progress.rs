@@ -1,6 +1,7 @@
 //! Progress on the terminal: a bar for a long single-file render, and for a frame directory a
 //! bar on a terminal or one plain line per frame otherwise (logs, Slurm output).
 
+use super::shown;
 use anim_pipeline::frames::{FrameObserver, FrameOutcome, ImageProgress};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
@@ -43,7 +44,7 @@ impl ImageProgress for LazyBar {
 
     fn image(&self, name: &str) {
         if let Some(bar) = &self.bar {
-            bar.set_message(name.to_string());
+            bar.set_message(shown(name).into_owned());
         }
     }
 
@@ -109,13 +110,15 @@ impl FrameObserver for FrameLog {
         let n = self.done.fetch_add(1, Ordering::Relaxed) + 1;
         let total = self.total.load(Ordering::Relaxed);
         let width = total.to_string().len();
+        let name = shown(name);
         let line = match outcome {
             FrameOutcome::Rendered { .. } => format!(
                 "[{n:>width$}/{total}] rendered {name} in {:.2} s",
                 took.as_secs_f64()
             ),
             FrameOutcome::Copied { from, .. } => format!(
-                "[{n:>width$}/{total}] copied {name} from {from} (same scene) in {:.2} s",
+                "[{n:>width$}/{total}] copied {name} from {} (same scene) in {:.2} s",
+                shown(from),
                 took.as_secs_f64()
             ),
             FrameOutcome::Failed(diags) => {

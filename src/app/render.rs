@@ -2,6 +2,7 @@
 //! directories rendered frames in parallel; warnings, errors and a summary on stderr.
 
 use super::progress::{plural, FrameLog, LazyBar};
+use super::shown;
 use anim_core::render::RenderSettings;
 use anim_core::sdf::LoadOptions;
 use anim_pipeline::frames::{self, FrameOptions, Summary};
@@ -47,12 +48,12 @@ fn render_file(input: &Path, config: &RenderConfig) -> bool {
                 }
                 let secs = start.elapsed().as_secs_f64();
                 for out in &outcome.outputs {
-                    eprintln!("wrote {}", out.path.display());
+                    eprintln!("wrote {}", shown(&out.path));
                 }
                 let r = outcome.rays;
                 eprintln!(
                     "{}: {} image(s) in {:.2} s, {:.1} Mrays/s (primary {}, shadow {}, reflected {}, refracted {})",
-                    input.display(),
+                    shown(input),
                     outcome.outputs.len(),
                     secs,
                     r.total() as f64 / secs.max(1e-9) / 1e6,
@@ -109,7 +110,7 @@ fn print_summary(dir: &Path, s: &Summary, quiet: bool) {
     if !s.failed.is_empty() {
         eprintln!("{} frame{} failed:", s.failed.len(), plural(s.failed.len()));
         for (name, diags) in &s.failed {
-            eprintln!("  {name}:");
+            eprintln!("  {}:", shown(name));
             for d in diags.iter().filter(|d| d.is_error() || !quiet) {
                 for line in d.to_string().lines() {
                     eprintln!("    {line}");
@@ -146,7 +147,7 @@ fn print_summary(dir: &Path, s: &Summary, quiet: bool) {
     };
     eprintln!(
         "{}: {shard}{} rendered{copied}, {} skipped (unchanged), {} failed in {:.2} s{rates}",
-        dir.display(),
+        shown(dir),
         s.rendered.len(),
         s.skipped.len(),
         s.failed.len(),

@@ -290,3 +290,42 @@ fn a_huge_line_is_quoted_in_part_and_read_in_linear_time() {
         assert!(stderr.contains('…'), "{name}: {stderr}");
     }
 }
+
+/// Control characters in the names of images, scene files and frame directories reach the
+/// terminal escaped (`\u{1b}`), in the `wrote` line, the progress lines and the summaries,
+/// never raw.
+#[test]
+fn control_characters_in_names_are_printed_escaped() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = dir.path().join("frames\u{7}dir");
+    std::fs::create_dir(&frames).unwrap();
+    let scene = |image: &str| {
+        format!(
+            "define material red 0.2 0 0 0.8 0.1 0.1 0.5 0.5 0.5 20\n\
+             define shape sphere ball 0 0 -5 1 red\n\
+             define light sun 5 5 5 1 1 1 1\n\
+             define camera cam 60\n\
+             render cam {image} 8 6\n"
+        )
+    };
+    let file = frames.join("f\u{1b}[2J\r1.sdf");
+    std::fs::write(&file, scene("a\u{1b}]0;title\u{7}b.png")).unwrap();
+    let raw = |bytes: &[u8]| bytes.iter().any(|&b| b == 0x1b || b == 0x07 || b == b'\r');
+    let alone = anim().arg("render").arg(&file).output().unwrap();
+    let stderr = String::from_utf8_lossy(&alone.stderr);
+    assert!(alone.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("wrote ") && stderr.contains("\\u{1b}"),
+        "{stderr}"
+    );
+    assert!(!raw(&alone.stderr) && !raw(&alone.stdout), "{stderr:?}");
+    std::fs::write(&file, scene("c\u{1b}[31m.png")).unwrap();
+    let all = anim().arg("render").arg(&frames).output().unwrap();
+    let stderr = String::from_utf8_lossy(&all.stderr);
+    assert!(all.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("rendered f\\u{1b}[2J\\u{d}1.sdf"),
+        "{stderr}"
+    );
+    assert!(!raw(&all.stderr) && !raw(&all.stdout), "{stderr:?}");
+}

@@ -46,7 +46,7 @@ pub fn run(config: &PreviewConfig, pool: &ThreadPool) -> ExitCode {
         }
     };
     if !config.input.is_file() {
-        eprintln!("{}: error: no such file", config.input.display());
+        eprintln!("{}: error: no such file", super::shown(&config.input));
         return ExitCode::FAILURE;
     }
     let project = Project {
@@ -105,7 +105,7 @@ fn serve(config: &PreviewConfig, shared: &Arc<Shared>, export: Export) -> ExitCo
         return ExitCode::FAILURE;
     };
     let url = format!("http://{addr}/");
-    eprintln!("previewing {} at {url}", config.input.display());
+    eprintln!("previewing {} at {url}", super::shown(&config.input));
     if !addr.ip().is_loopback() {
         eprintln!(
             "warning: listening on {}: other machines can see this preview",
