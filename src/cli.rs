@@ -334,7 +334,8 @@ fn parse_max_depth(s: &str) -> Result<u32, String> {
     whole_in(s, 0..=limits::MAX_DEPTH)
 }
 
-/// A byte count with an optional binary suffix: `4096`, `512K`, `512M`, `8G` (also `8GiB`).
+/// A byte count with an optional binary suffix: `4096`, `512K`, `512M`, `8G` (also `8GiB`),
+/// up to `16E`, which stands for the largest count there is (one byte short of 16 EiB).
 fn parse_bytes(s: &str) -> Result<u64, String> {
     let t = s.trim();
     let digits = t.find(|c: char| !c.is_ascii_digit()).unwrap_or(t.len());
@@ -348,11 +349,16 @@ fn parse_bytes(s: &str) -> Result<u64, String> {
         "M" | "MB" | "MIB" => 20,
         "G" | "GB" | "GIB" => 30,
         "T" | "TB" | "TIB" => 40,
+        "P" | "PB" | "PIB" => 50,
+        "E" | "EB" | "EIB" => 60,
         _ => return Err(format!("'{s}' is not a size such as 512M or 8G")),
     };
-    n.checked_mul(1 << shift)
-        .filter(|&b| b > 0)
-        .ok_or_else(|| format!("'{s}' is not a size between 1 byte and 16 EiB"))
+    let bytes = u128::from(n) << shift;
+    match bytes {
+        0 => Err(format!("'{s}' is not a size between 1 byte and 16 EiB")),
+        b if b == 1u128 << 64 => Ok(u64::MAX),
+        b => u64::try_from(b).map_err(|_| format!("'{s}' is not a size between 1 byte and 16 EiB")),
+    }
 }
 
 impl RenderArgs {

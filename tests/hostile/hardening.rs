@@ -453,3 +453,36 @@ fn two_frames_naming_one_image_is_an_error_at_the_later() {
         );
     }
 }
+
+/// Memory sizes read and read back: `--max-memory` takes sizes up to the 16 EiB its help
+/// names, and a tiny budget is written in bytes, never as "0.0 MiB".
+#[test]
+fn memory_budgets_are_read_and_written_at_both_ends() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.sdf");
+    std::fs::write(&scene, format!("{SPHERE}render cam s.png 8 6\n")).unwrap();
+    let check = |budget: &str| {
+        let out = anim()
+            .args(["check", "--max-memory", budget])
+            .arg(&scene)
+            .output()
+            .unwrap();
+        (
+            out.status.success(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    for budget in ["16E", "16EiB", "1P", "8G"] {
+        let (ok, stderr) = check(budget);
+        assert!(ok, "{budget}: {stderr}");
+    }
+    let (ok, stderr) = check("17E");
+    assert!(
+        !ok && stderr.contains("between 1 byte and 16 EiB"),
+        "{stderr}"
+    );
+    let (ok, stderr) = check("1");
+    assert!(!ok, "{stderr}");
+    assert!(stderr.contains("more than the 1 byte allowed"), "{stderr}");
+    assert!(!stderr.contains("0.0"), "{stderr}");
+}

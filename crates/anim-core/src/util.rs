@@ -250,15 +250,15 @@ pub fn physical_memory() -> Option<u64> {
     kib.checked_mul(1024)
 }
 
-/// `bytes` for messages: in MiB below a GiB, else in GiB, one decimal.
+/// `bytes` for messages: whole bytes below a KiB, then KiB, MiB or GiB with one decimal (a
+/// tiny figure never reads as "0.0").
 pub fn human_bytes(bytes: u64) -> String {
-    const MIB: f64 = (1u64 << 20) as f64;
-    const GIB: f64 = (1u64 << 30) as f64;
+    const UNITS: [(&str, u32); 3] = [("GiB", 30), ("MiB", 20), ("KiB", 10)];
     let b = bytes as f64;
-    if b < GIB {
-        format!("{:.1} MiB", b / MIB)
-    } else {
-        format!("{:.1} GiB", b / GIB)
+    match UNITS.iter().find(|(_, shift)| bytes >= 1u64 << shift) {
+        Some((unit, shift)) => format!("{:.1} {unit}", b / (1u64 << shift) as f64),
+        None if bytes == 1 => "1 byte".to_string(),
+        None => format!("{bytes} bytes"),
     }
 }
 
@@ -348,7 +348,10 @@ mod tests {
     fn bytes_read_in_mib_or_gib() {
         assert_eq!(human_bytes(3 << 20), "3.0 MiB");
         assert_eq!(human_bytes(1536 << 20), "1.5 GiB");
-        assert_eq!(human_bytes(0), "0.0 MiB");
+        assert_eq!(human_bytes(0), "0 bytes");
+        assert_eq!(human_bytes(1), "1 byte");
+        assert_eq!(human_bytes(1536), "1.5 KiB");
+        assert_eq!(human_bytes(u64::MAX), "17179869184.0 GiB");
     }
 
     #[test]

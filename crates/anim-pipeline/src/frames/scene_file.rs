@@ -9,7 +9,7 @@ use anim_core::render::film::{self, ImageBytes, ImageFormat};
 use anim_core::render::{render_prepared, Prepared, RayCounts, RenderSettings, Rendered};
 use anim_core::scene::RenderJob;
 use anim_core::sdf::LoadOptions;
-use anim_core::util::{write_atomically, Fnv64};
+use anim_core::util::{human_bytes, write_atomically, Fnv64};
 use std::io::Write as _;
 use std::path::{Component, Path, PathBuf};
 
@@ -266,8 +266,8 @@ fn resolve_targets(
                     job,
                     format!(
                         "a {width}×{height} image needs about {} to render, more than the {} allowed",
-                        gib(needed),
-                        gib(settings.max_memory)
+                        human_bytes(needed),
+                        human_bytes(settings.max_memory)
                     ),
                 )
                 .with_help(
@@ -312,11 +312,6 @@ fn resolve_targets(
     } else {
         Err(errors)
     }
-}
-
-/// `bytes` in GiB, for messages.
-fn gib(bytes: u64) -> String {
-    format!("{:.1} GiB", bytes as f64 / (1u64 << 30) as f64)
 }
 
 /// Renders and writes each job; the warnings that an image would be blank go to `blanks`,
