@@ -27,7 +27,7 @@ pub fn load(path: &Path) -> Result<Mesh, Box<Diagnostic>> {
         if !file.metadata().is_ok_and(|m| m.is_file()) {
             return Err(cannot("it is not a regular file".to_string()));
         }
-        Ok(BufReader::new(file))
+        Ok(obj_lines(file))
     };
     let scan = scan(open()?).map_err(|problem| Box::new(problem.diagnostic(path)))?;
     if scan.triangles == 0 {
@@ -43,18 +43,9 @@ pub fn load(path: &Path) -> Result<Mesh, Box<Diagnostic>> {
         ignore_lines: true,
     };
     // Materials are the scene file's business: `mtllib` lines are not followed.
-    // `tobj` reads a polyline of three or more points as a face; a polyline is a curve, and
-    // draws nothing, so those lines never reach it.
-    let loaded = if scan.polylines {
-        let mut faces_only = BufReader::new(WithoutPolylines::new(open()?));
-        tobj::load_obj_buf(&mut faces_only, &options, |_| {
-            Err(tobj::LoadError::OpenFileFailed)
-        })
-    } else {
-        tobj::load_obj_buf(&mut open()?, &options, |_| {
-            Err(tobj::LoadError::OpenFileFailed)
-        })
-    };
+    let loaded = tobj::load_obj_buf(&mut open()?, &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    });
     let (models, _) = loaded.map_err(|e| {
         Box::new(Diagnostic::file_error(
             path,
@@ -95,44 +86,114 @@ pub fn load(path: &Path) -> Result<Mesh, Box<Diagnostic>> {
         .map_err(|e| Box::new(Diagnostic::file_error(path, e.to_string())))
 }
 
-/// An OBJ file with its polyline (`l`) lines turned into comments, line by line.
-struct WithoutPolylines<R> {
-    lines: R,
+/// An OBJ file's text as both readers of it see it: a UTF-8 byte order mark dropped, every
+/// line ending (LF, CRLF or a lone CR, as old Mac files end their lines) written as LF, so that
+/// line numbers are an editor's, and polyline (`l`) lines turned into comments: `tobj` would
+/// read a polyline of three or more points as a face, and a polyline draws nothing.
+struct ObjLines<R> {
+    text: R,
     line: Vec<u8>,
     served: usize,
+    at_start: bool,
+    /// The last line ended in CR at the end of a buffer: an LF next is part of that ending.
+    after_cr: bool,
 }
 
-impl<R: BufRead> WithoutPolylines<R> {
-    fn new(lines: R) -> Self {
-        WithoutPolylines {
-            lines,
+impl<R: BufRead> ObjLines<R> {
+    fn new(text: R) -> Self {
+        ObjLines {
+            text,
             line: Vec::new(),
             served: 0,
+            at_start: true,
+            after_cr: false,
+        }
+    }
+
+    /// Reads the next line into `line`; false at the end of the text.
+    fn next_line(&mut self) -> std::io::Result<bool> {
+        self.line.clear();
+        self.served = 0;
+        loop {
+            let buf = self.text.fill_buf()?;
+            if buf.is_empty() {
+                // A last line without its line ending.
+                if self.line.is_empty() {
+                    return Ok(false);
+                }
+                self.finish_line();
+                return Ok(true);
+            }
+            let start = usize::from(std::mem::take(&mut self.after_cr) && buf[0] == b'\n');
+            let Some(i) = buf[start..].iter().position(|&b| b == b'\n' || b == b'\r') else {
+                self.line.extend_from_slice(&buf[start..]);
+                let n = buf.len();
+                self.text.consume(n);
+                continue;
+            };
+            let end = start + i;
+            self.line.extend_from_slice(&buf[start..end]);
+            let mut consumed = end + 1;
+            if buf[end] == b'\r' {
+                match buf.get(consumed) {
+                    Some(b'\n') => consumed += 1,
+                    Some(_) => {}
+                    None => self.after_cr = true,
+                }
+            }
+            self.text.consume(consumed);
+            self.finish_line();
+            return Ok(true);
+        }
+    }
+
+    /// Drops the byte order mark of the first line, comments out a polyline, and ends the
+    /// line with LF.
+    fn finish_line(&mut self) {
+        if std::mem::take(&mut self.at_start) && self.line.starts_with(b"\xef\xbb\xbf") {
+            self.line.drain(..3);
+        }
+        self.comment_out_polyline();
+        self.line.push(b'\n');
+    }
+
+    fn comment_out_polyline(&mut self) {
+        if let Some(at) = self.line.iter().position(|b| !b.is_ascii_whitespace()) {
+            let next = self.line.get(at + 1).copied();
+            if self.line[at] == b'l' && next.is_none_or(|b| b.is_ascii_whitespace()) {
+                self.line[at] = b'#';
+            }
         }
     }
 }
 
-impl<R: BufRead> Read for WithoutPolylines<R> {
+impl<R: BufRead> Read for ObjLines<R> {
     fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
-        if self.served == self.line.len() {
-            self.line.clear();
-            self.served = 0;
-            if self.lines.read_until(b'\n', &mut self.line)? == 0 {
-                return Ok(0);
-            }
-            let start = self.line.iter().position(|b| !b.is_ascii_whitespace());
-            if let Some(at) = start {
-                let next = self.line.get(at + 1).copied();
-                if self.line[at] == b'l' && next.is_none_or(|b| b.is_ascii_whitespace()) {
-                    self.line[at] = b'#';
-                }
-            }
-        }
-        let n = out.len().min(self.line.len() - self.served);
-        out[..n].copy_from_slice(&self.line[self.served..self.served + n]);
-        self.served += n;
+        let line = self.fill_buf()?;
+        let n = out.len().min(line.len());
+        out[..n].copy_from_slice(&line[..n]);
+        self.consume(n);
         Ok(n)
     }
+}
+
+/// Lines are served from the line just read, with no second buffer in between.
+impl<R: BufRead> BufRead for ObjLines<R> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        if self.served == self.line.len() && !self.next_line()? {
+            return Ok(&[]);
+        }
+        Ok(&self.line[self.served..])
+    }
+
+    fn consume(&mut self, amount: usize) {
+        self.served = (self.served + amount).min(self.line.len());
+    }
+}
+
+/// The lines of an OBJ file, as [`ObjLines`] gives them.
+fn obj_lines(file: File) -> ObjLines<BufReader<File>> {
+    ObjLines::new(BufReader::new(file))
 }
 
 /// A problem found on one line: byte range of the culprit and the message.
@@ -168,7 +229,7 @@ impl Problem {
 
 /// The text of line `n` (from 1), read again for a problem found after the line had passed.
 fn nth_line(path: &Path, n: u64) -> Option<String> {
-    let mut reader = BufReader::new(File::open(path).ok()?);
+    let mut reader = obj_lines(File::open(path).ok()?);
     let mut buf = Vec::new();
     for _ in 0..n {
         buf.clear();
@@ -202,8 +263,6 @@ struct Scan {
     /// Positions, texture coordinates and normals defined.
     counts: [u64; 3],
     triangles: usize,
-    /// Whether the file has polylines (`l`), which draw nothing.
-    polylines: bool,
     farthest: [Farthest; 3],
 }
 
@@ -259,10 +318,10 @@ fn scan(mut reader: impl BufRead) -> Result<Scan, Problem> {
             .map_err(|(start, end, message)| at(start, end, message))?;
     }
     for (kind, far) in s.farthest.iter().enumerate() {
-        // Indices of texture coordinates or normals a file does not define at all are
-        // ignored, as by `tobj`; vertices must exist.
+        // Every index must name something the file defines: `tobj` ignores indices of kinds
+        // a file defines none of, but such a face says the file is not what its author meant.
         let defined = s.counts[kind];
-        if far.index > defined && (kind == 0 || defined > 0) {
+        if far.index > defined {
             return Err(Problem {
                 line: far.line,
                 start: far.start,
@@ -316,15 +375,14 @@ fn scan_line(s: &mut Scan, line: &str, line_no: u64) -> Result<(), LineProblem> 
             }
             s.counts[2] += 1;
         }
-        "f" | "l" => {
+        // Polylines (`l`) never get here: they reach both readers as comments (`ObjLines`).
+        "f" => {
             let mut corners = 0usize;
             for (at, word) in ws {
                 face_vertex(s, at, word, line_no)?;
                 corners += 1;
             }
-            if keyword == "l" {
-                s.polylines = true;
-            } else if corners >= 3 {
+            if corners >= 3 {
                 s.triangles += corners - 2;
                 if s.triangles > MAX_MESH_TRIANGLES {
                     return Err((
@@ -549,13 +607,49 @@ mod tests {
     }
 
     #[test]
-    fn unused_kinds_of_index_are_ignored_as_tobj_ignores_them() {
-        // No `vt` lines at all: the texture indices are never looked at.
-        assert!(scan_str("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1/7 2/7 3/7\n").is_ok());
+    fn every_index_names_what_the_file_defines() {
+        // No `vt` or `vn` lines at all: a face naming one is an error, at the farthest.
+        let (line, start, msg) = problem("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1/7 2/7 3/9\n");
+        assert_eq!((line, start), (4, 12), "{msg}");
+        assert!(
+            msg.contains("texture coordinate 9 but the file defines 0"),
+            "{msg}"
+        );
+        let (line, _, msg) = problem("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1//1 2//1 3//1\n");
+        assert_eq!(line, 4);
+        assert!(msg.contains("normal 1 but the file defines 0"), "{msg}");
         // Some normals defined: an index past them is an error.
         let (line, start, msg) = problem("v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n");
         assert_eq!((line, start), (5, 10));
         assert!(msg.contains("normal 2"), "{msg}");
+    }
+
+    /// Whatever its line endings and a leading byte order mark, a file reads as an editor
+    /// shows it, whatever the reader's buffer size.
+    #[test]
+    fn line_endings_and_byte_order_marks_read_as_an_editor_shows_them() {
+        let normal = |text: &str, capacity: usize| {
+            let mut out = String::new();
+            let mut lines = ObjLines::new(BufReader::with_capacity(capacity, text.as_bytes()));
+            lines.read_to_string(&mut out).unwrap();
+            out
+        };
+        let text = "\u{feff}v 0 0 0\rv 1 0 0\r\nv 0 1 0\n\rl 1 2 3\r  f 1 2 3";
+        for capacity in [1, 2, 3, 5, 64] {
+            assert_eq!(
+                normal(text, capacity),
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\n\n#  1 2 3\n  f 1 2 3\n".replace("#  1", "# 1"),
+                "buffer of {capacity}"
+            );
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let old_mac = dir.path().join("mac.obj");
+        std::fs::write(&old_mac, "\u{feff}v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r").unwrap();
+        assert_eq!(load(&old_mac).unwrap().triangle_count(), 1);
+        std::fs::write(&old_mac, "v 0 0 0\rv 1 0 0\rf 1 2 3\r").unwrap();
+        let d = load(&old_mac).unwrap_err();
+        let loc = d.loc.clone().unwrap();
+        assert_eq!((loc.line, loc.col), (3, 7), "{d:?}");
     }
 
     /// A polyline (`l`) draws nothing, however many points it has: a file with a face and
