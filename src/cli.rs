@@ -55,8 +55,9 @@ pub struct SceneArgs {
     #[arg(long, value_name = "BYTES", default_value_t = limits::DEFAULT_MAX_INPUT)]
     pub max_input: u64,
     /// Memory a scene, and each image, may take while it is made, e.g. 512M or 8G (default:
-    /// half the machine's memory). Bigger scenes and images are refused before they are
-    /// built, with the memory they would need.
+    /// half of what the process may use: the machine's memory, or less under `ulimit -v` or a
+    /// cgroup limit). Bigger scenes and images are refused before they are built, with the
+    /// memory they would need.
     #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
     pub max_memory: Option<u64>,
 }

@@ -329,3 +329,50 @@ fn control_characters_in_names_are_printed_escaped() {
     );
     assert!(!raw(&all.stderr) && !raw(&all.stdout), "{stderr:?}");
 }
+
+/// Under an address-space limit (`ulimit -v`), the default memory budget is half of it: an
+/// image too large for it and a 2 GB sparse OBJ file each end at once with a located message
+/// and exit code 1, never an abort.
+#[test]
+fn an_address_space_limit_is_the_budget_and_nothing_aborts() {
+    let dir = tempfile::tempdir().unwrap();
+    let head = "define material m 0.2 0.2 0.2 0.8 0.8 0.8 0 0 0 1\n\
+        define light l 0 0 5 1 1 1 1\n\
+        define camera c 60 0.3 0.3 3 0 0 -1 0 1 0\n";
+    std::fs::write(
+        dir.path().join("huge.sdf"),
+        format!("{head}define shape sphere s 0 0 0 1 m\nrender c huge.png 16384 16384\n"),
+    )
+    .unwrap();
+    let obj = dir.path().join("big.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(&obj)
+        .unwrap()
+        .set_len(2 << 30)
+        .unwrap();
+    std::fs::write(
+        dir.path().join("mesh.sdf"),
+        format!("{head}define shape obj t big.obj m\nrender c mesh.png 8 6\n"),
+    )
+    .unwrap();
+    let anim_bin = assert_cmd::cargo::cargo_bin("anim");
+    for (scene, expected) in [
+        ("huge.sdf", "huge.sdf:5:"),
+        ("mesh.sdf", "mesh.sdf:4:1: error: mesh file `big.obj`"),
+    ] {
+        let start = std::time::Instant::now();
+        let out = std::process::Command::new("sh")
+            .arg("-c")
+            .arg("ulimit -v 4000000 && exec \"$0\" render \"$1\"")
+            .arg(&anim_bin)
+            .arg(dir.path().join(scene))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{scene}: {stderr}");
+        assert!(stderr.contains(expected), "{scene}: {stderr}");
+        assert!(start.elapsed().as_secs() < 10, "{scene}: {stderr}");
+    }
+}

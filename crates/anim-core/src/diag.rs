@@ -63,6 +63,16 @@ impl Diagnostic {
         }
     }
 
+    /// A file refused unread for its size (`size` says how large, as known), over the
+    /// `--max-input` limit of `limit` bytes: one message for every reader.
+    pub fn too_large(file: &Path, size: &str, limit: u64) -> Self {
+        Diagnostic::file_error(
+            file,
+            format!("too large to read: {size}, more than the limit of {limit} bytes"),
+        )
+        .with_help("raise the limit with --max-input BYTES if the file is meant")
+    }
+
     /// A problem with a whole file, e.g. it cannot be read.
     pub fn file_error(file: &Path, message: impl Into<String>) -> Self {
         Diagnostic {

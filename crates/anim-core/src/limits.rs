@@ -53,9 +53,10 @@ pub const IMAGE_BYTES_PER_PIXEL: u64 = 12 + 3 + 3 + 6;
 /// 4 GiB.
 const FALLBACK_MEMORY_BUDGET: u64 = 4 << 30;
 
-/// The default memory budget: half the machine's memory, leaving the rest to everything else.
+/// The default memory budget: half the memory the process may use (the machine's, or less
+/// under `ulimit -v` or a control group), leaving the rest to everything else.
 pub fn default_memory_budget() -> u64 {
-    crate::util::physical_memory().map_or(FALLBACK_MEMORY_BUDGET, |m| m / 2)
+    crate::util::memory_limit().map_or(FALLBACK_MEMORY_BUDGET, |m| m / 2)
 }
 
 /// Bytes needed to make a `width × height` image.
@@ -132,6 +133,10 @@ pub const MAX_TOKENS_PER_LINE: usize = 1 << 20;
 /// The default of `--max-input`: 1 GiB. Far beyond any hand-written or generated scene,
 /// and small enough that reading one whole cannot exhaust an ordinary machine.
 pub const DEFAULT_MAX_INPUT: u64 = 1 << 30;
+
+/// Longest line of an OBJ file, in bytes: a face of tens of thousands of corners fits, and a
+/// file without line endings is refused at this length instead of being read whole.
+pub const MAX_OBJ_LINE_BYTES: usize = 1 << 20;
 
 /// Most triangles one OBJ mesh may hold (`define shape obj`): at the renderer's 100 bytes or
 /// less per triangle, about 5 GB; triangle indices also stay far inside the `u32` range.

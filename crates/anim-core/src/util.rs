@@ -250,6 +250,40 @@ pub fn physical_memory() -> Option<u64> {
     kib.checked_mul(1024)
 }
 
+/// The memory this process may use, in bytes: the least of the machine's physical memory,
+/// the address-space limit it runs under (`ulimit -v`, `RLIMIT_AS`) and the memory limit of
+/// its control group (cgroup v2 `memory.max`, v1 `memory.limit_in_bytes`); `None` when the
+/// system says none of them. A limit the process cannot see would end it with an abort
+/// rather than a message, so every one the system tells is counted.
+pub fn memory_limit() -> Option<u64> {
+    let limits = [
+        physical_memory(),
+        address_space_limit(),
+        read_limit("/sys/fs/cgroup/memory.max"),
+        read_limit("/sys/fs/cgroup/memory/memory.limit_in_bytes"),
+    ];
+    limits.into_iter().flatten().min()
+}
+
+/// The soft address-space limit of this process (`Max address space` of
+/// `/proc/self/limits`), when there is one.
+fn address_space_limit() -> Option<u64> {
+    let limits = fs::read_to_string("/proc/self/limits").ok()?;
+    let line = limits
+        .lines()
+        .find(|l| l.starts_with("Max address space"))?;
+    line.trim_start_matches("Max address space")
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
+/// A byte count written alone in a control-group file (`max`, or no file: no limit).
+fn read_limit(path: &str) -> Option<u64> {
+    fs::read_to_string(path).ok()?.trim().parse().ok()
+}
+
 /// `bytes` for messages: whole bytes below a KiB, then KiB, MiB or GiB with one decimal (a
 /// tiny figure never reads as "0.0").
 pub fn human_bytes(bytes: u64) -> String {

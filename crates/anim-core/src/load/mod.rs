@@ -72,15 +72,7 @@ pub fn read_input(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Vec<Di
 fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Box<Diagnostic>> {
     let cannot =
         |e: std::io::Error| Diagnostic::file_error(path, format!("cannot read {what}: {e}"));
-    let too_big = |size: String| {
-        Box::new(
-            Diagnostic::file_error(
-                path,
-                format!("too large to read: {size}, more than the limit of {limit} bytes"),
-            )
-            .with_help("raise the limit with --max-input BYTES if the file is meant"),
-        )
-    };
+    let too_big = |size: String| Box::new(Diagnostic::too_large(path, &size, limit));
     let file = std::fs::File::open(path).map_err(cannot)?;
     let meta = file.metadata().map_err(cannot)?;
     // Regular files tell their length; devices and pipes say 0 and are bounded by `take`.

@@ -277,9 +277,13 @@ impl Builder<'_> {
             return;
         }
         let dir = self.path.parent().unwrap_or(Path::new(""));
-        let loaded = self.opts.meshes.load(&dir.join(&m.file), |path| {
-            crate::shape::mesh::load(path).map(Arc::new)
-        });
+        let max_input = self.opts.max_input;
+        let loaded = self
+            .opts
+            .meshes
+            .load(&dir.join(&m.file), max_input, |path| {
+                crate::shape::mesh::load(path, max_input).map(Arc::new)
+            });
         match loaded {
             Ok(mesh) => m.set(mesh),
             Err(d) if d.loc.is_none() => {

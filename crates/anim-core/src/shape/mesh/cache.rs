@@ -36,10 +36,16 @@ pub struct MeshCache {
 
 impl MeshCache {
     /// The mesh of the OBJ file at `path`: from the cache when a file with the same canonical
-    /// path and the same bytes was loaded before, else read with `load` and kept.
-    pub fn load(&self, path: &Path, load: impl FnOnce(&Path) -> Outcome) -> Outcome {
-        let Some(key) = key_of(path) else {
-            // Unreadable here: `load` says why, at the statement.
+    /// path and the same bytes was loaded before, else read with `load` and kept. A file over
+    /// `max_bytes` is never read here: `load` refuses it.
+    pub fn load(
+        &self,
+        path: &Path,
+        max_bytes: u64,
+        load: impl FnOnce(&Path) -> Outcome,
+    ) -> Outcome {
+        let Some(key) = key_of(path, max_bytes) else {
+            // Unreadable or refused here: `load` says why, at the statement.
             return load(path);
         };
         let slot = {
@@ -60,15 +66,16 @@ impl MeshCache {
     }
 }
 
-/// The canonical path, length and fingerprint of a regular file; `None` when it cannot be
-/// read or is not a regular file (a pipe could be endless, and its bytes would be consumed).
-fn key_of(path: &Path) -> Option<Key> {
+/// The canonical path, length and fingerprint of a regular text file of at most `max_bytes`;
+/// `None` when it cannot be read, is larger, holds a NUL byte, or is not a regular file (opening a pipe waits
+/// for a writer, and its bytes would be consumed).
+fn key_of(path: &Path, max_bytes: u64) -> Option<Key> {
     let path = path.canonicalize().ok()?;
-    let mut file = std::fs::File::open(&path).ok()?;
-    let meta = file.metadata().ok()?;
-    if !meta.is_file() {
+    let meta = std::fs::metadata(&path).ok()?;
+    if !meta.is_file() || meta.len() > max_bytes {
         return None;
     }
+    let mut file = std::fs::File::open(&path).ok()?;
     let mut h = Fnv64::default();
     let mut buf = vec![0u8; 1 << 16];
     let mut len = 0u64;
@@ -76,6 +83,10 @@ fn key_of(path: &Path) -> Option<Key> {
         let n = file.read(&mut buf).ok()?;
         if n == 0 {
             break;
+        }
+        // Not text: the loader refuses it at its first NUL, without this whole reading.
+        if buf[..n].contains(&0) {
+            return None;
         }
         h.write(&buf[..n]);
         len += n as u64;
@@ -111,9 +122,9 @@ mod tests {
 
     /// Loads through `cache`, counting the readings.
     fn load(cache: &MeshCache, path: &Path, reads: &AtomicUsize) -> Outcome {
-        cache.load(path, |p| {
+        cache.load(path, u64::MAX, |p| {
             reads.fetch_add(1, Ordering::SeqCst);
-            super::super::load(p).map(Arc::new)
+            super::super::load(p, u64::MAX).map(Arc::new)
         })
     }
 

@@ -8,7 +8,7 @@
 
 use super::{Mesh, MeshError};
 use crate::diag::{Diagnostic, Loc, Severity};
-use crate::limits::MAX_MESH_TRIANGLES;
+use crate::limits::{MAX_MESH_TRIANGLES, MAX_OBJ_LINE_BYTES};
 use glam::Vec3;
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read};
@@ -18,15 +18,20 @@ use std::sync::Arc;
 /// Loads the mesh of an OBJ file. A problem on a line points at the OBJ file's own line and
 /// column; a problem with the whole file (it cannot be read, it holds no triangles) has no
 /// location and a message that follows the file's name ("… holds no triangles").
-pub fn load(path: &Path) -> Result<Mesh, Box<Diagnostic>> {
-    let open = || {
-        let cannot =
-            |e: String| Box::new(Diagnostic::file_error(path, format!("cannot be read: {e}")));
+pub fn load(path: &Path, max_input: u64) -> Result<Mesh, Box<Diagnostic>> {
+    let cannot = |e: String| Box::new(Diagnostic::file_error(path, format!("cannot be read: {e}")));
+    // A device or pipe could feed a line without end (`/dev/zero`), and opening a pipe waits
+    // for a writer: what is not a regular file is refused before it is opened.
+    let meta = std::fs::metadata(path).map_err(|e| cannot(e.to_string()))?;
+    if !meta.is_file() {
+        return Err(cannot("it is not a regular file".to_string()));
+    }
+    if meta.len() > max_input {
+        let size = format!("{} bytes", meta.len());
+        return Err(Box::new(Diagnostic::too_large(path, &size, max_input)));
+    }
+    let open = || -> Result<_, Box<Diagnostic>> {
         let file = File::open(path).map_err(|e| cannot(e.to_string()))?;
-        // A device or pipe could feed a line without end (`/dev/zero`).
-        if !file.metadata().is_ok_and(|m| m.is_file()) {
-            return Err(cannot("it is not a regular file".to_string()));
-        }
         Ok(obj_lines(file))
     };
     let scan = scan(open()?).map_err(|problem| Box::new(problem.diagnostic(path)))?;
@@ -125,14 +130,22 @@ impl<R: BufRead> ObjLines<R> {
                 return Ok(true);
             }
             let start = usize::from(std::mem::take(&mut self.after_cr) && buf[0] == b'\n');
-            let Some(i) = buf[start..].iter().position(|&b| b == b'\n' || b == b'\r') else {
-                self.line.extend_from_slice(&buf[start..]);
+            let found = buf[start..].iter().position(|&b| b == b'\n' || b == b'\r');
+            let end = found.map_or(buf.len(), |i| start + i);
+            if self.line.len() + (end - start) > MAX_OBJ_LINE_BYTES {
+                return Err(invalid(format!(
+                    "a line is longer than {MAX_OBJ_LINE_BYTES} bytes"
+                )));
+            }
+            if buf[start..end].contains(&0) {
+                return Err(invalid("not a text file (it holds NUL bytes)".to_string()));
+            }
+            self.line.extend_from_slice(&buf[start..end]);
+            if found.is_none() {
                 let n = buf.len();
                 self.text.consume(n);
                 continue;
-            };
-            let end = start + i;
-            self.line.extend_from_slice(&buf[start..end]);
+            }
             let mut consumed = end + 1;
             if buf[end] == b'\r' {
                 match buf.get(consumed) {
@@ -189,6 +202,11 @@ impl<R: BufRead> BufRead for ObjLines<R> {
     fn consume(&mut self, amount: usize) {
         self.served = (self.served + amount).min(self.line.len());
     }
+}
+
+/// A reading error of the text itself, which the scan reports at the line it is on.
+fn invalid(message: String) -> std::io::Error {
+    std::io::Error::new(std::io::ErrorKind::InvalidData, message)
 }
 
 /// The lines of an OBJ file, as [`ObjLines`] gives them.
@@ -645,11 +663,44 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let old_mac = dir.path().join("mac.obj");
         std::fs::write(&old_mac, "\u{feff}v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r").unwrap();
-        assert_eq!(load(&old_mac).unwrap().triangle_count(), 1);
+        assert_eq!(load(&old_mac, u64::MAX).unwrap().triangle_count(), 1);
         std::fs::write(&old_mac, "v 0 0 0\rv 1 0 0\rf 1 2 3\r").unwrap();
-        let d = load(&old_mac).unwrap_err();
+        let d = load(&old_mac, u64::MAX).unwrap_err();
         let loc = d.loc.clone().unwrap();
         assert_eq!((loc.line, loc.col), (3, 7), "{d:?}");
+    }
+
+    /// What cannot be a mesh is refused before it costs memory or time: a pipe (opening it
+    /// would wait for a writer), a file over the input limit, a line without end, NUL bytes.
+    #[test]
+    fn pipes_huge_files_endless_lines_and_nul_bytes_are_refused_early() {
+        let dir = tempfile::tempdir().unwrap();
+        let pipe = dir.path().join("pipe.obj");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&pipe)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let d = load(&pipe, u64::MAX).unwrap_err();
+        assert!(d.message.contains("not a regular file"), "{d:?}");
+        let sparse = dir.path().join("sparse.obj");
+        std::fs::File::create(&sparse)
+            .unwrap()
+            .set_len(3 << 20)
+            .unwrap();
+        let d = load(&sparse, 1 << 20).unwrap_err();
+        assert!(
+            d.message.contains("too large to read: 3145728 bytes"),
+            "{d:?}"
+        );
+        let d = load(&sparse, u64::MAX).unwrap_err();
+        assert!(d.message.contains("NUL"), "{d:?}");
+        let endless = dir.path().join("endless.obj");
+        let line = "v 0 0 0\n".to_string() + &"1".repeat(MAX_OBJ_LINE_BYTES + 1);
+        std::fs::write(&endless, line).unwrap();
+        let d = load(&endless, u64::MAX).unwrap_err();
+        assert!(d.message.contains("longer than"), "{d:?}");
+        assert_eq!(d.loc.map(|l| l.line), Some(2));
     }
 
     /// A polyline (`l`) draws nothing, however many points it has: a file with a face and
@@ -664,11 +715,11 @@ mod tests {
             format!("{points}l 2 3 4\nf 1 2 3\n  l 1 2 3 4\nl 1 2\n"),
         )
         .unwrap();
-        let mesh = load(&with_face).unwrap();
+        let mesh = load(&with_face, u64::MAX).unwrap();
         assert_eq!(mesh.triangle_count(), 1);
         let lines_only = dir.path().join("lines.obj");
         std::fs::write(&lines_only, format!("{points}l 1 2 3\n")).unwrap();
-        let d = load(&lines_only).unwrap_err();
+        let d = load(&lines_only, u64::MAX).unwrap_err();
         assert!(d.message.contains("no triangles"), "{d:?}");
     }
 
@@ -681,7 +732,7 @@ mod tests {
             paths.push(Path::new("/dev/zero"));
         }
         for p in paths {
-            let d = load(p).unwrap_err();
+            let d = load(p, u64::MAX).unwrap_err();
             assert!(
                 d.loc.is_none() && d.message.contains("cannot be read"),
                 "{d:?}"
