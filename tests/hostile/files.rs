@@ -376,3 +376,36 @@ fn an_address_space_limit_is_the_budget_and_nothing_aborts() {
         assert!(start.elapsed().as_secs() < 10, "{scene}: {stderr}");
     }
 }
+
+/// A named pipe given as the scene file, which nothing writes to, is an error within a
+/// second, for `check` and `render` alike (opening it would wait for a writer forever).
+#[test]
+fn a_named_pipe_nothing_writes_to_is_an_error_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let pipe = dir.path().join("scene.sdf");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&pipe)
+        .status()
+        .unwrap();
+    assert!(made.success());
+    for command in ["check", "render"] {
+        let start = std::time::Instant::now();
+        let out = anim()
+            .arg(command)
+            .arg(&pipe)
+            .timeout(std::time::Duration::from_secs(20))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{command}: {stderr}");
+        assert!(
+            stderr.contains("a named pipe that nothing writes to"),
+            "{command}: {stderr}"
+        );
+        assert!(
+            start.elapsed().as_millis() < 1500,
+            "{command}: {:?}",
+            start.elapsed()
+        );
+    }
+}

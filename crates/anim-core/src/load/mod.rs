@@ -73,7 +73,7 @@ fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Box<Diag
     let cannot =
         |e: std::io::Error| Diagnostic::file_error(path, format!("cannot read {what}: {e}"));
     let too_big = |size: String| Box::new(Diagnostic::too_large(path, &size, limit));
-    let file = std::fs::File::open(path).map_err(cannot)?;
+    let file = open_without_waiting(path).map_err(cannot)?;
     let meta = file.metadata().map_err(cannot)?;
     // Regular files tell their length; devices and pipes say 0 and are bounded by `take`.
     if meta.is_file() && meta.len() > limit {
@@ -97,6 +97,30 @@ fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Box<Diag
         return Err(too_big("it goes on past the limit".to_string()));
     }
     Ok(bytes)
+}
+
+/// How long opening a named pipe may wait for a program to write to it.
+const PIPE_WAIT: std::time::Duration = std::time::Duration::from_millis(500);
+
+/// Opens `path` for reading. Opening a named pipe waits until something opens it for
+/// writing, which may be never: a pipe is opened on a thread of its own, and given up (the
+/// thread left waiting) when no writer comes within `PIPE_WAIT`. `/dev/stdin` fed by a
+/// pipe has its writer already.
+fn open_without_waiting(path: &Path) -> std::io::Result<std::fs::File> {
+    use std::os::unix::fs::FileTypeExt;
+    if !std::fs::metadata(path)?.file_type().is_fifo() {
+        return std::fs::File::open(path);
+    }
+    let (sender, opened) = std::sync::mpsc::channel();
+    let pipe = path.to_path_buf();
+    std::thread::spawn(move || {
+        let _ = sender.send(std::fs::File::open(pipe));
+    });
+    opened.recv_timeout(PIPE_WAIT).unwrap_or_else(|_| {
+        Err(std::io::Error::other(
+            "it is a named pipe that nothing writes to",
+        ))
+    })
 }
 
 /// Builds the render jobs of a statement list (from [`sdf::parse`], or made by a program, whose
