@@ -409,3 +409,40 @@ fn a_named_pipe_nothing_writes_to_is_an_error_at_once() {
         );
     }
 }
+
+/// Time linear in a shape's `motion` lines: 200,000 of them for one sphere check and render
+/// in seconds (placing the shape at each key's instant walked the keys from the first, which
+/// took minutes at this count).
+#[test]
+fn many_motion_lines_for_one_shape_take_linear_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 200_000;
+    let mut text = String::from(
+        "define material m 0.2 0.2 0.2 0.8 0.8 0.8 0 0 0 1\n\
+         define light l 0 0 5 1 1 1 1\n\
+         define shape sphere s 0 0 -5 1 m\n\
+         define camera c 60\n\
+         render c motion.ppm 16 12\n",
+    );
+    for i in 0..=n {
+        let u = i as f64 / n as f64;
+        text.push_str(&format!("motion s {u} translate {} 0 0\n", u * 0.5));
+    }
+    let scene = write(dir.path(), "motion.sdf", text.as_bytes());
+    for command in ["check", "render"] {
+        let start = std::time::Instant::now();
+        let out = anim()
+            .args([command, "--quiet"])
+            .arg(&scene)
+            .timeout(std::time::Duration::from_secs(120))
+            .output()
+            .unwrap();
+        let took = start.elapsed();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(took.as_secs() < 20, "{command}: {took:?}");
+    }
+}

@@ -130,7 +130,10 @@ impl MotionKeys {
 
     /// `at(u).world_from_object`, without the inverse (for chains that invert once).
     pub fn matrix_at(&self, u: f64) -> DMat4 {
-        let parts = match self.keys.iter().position(|(k, _)| *k >= u) {
+        // The first key at or after `u`, by bisection: the keys are in increasing order, and a
+        // moving shape is placed at every instant of its keys.
+        let first_after = self.keys.partition_point(|(k, _)| *k < u);
+        let parts = match (first_after < self.keys.len()).then_some(first_after) {
             // At a key exactly (and before the first), the key itself, not a blend ending on it.
             Some(i) if i == 0 || self.keys[i].0 == u => self.keys[i].1,
             None => self.keys[self.keys.len() - 1].1,
@@ -156,6 +159,33 @@ impl MotionKeys {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The key found by bisection is the one a walk from the first key finds: before the
+    /// first key, on a key exactly, between two, and past the last.
+    #[test]
+    fn keys_are_found_by_bisection_as_by_a_walk() {
+        let keys: Vec<(f64, Transform)> = [0.0, 0.1, 0.35, 0.5, 0.9]
+            .iter()
+            .map(|&u| (u, Transform::translate(DVec3::new(u * 4.0, u * u, -u))))
+            .collect();
+        let motion = MotionKeys::new(DVec3::ZERO, &keys).unwrap();
+        let walked = |u: f64| {
+            let parts = match motion.keys.iter().position(|(k, _)| *k >= u) {
+                Some(i) if i == 0 || motion.keys[i].0 == u => motion.keys[i].1,
+                None => motion.keys[motion.keys.len() - 1].1,
+                Some(i) => {
+                    let ((u0, a), (u1, b)) = (&motion.keys[i - 1], &motion.keys[i]);
+                    a.lerp(b, (u - u0) / (u1 - u0))
+                }
+            };
+            parts.matrix(motion.centre)
+        };
+        for u in [
+            -0.5, 0.0, 0.05, 0.1, 0.2, 0.35, 0.5, 0.7, 0.9, 0.95, 1.0, 2.0,
+        ] {
+            assert_eq!(motion.matrix_at(u), walked(u), "u = {u}");
+        }
+    }
     use proptest::prelude::*;
 
     fn trs(t: DVec3, degrees: f64, axis: DVec3, s: DVec3) -> Transform {
