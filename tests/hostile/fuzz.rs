@@ -1,6 +1,7 @@
-//! A stable-Rust fuzz harness for the two readers of user text: the SDF reader (parse and
-//! build, no rendering) and the RON keyframe spec reader (parse, then validate against a
-//! small base scene). See FUZZING.md; `scripts/fuzz.sh` runs it.
+//! A stable-Rust fuzz harness for the readers of user text: the SDF reader (parse and build,
+//! no rendering; frame files with `motion` lines among its seeds), the RON keyframe spec
+//! reader (parse, then validate against a small base scene) and the OBJ mesh reader (scan,
+//! `tobj`, the mesh and its hierarchy). See FUZZING.md; `scripts/fuzz.sh` runs it.
 //!
 //! Deterministic: the inputs are mutations of seed files (the shared corpus, `scenes/`,
 //! `animations/`) drawn from the seeded `SplitMix64` of `anim_core::util`, so a run is reproduced by its seed
@@ -20,6 +21,7 @@ use anim_pipeline::keyframe::generate::BaseScene;
 use anim_pipeline::keyframe::spec::{self, Source};
 use std::panic::{self, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
 use std::sync::{Arc, Mutex};
 use std::thread;
@@ -135,7 +137,37 @@ impl Pick for SplitMix64 {
 enum Target {
     Sdf,
     Spec,
+    Obj,
 }
+
+/// Seeds written here, so that every run has them whatever the corpus holds: frames with the
+/// `motion` lines `anim generate` writes for a shutter.
+const FRAME_SEEDS: &[&str] = &["define material m 0.2 0.2 0.2 0.8 0.8 0.8 0 0 0 1\n\
+     define light l 0 0 5 1 1 1 1\n\
+     define shape sphere ball 0 0 -5 1 m\n\
+     define shape box crate -1 -1 -7 1 1 -6 m\n\
+     define composite pair ball crate\n\
+     define camera cam 60 0 0 0 0 0 -1 0 1 0\n\
+     render cam frame.png 32 24\n\
+     motion ball 0 translate -0.2 0 0\n\
+     motion ball 0.5\n\
+     motion ball 1 translate 0.2 0 0 rotate 10 0 1 0\n\
+     motion pair 0 rotate -5 0 1 0\n\
+     motion pair 1 rotate 5 0 1 0 scale 1.1\n\
+     motion l 0 translate 0 1 0\n\
+     motion l 1\n\
+     motion cam 0 rotate 2 0 1 0\n\
+     motion cam 1\n"];
+
+/// OBJ seeds written here: faces of every index form, relative indices, normals, texture
+/// coordinates, polylines, points, groups, CRLF endings.
+const OBJ_SEEDS: &[&str] = &[
+    "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+    "o quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+     vn 0 0 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\nl 1 2 3\np 4\n",
+    "g a\r\nv 0 0 0 1\r\nv 1 0 0 1\r\nv 0 1 0 1\r\nvn 0 0 1\r\nf -3//-1 -2//-1 -1//-1\r\n\
+     usemtl red\r\ns 1\r\n",
+];
 
 /// Seed inputs of one target.
 struct Seeds {
@@ -366,6 +398,23 @@ fn execute(target: Target, input: &[u8], variant: u64, base: &BaseScene) {
                 );
             }
         }
+        Target::Obj => {
+            // The mesh reader reads a file: each input gets its own, gone afterwards.
+            static INPUTS: AtomicU64 = AtomicU64::new(0);
+            let n = INPUTS.fetch_add(1, Ordering::Relaxed);
+            let path =
+                std::env::temp_dir().join(format!("anim-fuzz-{}-{n}.obj", std::process::id()));
+            std::fs::write(&path, input).expect("a temporary file");
+            let result = anim_core::shape::mesh::load(&path, MAX_INPUT as u64);
+            let _ = std::fs::remove_file(&path);
+            if let Err(d) = result {
+                let shown = d.to_string();
+                assert!(
+                    !shown.contains('\u{1b}') && !shown.contains('\0'),
+                    "a raw control byte reaches the terminal: {shown:?}"
+                );
+            }
+        }
         Target::Spec => {
             let src = Source::new(Path::new("fuzz.ron"), text.into_owned());
             if let Ok(file) = spec::parse(&src) {
@@ -462,8 +511,15 @@ struct Report {
 
 /// The SDF and spec seeds (the corpus's and the repository's scenes and specs), announced with
 /// the run's settings.
-fn seeds(settings: &Settings, repo: &Path) -> (Seeds, Seeds) {
-    let sdf_seeds = read_seeds(
+/// The seeds of each target: the corpus and the repository's files, and those written here.
+struct AllSeeds {
+    sdf: Seeds,
+    spec: Seeds,
+    obj: Seeds,
+}
+
+fn seeds(settings: &Settings, repo: &Path) -> AllSeeds {
+    let mut sdf = read_seeds(
         &[
             settings.corpus.clone(),
             repo.join("scenes"),
@@ -474,23 +530,31 @@ fn seeds(settings: &Settings, repo: &Path) -> (Seeds, Seeds) {
             name.ends_with(".sdf") || name.ends_with(".txt")
         },
     );
-    let spec_seeds = read_seeds(&[repo.join("animations"), settings.corpus.clone()], &|p| {
+    sdf.files
+        .extend(FRAME_SEEDS.iter().map(|s| s.as_bytes().to_vec()));
+    let spec = read_seeds(&[repo.join("animations"), settings.corpus.clone()], &|p| {
         p.extension().is_some_and(|e| e == "ron")
     });
+    let mut obj = read_seeds(&[repo.join("scenes"), settings.corpus.clone()], &|p| {
+        p.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+    });
+    obj.files
+        .extend(OBJ_SEEDS.iter().map(|s| s.as_bytes().to_vec()));
     assert!(
-        !sdf_seeds.files.is_empty() && !spec_seeds.files.is_empty(),
+        !sdf.files.is_empty() && !spec.files.is_empty(),
         "no seeds found (corpus {})",
         settings.corpus.display()
     );
     eprintln!(
-        "fuzz: {} SDF seeds, {} spec seeds, seed {}, {} executions, {:?} per input",
-        sdf_seeds.files.len(),
-        spec_seeds.files.len(),
+        "fuzz: {} SDF seeds, {} spec seeds, {} OBJ seeds, seed {}, {} executions, {:?} per input",
+        sdf.files.len(),
+        spec.files.len(),
+        obj.files.len(),
         settings.seed,
         settings.execs,
         settings.timeout
     );
-    (sdf_seeds, spec_seeds)
+    AllSeeds { sdf, spec, obj }
 }
 
 /// The message of the last panic, kept by a panic hook (until `panic::take_hook`) for the
@@ -509,12 +573,12 @@ fn record_panics() -> Arc<Mutex<String>> {
 }
 
 /// The next input: a seed of the target chosen, mutated a few times with another seed.
-fn next_input(rng: &mut SplitMix64, sdf_seeds: &Seeds, spec_seeds: &Seeds) -> (Target, Vec<u8>) {
-    // Four in five inputs are scenes: the SDF reader has far more paths than the spec's.
-    let (target, seeds) = if rng.below(5) == 0 {
-        (Target::Spec, spec_seeds)
-    } else {
-        (Target::Sdf, sdf_seeds)
+fn next_input(rng: &mut SplitMix64, seeds: &AllSeeds) -> (Target, Vec<u8>) {
+    // Three in five inputs are scenes: the SDF reader has far more paths than the others.
+    let (target, seeds) = match rng.below(5) {
+        0 => (Target::Spec, &seeds.spec),
+        1 => (Target::Obj, &seeds.obj),
+        _ => (Target::Sdf, &seeds.sdf),
     };
     let mut input = rng.pick(&seeds.files).clone();
     let other = rng.pick(&seeds.files);
@@ -527,7 +591,7 @@ fn next_input(rng: &mut SplitMix64, sdf_seeds: &Seeds, spec_seeds: &Seeds) -> (T
 
 fn run(settings: &Settings) -> Report {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let (sdf_seeds, spec_seeds) = seeds(settings, repo);
+    let seeds = seeds(settings, repo);
     let base = Arc::new(base_scene(repo));
     let last_panic = record_panics();
     let mut worker = spawn_worker(base.clone(), last_panic.clone());
@@ -537,7 +601,7 @@ fn run(settings: &Settings) -> Report {
     let mut slowest = (Duration::ZERO, 0u64);
     let report_every = (settings.execs / 20).max(1);
     for exec in 0..settings.execs {
-        let (target, input) = next_input(&mut rng, &sdf_seeds, &spec_seeds);
+        let (target, input) = next_input(&mut rng, &seeds);
         let variant = rng.next_u64();
         let began = Instant::now();
         worker
@@ -605,6 +669,7 @@ fn save(settings: &Settings, kind: &str, exec: u64, target: Target, input: &[u8]
     let ext = match target {
         Target::Sdf => "sdf",
         Target::Spec => "ron",
+        Target::Obj => "obj",
     };
     let _ = std::fs::create_dir_all(&settings.out);
     let path = settings
