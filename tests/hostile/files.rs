@@ -446,3 +446,54 @@ fn many_motion_lines_for_one_shape_take_linear_time() {
         assert!(took.as_secs() < 20, "{command}: {took:?}");
     }
 }
+
+/// A spec saved with a byte order mark (as some editors save) generates like the same spec
+/// without one, and an error on its first line is at the column an editor shows.
+#[test]
+fn a_spec_with_a_byte_order_mark_reads_as_without() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("scene.sdf"),
+        "define material m 0.2 0.2 0.2 0.8 0.8 0.8 0 0 0 1\n\
+         define light l 0 0 5 1 1 1 1\n\
+         define shape sphere s 0 0 -5 1 m\n\
+         define camera cam 60\n",
+    )
+    .unwrap();
+    let spec = "(scene: File(\"scene.sdf\"), camera: \"cam\", fps: 24, length: Frames(2), \
+        resolution: (16, 12), output: \"f_{frame}.png\")\n";
+    for (name, text) in [
+        ("plain.ron", spec.to_string()),
+        ("bom.ron", format!("\u{feff}{spec}")),
+    ] {
+        std::fs::write(dir.path().join(name), text).unwrap();
+        let out = anim()
+            .arg("generate")
+            .arg(dir.path().join(name))
+            .arg("-o")
+            .arg(dir.path().join(name.replace(".ron", "")))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let frame = |d: &str| std::fs::read_to_string(dir.path().join(d).join("f_0001.sdf")).unwrap();
+    assert_eq!(
+        frame("plain").replace("plain.ron", "X"),
+        frame("bom").replace("bom.ron", "X")
+    );
+    std::fs::write(dir.path().join("bad.ron"), "\u{feff}(scene: 5)\n").unwrap();
+    let out = anim()
+        .arg("generate")
+        .arg(dir.path().join("bad.ron"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("bad.ron:1:9:"),
+        "{stderr}"
+    );
+}

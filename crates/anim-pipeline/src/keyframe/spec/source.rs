@@ -18,11 +18,17 @@ impl Source {
     pub const MAX_BYTES: u64 = anim_core::limits::DEFAULT_MAX_INPUT;
 
     /// Reads a spec file: refused unread when larger than `limit` bytes (a device or pipe
-    /// after `limit + 1` bytes), when it holds NUL bytes, or when it is not UTF-8.
+    /// after `limit + 1` bytes), when it holds NUL bytes, or when it is not UTF-8. A leading
+    /// byte order mark is dropped.
     pub fn read(path: &Path, limit: u64) -> Result<Source, Vec<Diagnostic>> {
         let bytes = anim_core::load::read_input(path, limit, "the spec")?;
         let text = String::from_utf8(bytes)
             .map_err(|_| vec![Diagnostic::file_error(path, "the spec is not UTF-8 text")])?;
+        // A byte order mark, as some editors write, is no part of the spec (nor a column).
+        let text = match text.strip_prefix('\u{feff}') {
+            Some(rest) => rest.to_string(),
+            None => text,
+        };
         Ok(Source::new(path, text))
     }
 
