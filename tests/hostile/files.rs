@@ -497,3 +497,43 @@ fn a_spec_with_a_byte_order_mark_reads_as_without() {
         "{stderr}"
     );
 }
+
+/// Output patterns whose frames `anim render DIR` would pass over (hidden files) or whose
+/// names would carry control characters are errors at the spec's `output` field.
+#[test]
+fn output_patterns_of_hidden_or_control_names_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("scene.sdf"),
+        "define material m 0.2 0.2 0.2 0.8 0.8 0.8 0 0 0 1\ndefine camera cam 60\n",
+    )
+    .unwrap();
+    for (output, says) in [
+        (".{frame}.png", "starts with a dot"),
+        ("a\\u{1b}[2J{frame}.png", "control character"),
+    ] {
+        let spec = format!(
+            "(scene: File(\"scene.sdf\"), camera: \"cam\", fps: 24, length: Frames(2), \
+             resolution: (16, 12), output: \"{output}\")\n"
+        );
+        std::fs::write(dir.path().join("s.ron"), spec).unwrap();
+        let out = anim()
+            .arg("generate")
+            .arg(dir.path().join("s.ron"))
+            .arg("-o")
+            .arg(dir.path().join("frames"))
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{output}: {stderr}");
+        assert!(
+            stderr.contains("s.ron:1:") && stderr.contains(says),
+            "{output}: {stderr}"
+        );
+        assert!(!stderr.contains('\u{1b}'), "{stderr:?}");
+        assert!(
+            !dir.path().join("frames").exists(),
+            "{output}: frames were written"
+        );
+    }
+}

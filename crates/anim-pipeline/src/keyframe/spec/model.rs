@@ -90,6 +90,18 @@ impl NamePattern {
                 "output '{s}' is a file name, not a path: frames go into frames_dir (or -o)"
             ));
         }
+        if s.starts_with('.') {
+            return Err(format!(
+                "output '{s}' starts with a dot: its frames would be hidden files, which \
+                 `anim render DIR` passes over"
+            ));
+        }
+        if s.contains(char::is_control) {
+            return Err(format!(
+                "output '{}' contains a control character, which a file name should not hold",
+                s.escape_default()
+            ));
+        }
         if s.contains(|c: char| c.is_whitespace() || c == '#') {
             return Err(format!(
                 "output '{s}' contains a space or '#', which the SDF render line cannot hold"
