@@ -537,3 +537,42 @@ fn output_patterns_of_hidden_or_control_names_are_refused() {
         );
     }
 }
+
+/// A spec with 100,000 bad keys lists the first errors and counts the rest, in seconds (each
+/// error quoted its line, which took minutes at this count).
+#[test]
+fn a_spec_with_very_many_bad_keys_lists_the_first_and_counts_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("scene.sdf"),
+        "define material m 0.2 0.2 0.2 0.8 0.8 0.8 0 0 0 1\ndefine camera cam 60\n",
+    )
+    .unwrap();
+    let keys: Vec<String> = (0..100_000)
+        .map(|i| format!("(at: -1, value: ({i}, 0, 0))"))
+        .collect();
+    let spec = format!(
+        "(scene: File(\"scene.sdf\"), camera: \"cam\", fps: 24, length: Frames(2), \
+         resolution: (16, 12), output: \"f_{{frame}}.png\", \
+         tracks: [(target: \"cam\", translate: [{}])])\n",
+        keys.join(",")
+    );
+    std::fs::write(dir.path().join("bad.ron"), spec).unwrap();
+    let start = std::time::Instant::now();
+    let out = anim()
+        .arg("generate")
+        .arg(dir.path().join("bad.ron"))
+        .timeout(std::time::Duration::from_secs(120))
+        .output()
+        .unwrap();
+    let took = start.elapsed();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(took.as_secs() < 20, "{took:?}");
+    assert!(
+        stderr.contains("more (199949 errors) not shown"),
+        "{}",
+        &stderr[stderr.len().saturating_sub(500)..]
+    );
+    assert_eq!(stderr.matches(": error: ").count(), 51);
+}

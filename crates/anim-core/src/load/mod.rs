@@ -342,45 +342,42 @@ fn conclude<'t>(
 }
 
 /// The first [`MAX_DIAGNOSTICS`] diagnostics and, if there were more, one saying how many
-/// were left out (an error if any of those is one, so the count is never mistaken for
-/// harmless).
+/// were left out ([`not_shown`]).
 fn cap(mut diagnostics: Vec<Diagnostic>, path: &Path) -> Vec<Diagnostic> {
     if diagnostics.len() <= MAX_DIAGNOSTICS {
         return diagnostics;
     }
     let rest = diagnostics.split_off(MAX_DIAGNOSTICS);
     let errors = rest.iter().filter(|d| d.is_error()).count();
-    let warnings = rest.len() - errors;
-    let mut kinds = Vec::new();
-    if errors > 0 {
-        kinds.push(format!(
-            "{errors} error{}",
-            if errors == 1 { "" } else { "s" }
-        ));
-    }
-    if warnings > 0 {
-        kinds.push(format!(
-            "{warnings} warning{}",
-            if warnings == 1 { "" } else { "s" }
-        ));
-    }
+    diagnostics.push(not_shown(path, errors, rest.len() - errors));
+    diagnostics
+}
+
+/// The last diagnostic of a file with more problems than are listed: how many `errors` and
+/// `warnings` were left out after the first [`MAX_DIAGNOSTICS`].
+/// An error if any of those is one, so that the count is never mistaken for harmless.
+pub fn not_shown(path: &Path, errors: usize, warnings: usize) -> Diagnostic {
+    let plural = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
+    let kinds: Vec<String> = [(errors, "error"), (warnings, "warning")]
+        .into_iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, what)| plural(n, what))
+        .collect();
     let severity = if errors > 0 {
         Severity::Error
     } else {
         Severity::Warning
     };
-    diagnostics.push(
-        Diagnostic::file_error(
-            path,
-            format!(
-                "and {} more ({}) not shown: only the first {MAX_DIAGNOSTICS} problems of a file are listed",
-                rest.len(),
-                kinds.join(", ")
-            ),
-        )
-        .with_severity(severity),
-    );
-    diagnostics
+    Diagnostic::file_error(
+        path,
+        format!(
+            "and {} more ({}) not shown: only the first {} problems of a file are listed",
+            errors + warnings,
+            kinds.join(", "),
+            MAX_DIAGNOSTICS
+        ),
+    )
+    .with_severity(severity)
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@
 //! reader that records the position of every value; it never decides whether the document
 //! is valid (ron does that first).
 
-use std::collections::HashMap;
+use anim_core::util::FastMap;
 
 /// A 1-based line and column (columns in characters).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -17,7 +17,9 @@ pub struct Pos {
 /// Start position and length (in characters, for the caret) of every value, by path.
 #[derive(Debug, Default)]
 pub struct Locations {
-    spans: HashMap<String, (Pos, u32)>,
+    // Keyed by paths of the user's own file, not by an adversary probing collisions: the fast
+    // hash, as for the scene reader's names.
+    spans: FastMap<String, (Pos, u32)>,
 }
 
 impl Locations {

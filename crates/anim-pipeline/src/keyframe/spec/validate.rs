@@ -9,7 +9,8 @@ use crate::keyframe::interp::Key;
 use crate::keyframe::locate::{field, index};
 use crate::keyframe::tidy::tidy;
 use anim_core::diag::{suggest, Diagnostic};
-use anim_core::limits;
+use anim_core::limits::{self, MAX_DIAGNOSTICS};
+use anim_core::load::not_shown;
 use glam::DVec3;
 
 /// Largest frame count accepted: far beyond any real use, small enough to catch `fps: 24000`.
@@ -28,6 +29,7 @@ pub fn validate(
         duration: 0.0,
         src,
         errors: Vec::new(),
+        unshown: 0,
     };
     let fps = c.fps(spec.fps);
     let frames = c.frame_count(spec.length, fps);
@@ -73,7 +75,7 @@ pub fn validate(
             tracks,
             shutter,
         }),
-        _ => Err(c.errors),
+        _ => Err(c.into_errors()),
     }
 }
 
@@ -122,11 +124,31 @@ struct Checker<'a> {
     duration: f64,
     src: &'a Source,
     errors: Vec<Diagnostic>,
+    /// Errors found past the first `MAX_DIAGNOSTICS`, counted but not made (quoting a line
+    /// costs its length, and a spec may hold a million bad keys).
+    unshown: usize,
 }
 
 impl Checker<'_> {
     fn err(&mut self, paths: &[&str], msg: String) {
-        self.errors.push(self.src.error(paths, msg));
+        if !self.full() {
+            self.errors.push(self.src.error(paths, msg));
+        }
+    }
+
+    /// Whether as many errors as are listed are found already; counts the one about to be.
+    fn full(&mut self) -> bool {
+        let full = self.errors.len() >= MAX_DIAGNOSTICS;
+        self.unshown += usize::from(full);
+        full
+    }
+
+    /// The errors listed, and one counting those that were not.
+    fn into_errors(mut self) -> Vec<Diagnostic> {
+        if self.unshown > 0 {
+            self.errors.push(not_shown(&self.src.path, self.unshown, 0));
+        }
+        self.errors
     }
 
     /// The frame rate; the default rate when it is wrong, so that checking can go on.
@@ -414,7 +436,7 @@ impl Checker<'_> {
         names: &dyn SceneNames,
     ) -> Option<TargetKind> {
         let kind = names.kind_of(&t.target);
-        if kind.is_none() {
+        if kind.is_none() && !self.full() {
             let d = self.src.error(
                 &[&field(path, "target"), path],
                 format!(
