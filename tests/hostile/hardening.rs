@@ -486,3 +486,40 @@ fn memory_budgets_are_read_and_written_at_both_ends() {
     assert!(stderr.contains("more than the 1 byte allowed"), "{stderr}");
     assert!(!stderr.contains("0.0"), "{stderr}");
 }
+
+/// A generate run that cannot write one of its frames (a full disk, or as here a folder in
+/// the way) fails and takes back the frames it had added, so no frame is left that the list
+/// of generated frames does not name.
+#[test]
+fn a_generate_that_fails_midway_takes_back_the_frames_it_added() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("scene.sdf"),
+        format!("{SPHERE}render cam s.png 8 6\n"),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("s.ron"),
+        "(scene: File(\"scene.sdf\"), camera: \"cam\", fps: 24, length: Frames(5), \
+         resolution: (16, 12), output: \"f_{frame}.png\")\n",
+    )
+    .unwrap();
+    let frames = dir.path().join("frames");
+    std::fs::create_dir_all(frames.join("f_0002.sdf")).unwrap();
+    let out = anim()
+        .arg("generate")
+        .arg(dir.path().join("s.ron"))
+        .arg("-o")
+        .arg(&frames)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(stderr.contains("cannot write the frame"), "{stderr}");
+    let mut left: Vec<String> = std::fs::read_dir(&frames)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["f_0002.sdf"], "{stderr}");
+}

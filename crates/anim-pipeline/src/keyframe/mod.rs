@@ -151,19 +151,33 @@ fn write_frames(
     })?;
     let mut written = 0;
     let mut manifest = String::new();
+    // Frames this run adds: a run that fails (a full disk) takes them away again, so that no
+    // frame is left that no list names.
+    let mut created: Vec<PathBuf> = Vec::new();
+    let undo = |created: &[PathBuf], e: Vec<Diagnostic>| {
+        for path in created {
+            let _ = std::fs::remove_file(path);
+        }
+        e
+    };
     for i in 0..anim.frames {
-        let text = checked_frame_text(&generator, anim, src, dir, i)?;
+        let text =
+            checked_frame_text(&generator, anim, src, dir, i).map_err(|e| undo(&created, e))?;
         let name = anim.output.sdf(i, anim.digits());
         let path = dir.join(&name);
         manifest.push_str(&name);
         manifest.push('\n');
         // Unchanged frames are left alone, so their files keep their identity for tools
         // that look at modification times.
-        if std::fs::read(&path).ok().as_deref() == Some(text.as_bytes()) {
+        let before = std::fs::read(&path).ok();
+        if before.as_deref() == Some(text.as_bytes()) {
             continue;
         }
         write_atomically(&path, |w| w.write_all(text.as_bytes()))
-            .map_err(|e| fail(&path, "cannot write the frame", e))?;
+            .map_err(|e| undo(&created, fail(&path, "cannot write the frame", e)))?;
+        if before.is_none() {
+            created.push(path);
+        }
         written += 1;
     }
     let current: HashSet<&str> = manifest.lines().collect();
@@ -173,11 +187,13 @@ fn write_frames(
         match std::fs::remove_file(&path) {
             Ok(()) => removed += 1,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(e) => return Err(fail(&path, "cannot remove an old frame", e)),
+            Err(e) => return Err(undo(&created, fail(&path, "cannot remove an old frame", e))),
         }
     }
-    write_atomically(&manifest_path, |w| w.write_all(manifest.as_bytes()))
-        .map_err(|e| fail(&manifest_path, "cannot record the generated frames", e))?;
+    write_atomically(&manifest_path, |w| w.write_all(manifest.as_bytes())).map_err(|e| {
+        let e = fail(&manifest_path, "cannot record the generated frames", e);
+        undo(&created, e)
+    })?;
     Ok((written, removed))
 }
 
