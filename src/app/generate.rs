@@ -3,17 +3,22 @@
 use anim_pipeline::keyframe::{self, GenerateConfig};
 use std::process::ExitCode;
 
-/// Prints warnings (unless `quiet`), errors and what was written.
+/// Prints warnings (unless `quiet`: once the spec and the base scene are checked, before any
+/// frame is written), errors and what was written.
 pub fn run(config: &GenerateConfig, quiet: bool) -> ExitCode {
-    match keyframe::run_generate(config) {
+    let print_warnings = |warnings: &[anim_core::diag::Diagnostic]| {
+        if !quiet {
+            for w in warnings {
+                eprintln!("{w}");
+            }
+        }
+    };
+    match keyframe::run_generate_reporting(config, print_warnings) {
         Ok(report) => {
             if !quiet {
-                for w in &report.warnings {
-                    eprintln!("{w}");
-                }
                 let length = format!(
                     "{} s at {} fps",
-                    keyframe::tidy::tidy(report.frames as f64 / report.fps as f64),
+                    keyframe::tidy::tidy(report.duration),
                     report.fps
                 );
                 let mut line = if report.written == report.frames {

@@ -248,7 +248,7 @@ fn generate_reports_located_spec_errors() {
         // unknown target
         (
             "(scene: File(\"showcase.sdf\"), length: Frames(3), resolution: (8, 8),\n tracks: [(target: \"lense\", rotate: [(at: 0, value: 1)])])",
-            "spec.ron:2:20: error: the base scene has no shape, composite, camera or light named 'lense'",
+            "spec.ron:2:20: error: the base scene has no shape, composite, camera, light or material named 'lense'",
         ),
         // unsorted keys
         (

@@ -159,7 +159,7 @@ fn unknown_target_is_located_with_a_suggestion() {
     );
     let e = one_error(&text);
     assert!(
-        e.starts_with("spec.ron:8:21: error: the base scene has no shape, composite, camera or light named 'bal'"),
+        e.starts_with("spec.ron:8:21: error: the base scene has no shape, composite, camera, light or material named 'bal'"),
         "{e}"
     );
     assert!(e.contains("did you mean 'ball'?"), "{e}");
@@ -555,7 +555,7 @@ fn scale_through_zero_is_reported_at_the_frame() {
     let e = errors[0].to_string();
     assert!(
         e.starts_with(
-            "spec.ron:6:38: error: at frame 24 (t = 1 s) the scale of 'ball' passes through 0"
+            "spec.ron:6:39: error: at frame 24 (between t = 1 and 1.04166666667 s) the scale of 'ball' passes through 0"
         ),
         "{e}"
     );

@@ -8,7 +8,7 @@ use anim_core::sdf::ast::StatementKind;
 use anim_core::sdf::LoadOptions;
 use anim_core::util::Fnv64;
 use anim_pipeline::frames::list_frames;
-use anim_pipeline::keyframe::spec::{self, KeySpec, SceneSource, Source, SpecFile};
+use anim_pipeline::keyframe::spec::{self, SceneSource, Source, SpecFile};
 use anim_pipeline::keyframe::{run_generate, GenerateConfig};
 use std::path::{Path, PathBuf};
 
@@ -108,7 +108,7 @@ impl Project {
         Ok(Built {
             frames,
             fps: f64::from(report.fps),
-            keys: spec.as_ref().map(key_times).unwrap_or_default(),
+            keys: spec.as_ref().map(SpecFile::key_times).unwrap_or_default(),
             warnings: text(report.warnings),
         })
     }
@@ -151,20 +151,4 @@ fn mesh_files(scene: &Path, load: &LoadOptions) -> Vec<PathBuf> {
             _ => None,
         })
         .collect()
-}
-
-/// Every key time of the spec, sorted, once each.
-fn key_times(spec: &SpecFile) -> Vec<f64> {
-    fn at<T>(keys: &[KeySpec<T>]) -> impl Iterator<Item = f64> + '_ {
-        keys.iter().map(|k| k.at)
-    }
-    let mut times: Vec<f64> = at(&spec.ambient).chain(at(&spec.background)).collect();
-    for t in &spec.tracks {
-        times.extend(at(&t.translate).chain(at(&t.rotate)).chain(at(&t.scale)));
-        times.extend(at(&t.brightness).chain(at(&t.color)).chain(at(&t.fov)));
-    }
-    times.retain(|t| t.is_finite());
-    times.sort_by(f64::total_cmp);
-    times.dedup();
-    times
 }

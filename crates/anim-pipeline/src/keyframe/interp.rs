@@ -1,40 +1,79 @@
-//! Keyframe interpolation: easing curves and sampling a list of keys at a time.
+//! Keyframe interpolation: easing curves, splines, cycles, and sampling a list of keys at a time.
 //!
 //! A key's `interp` governs the segment that *starts* at that key and ends at the next one:
-//! `EaseIn` on a key means the motion towards the next key starts slowly.
+//! `EaseIn` on a key means the motion towards the next key starts slowly. The curves are
+//! documented for users in `docs/animation.md` ("Keys and curves").
 
 use glam::DVec3;
 use serde::Deserialize;
+use std::f64::consts::PI;
 
 /// How a segment between two keys is traversed. With `s ∈ [0, 1]` the fraction of the
-/// segment's time that has passed, the value is `a + (b − a)·e(s)` for:
+/// segment's time that has passed, the value is `a + (b − a)·e(s)` for an easing `e`
+/// ([`Interp::ease`]), except for the two splines, which need the neighbouring keys:
 ///
-/// | mode        | `e(s)`                    | feel                                   |
-/// |-------------|---------------------------|----------------------------------------|
-/// | `Step`      | 0 (until the next key)    | holds, then jumps                      |
-/// | `Linear`    | `s`                       | constant speed                         |
-/// | `EaseIn`    | `s²`                      | starts at rest, speeds up              |
-/// | `EaseOut`   | `1 − (1 − s)²`            | arrives at rest                        |
-/// | `EaseInOut` | `3s² − 2s³` (smoothstep)  | starts and arrives at rest             |
-///
-/// `Smooth` is a Catmull-Rom spline: a cubic Hermite segment whose tangents at each key are
-/// the slope between the neighbouring keys, so a path through several keys has no corners.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize)]
+/// - `Smooth`: a Catmull-Rom spline (each key's tangent is the slope between its
+///   neighbours); no corners, but it can overshoot its keys.
+/// - `Monotone`: a monotone cubic (Fritsch–Carlson tangents, as in PCHIP): no corners where
+///   the keys keep rising or falling, a flat tangent at every peak and dip, and never a value
+///   outside the two keys of its segment.
+#[derive(Clone, Copy, Debug, PartialEq, Default, Deserialize)]
 pub enum Interp {
     Step,
     #[default]
     Linear,
     Smooth,
+    Monotone,
     EaseIn,
     EaseOut,
     EaseInOut,
+    SineIn,
+    SineOut,
+    SineInOut,
+    CubicIn,
+    CubicOut,
+    CubicInOut,
+    QuartIn,
+    QuartOut,
+    QuartInOut,
+    ExpoIn,
+    ExpoOut,
+    ExpoInOut,
+    BackIn,
+    BackOut,
+    BackInOut,
+    BounceIn,
+    BounceOut,
+    BounceInOut,
+    ElasticIn,
+    ElasticOut,
+    ElasticInOut,
+    /// CSS `cubic-bezier(x1, y1, x2, y2)`: the timing curve from (0, 0) to (1, 1) with those
+    /// two control points; `x1` and `x2` lie in [0, 1] so that time never runs backwards.
+    CubicBezier(f64, f64, f64, f64),
 }
 
+/// Back's overshoot constant: about a tenth past the target (Penner's easing equations).
+const BACK: f64 = 1.70158;
+
 impl Interp {
-    /// The eased fraction `e(s)` for the non-spline modes (`Smooth` is linear here: the spline
-    /// needs the neighbouring keys, see [`sample`]).
+    /// Whether this segment's curve needs the neighbouring keys (the two splines).
+    pub fn is_spline(self) -> bool {
+        matches!(self, Interp::Smooth | Interp::Monotone)
+    }
+
+    /// The eased fraction `e(s)`: 0 at `s = 0`, 1 at `s = 1` (the splines are linear here:
+    /// they need the neighbouring keys, see [`sample`]). Back and Elastic leave [0, 1] on
+    /// the way, as they are meant to.
     pub fn ease(self, s: f64) -> f64 {
         let s = s.clamp(0.0, 1.0);
+        let in_out = |e: fn(f64) -> f64| {
+            if s < 0.5 {
+                e(2.0 * s) / 2.0
+            } else {
+                1.0 - e(2.0 - 2.0 * s) / 2.0
+            }
+        };
         match self {
             Interp::Step => {
                 if s >= 1.0 {
@@ -43,22 +82,137 @@ impl Interp {
                     0.0
                 }
             }
-            Interp::Linear | Interp::Smooth => s,
+            Interp::Linear | Interp::Smooth | Interp::Monotone => s,
             Interp::EaseIn => s * s,
             Interp::EaseOut => 1.0 - (1.0 - s) * (1.0 - s),
             Interp::EaseInOut => s * s * (3.0 - 2.0 * s),
+            Interp::SineIn => sine_in(s),
+            Interp::SineOut => 1.0 - sine_in(1.0 - s),
+            Interp::SineInOut => in_out(sine_in),
+            Interp::CubicIn => s.powi(3),
+            Interp::CubicOut => 1.0 - (1.0 - s).powi(3),
+            Interp::CubicInOut => in_out(|s| s.powi(3)),
+            Interp::QuartIn => s.powi(4),
+            Interp::QuartOut => 1.0 - (1.0 - s).powi(4),
+            Interp::QuartInOut => in_out(|s| s.powi(4)),
+            Interp::ExpoIn => expo_in(s),
+            Interp::ExpoOut => 1.0 - expo_in(1.0 - s),
+            Interp::ExpoInOut => in_out(expo_in),
+            Interp::BackIn => back_in(s),
+            Interp::BackOut => 1.0 - back_in(1.0 - s),
+            Interp::BackInOut => in_out(back_in),
+            Interp::BounceIn => 1.0 - bounce_out(1.0 - s),
+            Interp::BounceOut => bounce_out(s),
+            Interp::BounceInOut => in_out(|s| 1.0 - bounce_out(1.0 - s)),
+            Interp::ElasticIn => elastic_in(s),
+            Interp::ElasticOut => 1.0 - elastic_in(1.0 - s),
+            Interp::ElasticInOut => in_out(elastic_in),
+            Interp::CubicBezier(x1, y1, x2, y2) => cubic_bezier(x1, y1, x2, y2, s),
         }
     }
+
+    /// What is wrong with this curve's parameters, if anything.
+    pub fn problem(self) -> Option<String> {
+        let Interp::CubicBezier(x1, y1, x2, y2) = self else {
+            return None;
+        };
+        if ![x1, y1, x2, y2].iter().all(|v| v.is_finite()) {
+            return Some("the control points of CubicBezier must be finite".into());
+        }
+        (!((0.0..=1.0).contains(&x1) && (0.0..=1.0).contains(&x2))).then(|| {
+            format!(
+                "CubicBezier's x1 and x2 must lie in 0..1 (time cannot run backwards), not {x1} and {x2}"
+            )
+        })
+    }
+}
+
+fn sine_in(s: f64) -> f64 {
+    1.0 - (s * PI / 2.0).cos()
+}
+
+fn expo_in(s: f64) -> f64 {
+    // 2^(10s − 10) is 1/1024 at s = 0: shifted and scaled so that the curve starts at 0.
+    let floor = 2f64.powi(-10);
+    (2f64.powf(10.0 * s - 10.0) - floor) / (1.0 - floor)
+}
+
+fn back_in(s: f64) -> f64 {
+    (BACK + 1.0) * s * s * s - BACK * s * s
+}
+
+fn bounce_out(s: f64) -> f64 {
+    // Four parabolic arcs of falling heights (Penner): 1, 1/4, 1/16, 1/64 of the first.
+    const N: f64 = 7.5625;
+    const D: f64 = 2.75;
+    if s < 1.0 / D {
+        N * s * s
+    } else if s < 2.0 / D {
+        let s = s - 1.5 / D;
+        N * s * s + 0.75
+    } else if s < 2.5 / D {
+        let s = s - 2.25 / D;
+        N * s * s + 0.9375
+    } else {
+        let s = s - 2.625 / D;
+        N * s * s + 0.984375
+    }
+}
+
+fn elastic_in(s: f64) -> f64 {
+    if s <= 0.0 || s >= 1.0 {
+        return s.clamp(0.0, 1.0);
+    }
+    let c4 = 2.0 * PI / 3.0;
+    -(2f64.powf(10.0 * s - 10.0)) * ((10.0 * s - 10.75) * c4).sin()
+}
+
+/// The CSS timing curve: solves `x(u) = s` for the Bézier parameter `u` (Newton's method,
+/// bisection where its slope vanishes), then returns `y(u)`.
+fn cubic_bezier(x1: f64, y1: f64, x2: f64, y2: f64, s: f64) -> f64 {
+    let coord = |p1: f64, p2: f64, u: f64| {
+        let v = 1.0 - u;
+        3.0 * v * v * u * p1 + 3.0 * v * u * u * p2 + u * u * u
+    };
+    let slope = |p1: f64, p2: f64, u: f64| {
+        let v = 1.0 - u;
+        3.0 * v * v * p1 + 6.0 * v * u * (p2 - p1) + 3.0 * u * u * (1.0 - p2)
+    };
+    let (mut lo, mut hi, mut u) = (0.0f64, 1.0f64, s);
+    for _ in 0..64 {
+        let x = coord(x1, x2, u) - s;
+        if x.abs() < 1e-14 {
+            break;
+        }
+        if x > 0.0 {
+            hi = u;
+        } else {
+            lo = u;
+        }
+        let d = slope(x1, x2, u);
+        let newton = u - x / d;
+        u = if d.abs() > 1e-9 && newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+    }
+    coord(y1, y2, u)
 }
 
 /// Values that can be keyed: numbers and 3-vectors.
 pub trait Keyable: Copy {
+    /// How many numbers the value holds.
+    const COMPONENTS: usize;
     fn add(self, o: Self) -> Self;
     fn sub(self, o: Self) -> Self;
     fn mul(self, k: f64) -> Self;
+    fn component(self, i: usize) -> f64;
+    fn with_component(self, i: usize, v: f64) -> Self;
 }
 
 impl Keyable for f64 {
+    const COMPONENTS: usize = 1;
     fn add(self, o: Self) -> Self {
         self + o
     }
@@ -67,10 +221,17 @@ impl Keyable for f64 {
     }
     fn mul(self, k: f64) -> Self {
         self * k
+    }
+    fn component(self, _: usize) -> f64 {
+        self
+    }
+    fn with_component(self, _: usize, v: f64) -> Self {
+        v
     }
 }
 
 impl Keyable for DVec3 {
+    const COMPONENTS: usize = 3;
     fn add(self, o: Self) -> Self {
         self + o
     }
@@ -79,6 +240,13 @@ impl Keyable for DVec3 {
     }
     fn mul(self, k: f64) -> Self {
         self * k
+    }
+    fn component(self, i: usize) -> f64 {
+        self[i]
+    }
+    fn with_component(mut self, i: usize, v: f64) -> Self {
+        self[i] = v;
+        self
     }
 }
 
@@ -90,82 +258,216 @@ pub struct Key<T> {
     pub interp: Interp,
 }
 
-/// The value of a keyed channel at time `t` (seconds).
-///
-/// Outside the keyed span the first or last value holds, unless `looping`: then the keys
-/// repeat with period `last.at − first.at` (the first and last key are the same instant of
-/// the cycle), and the spline's neighbours wrap around so a loop has no corner at the seam.
-/// `keys` must have strictly increasing times; `None` only when there are no keys.
-pub fn sample<T: Keyable>(keys: &[Key<T>], t: f64, looping: bool) -> Option<T> {
-    let (first, last) = (keys.first()?, keys.last()?);
-    Some(sample_nonempty(keys, first, last, t, looping))
+/// What a channel does outside its keys.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize)]
+pub enum Cycle {
+    /// The first value holds before the keys, the last after them.
+    #[default]
+    Hold,
+    /// The keys repeat with period `last.at − first.at`, before and after.
+    Repeat,
+    /// The keys play forwards, then backwards, then forwards again.
+    PingPong,
+    /// The keys repeat, each repetition starting where the last ended (Blender's "repeat
+    /// with offset"): a walk cycle that keeps walking.
+    RepeatOffset,
 }
 
-fn sample_nonempty<T: Keyable>(
-    keys: &[Key<T>],
-    first: &Key<T>,
-    last: &Key<T>,
-    t: f64,
-    looping: bool,
-) -> T {
-    if keys.len() == 1 {
-        return first.value;
+/// When a channel's keys play: shifted by `offset` seconds, and cycled.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Timing {
+    /// The keys play this many seconds later than written.
+    pub offset: f64,
+    pub cycle: Cycle,
+    /// How many times the keys play when cycled (`None`: forever, before and after); after
+    /// the last time the value holds where it ended, before the first it holds the first.
+    pub count: Option<u32>,
+}
+
+impl Timing {
+    /// The timing of a plain channel (`looping: false`) or of a repeating one.
+    pub fn looping(looping: bool) -> Timing {
+        Timing {
+            cycle: if looping { Cycle::Repeat } else { Cycle::Hold },
+            ..Timing::default()
+        }
     }
-    let period = last.at - first.at;
-    let t = if looping && period > 0.0 {
-        first.at + (t - first.at).rem_euclid(period)
+
+    /// Whether the keys repeat forever with no offset: the spline's tangents then wrap
+    /// around the seam.
+    fn wraps(&self) -> bool {
+        self.cycle == Cycle::Repeat && self.count.is_none()
+    }
+}
+
+/// Where time `t` falls in a channel's keys once cycled: a time within the keys' span (or
+/// outside it, where the end values hold) and how many whole periods came before.
+pub fn cycled_time(first: f64, last: f64, t: f64, timing: &Timing) -> (f64, i64) {
+    let t = t - timing.offset;
+    let period = last - first;
+    if timing.cycle == Cycle::Hold || period <= 0.0 {
+        return (t, 0);
+    }
+    if timing.wraps() {
+        // Written as it always was, so that looping channels keep their exact values.
+        return (first + (t - first).rem_euclid(period), 0);
+    }
+    let cycles = ((t - first) / period).floor();
+    let limit = timing.count.map_or(f64::INFINITY, f64::from);
+    if timing.count.is_some() && cycles < 0.0 {
+        return (first, 0);
+    }
+    if cycles >= limit {
+        // Held where the last cycle ended: a ping-pong with an even count ends at the start.
+        let last_cycle = limit - 1.0;
+        let back = timing.cycle == Cycle::PingPong && last_cycle.rem_euclid(2.0) == 1.0;
+        return (if back { first } else { last }, last_cycle as i64);
+    }
+    let within = (t - first) - cycles * period;
+    let backwards = timing.cycle == Cycle::PingPong && cycles.rem_euclid(2.0) == 1.0;
+    let local = if backwards {
+        last - within
     } else {
-        t
+        first + within
     };
+    (local, cycles as i64)
+}
+
+/// The value of a keyed channel at time `t` (seconds): repeating when `looping`. See
+/// [`sample_timed`].
+pub fn sample<T: Keyable>(keys: &[Key<T>], t: f64, looping: bool) -> Option<T> {
+    sample_timed(keys, t, &Timing::looping(looping))
+}
+
+/// The value of a keyed channel at time `t` (seconds) under `timing`.
+///
+/// Outside the keyed span the first or last value holds, unless the channel cycles: a
+/// repeating channel's first and last key are the same instant of the cycle, and the
+/// spline's neighbours wrap around so a loop has no corner at the seam. `keys` must have
+/// strictly increasing times; `None` only when there are no keys.
+pub fn sample_timed<T: Keyable>(keys: &[Key<T>], t: f64, timing: &Timing) -> Option<T> {
+    let (first, last) = (keys.first()?, keys.last()?);
+    if keys.len() == 1 {
+        return Some(first.value);
+    }
+    let (t, cycles) = cycled_time(first.at, last.at, t, timing);
+    let value = within_keys(keys, t, timing.wraps());
+    if timing.cycle == Cycle::RepeatOffset && cycles != 0 {
+        return Some(value.add(last.value.sub(first.value).mul(cycles as f64)));
+    }
+    Some(value)
+}
+
+/// The segment `[k, k + 1]` holding `t` and the fraction `s` of it passed; `Err(false)` at
+/// or before the first key, `Err(true)` at or after the last.
+pub fn segment<T>(keys: &[Key<T>], t: f64) -> Result<(usize, f64), bool> {
+    let (first, last) = (&keys[0], &keys[keys.len() - 1]);
     if t <= first.at {
-        return first.value;
+        return Err(false);
     }
     if t >= last.at {
-        return last.value;
+        return Err(true);
     }
-    // The segment [k, k+1] holding t: the last key at or before t.
+    // The last key at or before t.
     let k = keys.partition_point(|key| key.at <= t) - 1;
     let (a, b) = (&keys[k], &keys[k + 1]);
+    Ok((k, (t - a.at) / (b.at - a.at)))
+}
+
+fn within_keys<T: Keyable>(keys: &[Key<T>], t: f64, wraps: bool) -> T {
+    let (k, s) = match segment(keys, t) {
+        Ok(found) => found,
+        Err(after) => return if after { keys[keys.len() - 1] } else { keys[0] }.value,
+    };
+    let (a, b) = (&keys[k], &keys[k + 1]);
     let h = b.at - a.at;
-    let s = (t - a.at) / h;
     match a.interp {
         Interp::Smooth => {
-            let m0 = tangent(keys, k, looping);
-            let m1 = tangent(keys, k + 1, looping);
+            let m0 = tangent(keys, k, wraps);
+            let m1 = tangent(keys, k + 1, wraps);
+            hermite(a.value, m0, b.value, m1, h, s)
+        }
+        Interp::Monotone => {
+            let m0 = monotone_tangent(keys, k, wraps);
+            let m1 = monotone_tangent(keys, k + 1, wraps);
             hermite(a.value, m0, b.value, m1, h, s)
         }
         mode => a.value.add(b.value.sub(a.value).mul(mode.ease(s))),
     }
 }
 
-/// Catmull-Rom tangent (value per second) at key `i`: the slope between its neighbours.
-/// At the ends of a non-looping channel, the slope of the one adjacent segment.
-fn tangent<T: Keyable>(keys: &[Key<T>], i: usize, looping: bool) -> T {
+/// The (value, time) of the keys before and after key `i`, wrapping around the cycle when
+/// `wraps`. Keys 0 and n−1 are the same instant of a loop, so the neighbour across the seam
+/// skips one.
+type Neighbours<T> = (Option<(T, f64)>, Option<(T, f64)>);
+
+fn neighbours<T: Keyable>(keys: &[Key<T>], i: usize, wraps: bool) -> Neighbours<T> {
     let n = keys.len();
     let period = keys[n - 1].at - keys[0].at;
-    // (value, time) of the neighbours, wrapping around the cycle when looping. Keys 0 and
-    // n−1 are the same instant of a loop, so the neighbour across the seam skips one.
     let prev = if i > 0 {
         Some((keys[i - 1].value, keys[i - 1].at))
-    } else if looping && n > 2 {
+    } else if wraps && n > 2 {
         Some((keys[n - 2].value, keys[n - 2].at - period))
     } else {
         None
     };
     let next = if i + 1 < n {
         Some((keys[i + 1].value, keys[i + 1].at))
-    } else if looping && n > 2 {
+    } else if wraps && n > 2 {
         Some((keys[1].value, keys[1].at + period))
     } else {
         None
     };
+    (prev, next)
+}
+
+/// Catmull-Rom tangent (value per second) at key `i`: the slope between its neighbours.
+/// At the ends of a non-looping channel, the slope of the one adjacent segment.
+fn tangent<T: Keyable>(keys: &[Key<T>], i: usize, wraps: bool) -> T {
     let (v, t) = (keys[i].value, keys[i].at);
-    match (prev, next) {
+    match neighbours(keys, i, wraps) {
         (Some((pv, pt)), Some((nv, nt))) => nv.sub(pv).mul(1.0 / (nt - pt)),
         (None, Some((nv, nt))) => nv.sub(v).mul(1.0 / (nt - t)),
         (Some((pv, pt)), None) => v.sub(pv).mul(1.0 / (t - pt)),
         (None, None) => v.mul(0.0),
     }
+}
+
+/// Fritsch–Carlson tangent at key `i`, per component: 0 at a peak, a dip or beside a flat
+/// segment; otherwise the weighted harmonic mean of the two slopes (Fritsch–Butland), which
+/// is at most three times the smaller one, so no segment overshoots its keys. At the ends of
+/// a non-looping channel, the slope of the end segment.
+fn monotone_tangent<T: Keyable>(keys: &[Key<T>], i: usize, wraps: bool) -> T {
+    let (v, t) = (keys[i].value, keys[i].at);
+    let (prev, next) = neighbours(keys, i, wraps);
+    let mut out = v.mul(0.0);
+    for c in 0..T::COMPONENTS {
+        let slope =
+            |(pv, pt): (T, f64), (nv, nt): (T, f64)| (nv.component(c) - pv.component(c), nt - pt);
+        let m = match (prev, next) {
+            (Some(p), Some(n)) => {
+                let (dy0, h0) = slope(p, (v, t));
+                let (dy1, h1) = slope((v, t), n);
+                let (d0, d1) = (dy0 / h0, dy1 / h1);
+                if d0 * d1 <= 0.0 {
+                    0.0
+                } else {
+                    3.0 * (h0 + h1) / ((2.0 * h1 + h0) / d0 + (h1 + 2.0 * h0) / d1)
+                }
+            }
+            (None, Some(n)) => {
+                let (dy, h) = slope((v, t), n);
+                dy / h
+            }
+            (Some(p), None) => {
+                let (dy, h) = slope(p, (v, t));
+                dy / h
+            }
+            (None, None) => 0.0,
+        };
+        out = out.with_component(c, m);
+    }
+    out
 }
 
 /// Cubic Hermite segment from `p0` (tangent `m0`) to `p1` (tangent `m1`), tangents in value
@@ -184,62 +486,4 @@ pub fn hermite<T: Keyable>(p0: T, m0: T, p1: T, m1: T, h: f64, s: f64) -> T {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn k(at: f64, value: f64, interp: Interp) -> Key<f64> {
-        Key { at, value, interp }
-    }
-
-    fn close(a: impl Into<Option<f64>>, b: f64) {
-        let a = a.into().expect("keys");
-        assert!((a - b).abs() < 1e-12, "{a} != {b}");
-    }
-
-    #[test]
-    fn easing_curves_at_known_fractions() {
-        close(Interp::Linear.ease(0.25), 0.25);
-        close(Interp::EaseIn.ease(0.5), 0.25);
-        close(Interp::EaseOut.ease(0.5), 0.75);
-        close(Interp::EaseInOut.ease(0.5), 0.5);
-        // 3·0.0625 − 2·0.015625 = 0.15625
-        close(Interp::EaseInOut.ease(0.25), 0.15625);
-        close(Interp::Step.ease(0.999), 0.0);
-        close(Interp::Step.ease(1.0), 1.0);
-    }
-
-    #[test]
-    fn holds_outside_the_keys() {
-        let keys = [k(1.0, 10.0, Interp::Linear), k(2.0, 20.0, Interp::Linear)];
-        close(sample(&keys, 0.0, false), 10.0);
-        close(sample(&keys, 3.0, false), 20.0);
-        close(sample(&keys, 1.5, false), 15.0);
-    }
-
-    #[test]
-    fn loop_wraps_time() {
-        let keys = [
-            k(0.0, 0.0, Interp::Linear),
-            k(1.0, 10.0, Interp::Linear),
-            k(2.0, 0.0, Interp::Linear),
-        ];
-        close(sample(&keys, 2.5, true), 5.0);
-        close(sample(&keys, -0.5, true), 5.0);
-        close(sample(&keys, 2.5, false), 0.0);
-    }
-
-    #[test]
-    fn smooth_passes_through_keys_and_uses_neighbour_slopes() {
-        // Keys 0→0, 1→1, 2→4 (y = x² at the keys). Tangents: m0 = 1 (one-sided),
-        // m1 = (4 − 0)/2 = 2. At s = 0.5 of the first segment (h = 1):
-        // h00 = 0.5, h10 = 0.125, h01 = 0.5, h11 = −0.125 →
-        // 0.5·0 + 0.125·1 + 0.5·1 − 0.125·2 = 0.375.
-        let keys = [
-            k(0.0, 0.0, Interp::Smooth),
-            k(1.0, 1.0, Interp::Smooth),
-            k(2.0, 4.0, Interp::Smooth),
-        ];
-        close(sample(&keys, 0.5, false), 0.375);
-        close(sample(&keys, 1.0, false), 1.0);
-    }
-}
+mod tests;

@@ -6,11 +6,16 @@
 //! [`generate`] writes the frames. Imports run one way: `generate` → `motion` → `orbit` →
 //! `spec` → {`interp`, `locate`, `tidy`}.
 
+pub mod base;
 pub mod generate;
 pub mod interp;
+pub mod keyed;
 pub mod locate;
 pub mod motion;
 pub mod orbit;
+pub mod placement;
+pub mod ranges;
+pub mod rotation;
 pub mod spec;
 pub mod tidy;
 
@@ -48,12 +53,23 @@ pub struct GenerateReport {
     /// their images).
     pub removed: usize,
     pub fps: u32,
-    /// Warnings about the base scene.
+    /// The animation's length in seconds (the last frame's time, for `end: Inclusive`).
+    pub duration: f64,
+    /// Warnings about the spec and the base scene.
     pub warnings: Vec<Diagnostic>,
 }
 
 /// `anim generate`: reads the spec, writes the frames. `Err` holds every error found.
 pub fn run_generate(config: &GenerateConfig) -> Result<GenerateReport, Vec<Diagnostic>> {
+    run_generate_reporting(config, |_| {})
+}
+
+/// [`run_generate`], handing the warnings to `checked` once everything is checked and before
+/// any frame is written (the report holds them too).
+pub fn run_generate_reporting(
+    config: &GenerateConfig,
+    checked: impl FnOnce(&[Diagnostic]),
+) -> Result<GenerateReport, Vec<Diagnostic>> {
     let spec_path = config.spec.as_path();
     let src = Source::read(spec_path, Source::MAX_BYTES)?;
     let spec_file = spec::parse(&src)?;
@@ -62,9 +78,16 @@ pub fn run_generate(config: &GenerateConfig) -> Result<GenerateReport, Vec<Diagn
         .map(Path::to_path_buf)
         .unwrap_or_default();
 
-    let (statements, warnings) = load_base(&spec_file.scene, &spec_dir, &src)?;
+    let (statements, mut warnings) = load_base(&spec_file.scene, &spec_dir, &src)?;
     let mut base = BaseScene::new(statements);
     let anim = spec::validate(&spec_file, &base, &src)?;
+    warnings.extend(anim.warnings.iter().cloned());
+    for w in first_frame_warnings(&base, &anim, &src, &spec_file.scene, &spec_dir) {
+        if !warnings.iter().any(|d| d.to_string() == w.to_string()) {
+            warnings.push(w);
+        }
+    }
+    checked(&warnings);
 
     let dir = match (&config.out, &spec_file.frames_dir) {
         (Some(out), _) => out.clone(),
@@ -100,6 +123,7 @@ pub fn run_generate(config: &GenerateConfig) -> Result<GenerateReport, Vec<Diagn
             written,
             removed,
             fps: anim.fps,
+            duration: anim.duration(),
             warnings,
         }),
         Err(e) => {
@@ -246,6 +270,41 @@ fn load_base(
         return Err(diags);
     }
     Ok((statements, diags))
+}
+
+/// What `anim check` would say of the first frame, located in the base scene where a base
+/// statement is the cause: an unknown material, an image that would be blank. Said once here
+/// rather than by every frame at render time. A frame that cannot be made yields nothing:
+/// writing the frames reports that.
+fn first_frame_warnings(
+    base: &BaseScene,
+    anim: &Animation,
+    src: &Source,
+    scene: &SceneSource,
+    spec_dir: &Path,
+) -> Vec<Diagnostic> {
+    let Ok(statements) = Generator::new(base, anim, src).frame_statements(0) else {
+        return Vec::new();
+    };
+    let path = match scene {
+        SceneSource::File(rel) => spec_dir.join(rel),
+        SceneSource::Inline(_) => src.path.to_path_buf(),
+    };
+    let Ok(loaded) = anim_core::load::build(&statements, &path, &LoadOptions::default()) else {
+        return Vec::new();
+    };
+    let mut warnings = loaded.diagnostics;
+    warnings.extend(anim_core::load::probe::blank_image_warnings(
+        &loaded.jobs,
+        &path,
+    ));
+    if matches!(scene, SceneSource::Inline(_)) {
+        warnings = warnings
+            .into_iter()
+            .map(|d| shift_into_spec(d, src))
+            .collect();
+    }
+    warnings
 }
 
 /// Points the base scene's OBJ files (`define shape obj`, relative to the base scene) at the

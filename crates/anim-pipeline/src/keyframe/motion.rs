@@ -12,18 +12,21 @@
 //! and `anim_core::render::motion`.
 
 use super::orbit::{self, Pose};
+use super::rotation::axis_degrees;
 use super::spec::{Animation, Track};
 use super::tidy::{tidy, tidy3};
 use anim_core::limits;
 use anim_core::sdf::ast::TransformOp;
 use glam::{DMat3, DQuat, DVec3};
 
-/// Where a track puts its target at one instant: its keyed translation, turn and scale.
+/// Where a track puts its target at one instant: its keyed translation, turn and scale, and
+/// its orientation (keyed, or turned to face what it looks at).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TrackPose {
     pub translate: DVec3,
     pub degrees: f64,
     pub scale: DVec3,
+    pub orient: DQuat,
 }
 
 impl TrackPose {
@@ -46,16 +49,32 @@ impl TrackPose {
                     .and_then(|c| c.at(t))
                     .unwrap_or(DVec3::ONE),
             ),
+            orient: track
+                .orient
+                .as_ref()
+                .and_then(|c| c.orientation(t))
+                .unwrap_or(DQuat::IDENTITY),
         }
     }
 
+    /// The orientation as the frame writes it: a tidy axis and angle, `None` for no turn.
+    fn orientation_op(&self) -> Option<TransformOp> {
+        let (axis, degrees) = axis_degrees(self.orient);
+        let degrees = tidy(degrees);
+        (degrees != 0.0).then(|| TransformOp::Rotate {
+            degrees,
+            axis: tidy3(axis),
+        })
+    }
+
     /// The operations that place the target (see `generate`'s module doc): about the pivot
-    /// `p`, scale and turn, then move by the translation.
+    /// `p`, scale, orient and turn, then move by the translation.
     pub fn ops(&self, pivot: DVec3, axis: DVec3) -> Vec<TransformOp> {
         let mut ops = Vec::new();
         let turns = self.degrees != 0.0;
         let scales = self.scale != DVec3::ONE;
-        if turns || scales {
+        let orientation = self.orientation_op();
+        if turns || scales || orientation.is_some() {
             let p = tidy3(pivot);
             if p != DVec3::ZERO {
                 ops.push(TransformOp::Translate(-p));
@@ -63,6 +82,7 @@ impl TrackPose {
             if scales {
                 ops.push(TransformOp::Scale(self.scale));
             }
+            ops.extend(orientation);
             if turns {
                 ops.push(TransformOp::Rotate {
                     degrees: self.degrees,
@@ -83,6 +103,13 @@ impl TrackPose {
 /// The operations that take a target from where `from` puts it to where `to` does: `to`'s
 /// placement after undoing `from`'s, `P(to)·P(from)⁻¹`, with the steps that cancel left out.
 pub fn delta_ops(from: &TrackPose, to: &TrackPose, pivot: DVec3, axis: DVec3) -> Vec<TransformOp> {
+    if from.orient != DQuat::IDENTITY || to.orient != DQuat::IDENTITY {
+        // Two orientations do not fold into one turn about the track's axis: undo one
+        // placement, then make the other.
+        let mut ops = inverse_ops(&from.ops(pivot, axis));
+        ops.extend(to.ops(pivot, axis));
+        return simplify(ops);
+    }
     let p = tidy3(pivot);
     let mut ops = Vec::new();
     let translate = |v: DVec3, ops: &mut Vec<TransformOp>| {
@@ -234,8 +261,9 @@ fn degrees_turned(angle: impl Fn(f64) -> f64, t0: f64, t1: f64) -> f64 {
 
 /// How many equal steps frame `i`'s exposure is cut into: even, so that the middle is an
 /// instant, at least 2, and enough that nothing turns more than
-/// `limits::MOTION_KEY_DEGREES` in one.
-pub fn steps(anim: &Animation, i: usize) -> usize {
+/// `limits::MOTION_KEY_DEGREES` in one. `turned` is the most that anything turns during the
+/// exposure by orientations and aims, which only the generator can follow.
+pub fn steps(anim: &Animation, i: usize, turned: f64) -> usize {
     let (t0, t1) = (anim.shutter_time(i, 0.0), anim.shutter_time(i, 1.0));
     let tracks = anim
         .tracks
@@ -246,7 +274,7 @@ pub fn steps(anim: &Animation, i: usize) -> usize {
         .orbit
         .iter()
         .map(|o| degrees_turned(|t| orbit::angle_at(o, t, anim.duration()), t0, t1));
-    let most = tracks.chain(orbit).fold(0.0f64, f64::max);
+    let most = tracks.chain(orbit).fold(turned, f64::max);
     let half = (most / (2.0 * limits::MOTION_KEY_DEGREES)).ceil();
     let half = if half.is_finite() { half as usize } else { 1 };
     2 * half.clamp(1, limits::MOTION_MAX_STEPS / 2)
@@ -279,21 +307,25 @@ mod tests {
                 translate: DVec3::new(0.5, 0.0, -1.0),
                 degrees: 30.0,
                 scale: DVec3::ONE,
+                orient: DQuat::IDENTITY,
             },
             TrackPose {
                 translate: DVec3::new(2.0, 1.0, 0.0),
                 degrees: 75.0,
                 scale: DVec3::ONE,
+                orient: DQuat::from_axis_angle(DVec3::X, 0.5),
             },
             TrackPose {
                 translate: DVec3::ZERO,
                 degrees: 0.0,
                 scale: DVec3::new(2.0, 0.5, 1.5),
+                orient: DQuat::IDENTITY,
             },
             TrackPose {
                 translate: DVec3::new(-1.0, 3.0, 2.0),
                 degrees: -140.0,
                 scale: DVec3::new(1.0, 3.0, 0.25),
+                orient: DQuat::IDENTITY,
             },
         ];
         for from in &poses {
@@ -316,10 +348,20 @@ mod tests {
     fn pose() -> impl proptest::strategy::Strategy<Value = TrackPose> {
         use proptest::prelude::*;
         let v = |r: std::ops::Range<f64>| prop::array::uniform3(r).prop_map(DVec3::from);
-        (v(-50.0..50.0), -1000.0f64..1000.0, v(0.05..20.0)).prop_map(|(t, d, s)| TrackPose {
-            translate: tidy3(t),
-            degrees: tidy(d),
-            scale: tidy3(s),
+        let turn =
+            (v(-1.0..1.0), -4.0f64..4.0, any::<bool>()).prop_map(
+                |(axis, angle, turned)| match axis.try_normalize() {
+                    Some(a) if turned => DQuat::from_axis_angle(a, angle),
+                    _ => DQuat::IDENTITY,
+                },
+            );
+        (v(-50.0..50.0), -1000.0f64..1000.0, v(0.05..20.0), turn).prop_map(|(t, d, s, q)| {
+            TrackPose {
+                translate: tidy3(t),
+                degrees: tidy(d),
+                scale: tidy3(s),
+                orient: q,
+            }
         })
     }
 

@@ -4,13 +4,21 @@
 //!
 //! The format is documented for users in `README.md`.
 
+mod checker;
 mod model;
 mod raw;
 mod source;
+mod track;
 mod validate;
 
-pub use model::{Animation, Channel, NamePattern, Orbit, SceneNames, TargetKind, Track};
-pub use raw::{KeySpec, Length, OrbitSpec, Rgb, Scale, SceneSource, SpecFile, TrackSpec, V3};
+pub use model::{
+    Aim, AimTarget, Animation, Channel, End, MaterialChannels, NamePattern, Orbit, OrientChannel,
+    SceneNames, TargetKind, Track,
+};
+pub use raw::{
+    AimSpec, KeySpec, Length, OrbitSpec, Orientation, Rgb, Scale, SceneSource, SpecFile, TrackSpec,
+    V3,
+};
 pub use source::Source;
 pub use validate::validate;
 

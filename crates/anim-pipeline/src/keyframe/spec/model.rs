@@ -1,20 +1,121 @@
 //! The checked animation: what the generator needs, with every value valid.
 
-use crate::keyframe::interp::{sample, Interp, Key, Keyable};
+use crate::keyframe::interp::{cycled_time, sample_timed, segment, Interp, Key, Keyable, Timing};
 use anim_core::limits;
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 
 /// A keyed channel with the path of its key list (for messages about interpolated values).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Channel<T> {
     pub keys: Vec<Key<T>>,
-    pub looping: bool,
+    pub timing: Timing,
     pub path: String,
 }
 
 impl<T: Keyable> Channel<T> {
     pub fn at(&self, t: f64) -> Option<T> {
-        sample(&self.keys, t, self.looping)
+        sample_timed(&self.keys, t, &self.timing)
+    }
+}
+
+impl<T> Channel<T> {
+    /// The path of the key whose segment plays at time `t` (for messages about a value
+    /// between keys), else of the whole list.
+    pub fn key_path_at(&self, t: f64) -> String {
+        let (Some(first), Some(last)) = (self.keys.first(), self.keys.last()) else {
+            return self.path.clone();
+        };
+        let (local, _) = cycled_time(first.at, last.at, t, &self.timing);
+        match segment(&self.keys, local) {
+            Ok((k, _)) => format!("{}[{k}]", self.path),
+            Err(after) => format!(
+                "{}[{}]",
+                self.path,
+                if after { self.keys.len() - 1 } else { 0 }
+            ),
+        }
+    }
+}
+
+/// Keyed orientations, turned by slerp along the shorter arc.
+pub type OrientChannel = Channel<DQuat>;
+
+impl OrientChannel {
+    /// The orientation at time `t`: the segment's easing applied to the slerp fraction.
+    pub fn orientation(&self, t: f64) -> Option<DQuat> {
+        let (first, last) = (self.keys.first()?, self.keys.last()?);
+        let (local, cycles) = cycled_time(first.at, last.at, t, &self.timing);
+        let q = match segment(&self.keys, local) {
+            Ok((k, s)) => {
+                let (a, b) = (&self.keys[k], &self.keys[k + 1]);
+                // q and −q are one orientation: the shorter arc starts from the nearer sign.
+                let to = if a.value.dot(b.value) < 0.0 {
+                    -b.value
+                } else {
+                    b.value
+                };
+                a.value.slerp(to, a.interp.ease(s)).normalize()
+            }
+            Err(after) => {
+                if after {
+                    last.value
+                } else {
+                    first.value
+                }
+            }
+        };
+        if self.timing.cycle == crate::keyframe::interp::Cycle::RepeatOffset && cycles != 0 {
+            // Each repetition starts where the last ended: the whole cycle's turn, again.
+            let (axis, angle) = (last.value * first.value.inverse()).to_axis_angle();
+            let placed = DQuat::from_axis_angle(axis, angle * cycles as f64) * q;
+            return Some(placed.normalize());
+        }
+        Some(q)
+    }
+}
+
+/// What a `look_at` aims at.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AimTarget {
+    Point(DVec3),
+    Keys(Channel<DVec3>),
+    /// A shape or composite of the base scene: its animated centre.
+    Object(String),
+}
+
+/// A track's aim: its target turns to face `target` with `up` kept up, then rolls about the
+/// line of sight.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Aim {
+    pub target: AimTarget,
+    pub up: DVec3,
+    /// Objects only: the direction (in the parent's frame, as the base scene places the
+    /// object) that turns to face the target. Cameras face along their view direction.
+    pub forward: DVec3,
+    pub roll: Option<Channel<f64>>,
+    /// `tracks[i].look_at`, for messages.
+    pub path: String,
+}
+
+/// A material's keyed values.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct MaterialChannels {
+    pub ka: Option<Channel<DVec3>>,
+    pub kd: Option<Channel<DVec3>>,
+    pub ks: Option<Channel<DVec3>>,
+    pub reflectivity: Option<Channel<f64>>,
+    pub opacity: Option<Channel<f64>>,
+    pub ior: Option<Channel<f64>>,
+}
+
+impl MaterialChannels {
+    pub fn any(&self) -> bool {
+        self.ka.is_some()
+            || self.kd.is_some()
+            || self.ks.is_some()
+            || self.reflectivity.is_some()
+            || self.opacity.is_some()
+            || self.ior.is_some()
     }
 }
 
@@ -25,6 +126,7 @@ pub enum TargetKind {
     Composite,
     Camera,
     Light,
+    Material,
 }
 
 impl TargetKind {
@@ -34,6 +136,7 @@ impl TargetKind {
             TargetKind::Composite => "composite",
             TargetKind::Camera => "camera",
             TargetKind::Light => "light",
+            TargetKind::Material => "material",
         }
     }
 }
@@ -51,8 +154,25 @@ pub struct Track {
     pub brightness: Option<Channel<f64>>,
     pub color: Option<Channel<DVec3>>,
     pub fov: Option<Channel<f64>>,
+    /// Keyed orientation, applied about the pivot before `rotate`.
+    pub orient: Option<OrientChannel>,
+    pub aim: Option<Aim>,
+    pub material: MaterialChannels,
+    /// 1 shown, 0 hidden; stepped.
+    pub visible: Option<Channel<f64>>,
     /// `tracks[i]`, for messages.
     pub path: String,
+}
+
+impl Track {
+    /// Whether the track moves its target (rather than setting its parameters only).
+    pub fn moves(&self) -> bool {
+        self.translate.is_some()
+            || self.rotate.is_some()
+            || self.scale.is_some()
+            || self.orient.is_some()
+            || self.aim.is_some()
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -137,6 +257,17 @@ impl NamePattern {
     }
 }
 
+/// Where the last frame falls.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize)]
+pub enum End {
+    /// One step before `length`: the frame after the last is the first again, so a loop has
+    /// no doubled frame.
+    #[default]
+    Cyclic,
+    /// At `length`: `length·fps + 1` frames, the last showing the pose keyed at `length`.
+    Inclusive,
+}
+
 /// A validated animation, ready to generate frames from.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Animation {
@@ -153,6 +284,9 @@ pub struct Animation {
     pub tracks: Vec<Track>,
     /// The fraction of each frame's interval the shutter stays open (0: an instant).
     pub shutter: f64,
+    pub end: End,
+    /// What the checks found worth saying that does not stop generation.
+    pub warnings: Vec<anim_core::diag::Diagnostic>,
 }
 
 impl Animation {
@@ -161,9 +295,25 @@ impl Animation {
         self.frames.saturating_sub(1).to_string().len().max(4)
     }
 
-    /// Length in seconds.
+    /// Length in seconds: the time of the frame after the last (cyclic), or of the last
+    /// frame (inclusive).
     pub fn duration(&self) -> f64 {
-        self.frames as f64 / self.fps as f64
+        match self.end {
+            End::Cyclic => self.frames as f64 / self.fps as f64,
+            End::Inclusive => self.frames.saturating_sub(1) as f64 / self.fps as f64,
+        }
+    }
+
+    /// The span of time frame `i` stands for: up to the next frame (the last frame of a
+    /// cyclic animation up to its end; of an inclusive one, its instant).
+    pub fn frame_span(&self, i: usize) -> (f64, f64) {
+        let start = self.time(i);
+        let end = if i + 1 < self.frames {
+            self.time(i + 1)
+        } else {
+            self.duration().max(start)
+        };
+        (start, end)
     }
 
     /// Time of frame `i` in seconds.

@@ -1,7 +1,9 @@
 //! The spec as the user writes it: serde types that mirror the RON text one to one, so that
 //! ron rejects every unknown field and variant with its position.
 
-use crate::keyframe::interp::Interp;
+use super::model::End;
+use crate::keyframe::interp::{Cycle, Interp};
+use crate::keyframe::rotation::EulerOrder;
 use glam::DVec3;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
@@ -50,6 +52,32 @@ pub struct SpecFile {
     pub background: Vec<KeySpec<Rgb>>,
     #[serde(default)]
     pub tracks: Vec<TrackSpec>,
+    /// Named sets of keyed channels that tracks use with `curve: "name"`.
+    #[serde(default)]
+    pub curves: Vec<TrackSpec>,
+    /// Whether the last frame is one step before `length` (`Cyclic`, the default) or at it.
+    #[serde(default)]
+    pub end: End,
+}
+
+impl SpecFile {
+    /// Every key time written in the spec, sorted, once each (the preview marks them).
+    pub fn key_times(&self) -> Vec<f64> {
+        let mut times: Vec<f64> = key_times(&self.ambient)
+            .chain(key_times(&self.background))
+            .collect();
+        for t in self.tracks.iter().chain(&self.curves) {
+            times.extend(t.key_times().map(|at| at + t.offset));
+        }
+        times.retain(|t| t.is_finite());
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        times
+    }
+}
+
+fn key_times<T>(keys: &[KeySpec<T>]) -> impl Iterator<Item = f64> + '_ {
+    keys.iter().map(|k| k.at)
 }
 
 fn default_fps() -> f64 {
@@ -102,11 +130,19 @@ fn one() -> f64 {
     1.0
 }
 
-#[derive(Debug, Deserialize)]
+/// A track (with a `target`) or a named curve (with a `name`): keyed channels.
+#[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TrackSpec {
-    /// A shape, composite, camera or light of the base scene.
-    pub target: String,
+    /// A shape, composite, camera, light or material of the base scene (tracks only).
+    #[serde(default)]
+    pub target: Option<String>,
+    /// The name a curve is used by (curves only).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// A named curve whose channels this track plays where it keys none of its own.
+    #[serde(default)]
+    pub curve: Option<String>,
     #[serde(default)]
     pub translate: Vec<KeySpec<V3>>,
     /// Degrees about `axis`.
@@ -120,6 +156,24 @@ pub struct TrackSpec {
     /// Centre of rotation and scaling; default: the object's centre as the base scene places it.
     #[serde(default)]
     pub pivot: Option<V3>,
+    /// Full 3-D orientation keys, slerped.
+    #[serde(default)]
+    pub orient: Vec<KeySpec<Orientation>>,
+    /// The order of `Euler` angles: `XYZ` turns about x first (the parent's axes).
+    #[serde(default)]
+    pub euler_order: Option<EulerOrder>,
+    /// Turn to face a point, keyed points or an object.
+    #[serde(default)]
+    pub look_at: Option<AimSpec>,
+    /// With `look_at`: the direction kept up (default +y).
+    #[serde(default)]
+    pub up: Option<V3>,
+    /// With `look_at`: degrees about the line of sight.
+    #[serde(default)]
+    pub roll: Vec<KeySpec<f64>>,
+    /// With `look_at` on an object: the direction that faces the target (default −z).
+    #[serde(default)]
+    pub forward: Option<V3>,
     /// Lights only.
     #[serde(default)]
     pub brightness: Vec<KeySpec<f64>>,
@@ -129,9 +183,84 @@ pub struct TrackSpec {
     /// Cameras only: horizontal field of view in degrees.
     #[serde(default)]
     pub fov: Vec<KeySpec<f64>>,
+    /// Materials only: ambient, diffuse and specular colours.
+    #[serde(default)]
+    pub ka: Vec<KeySpec<Rgb>>,
+    #[serde(default)]
+    pub kd: Vec<KeySpec<Rgb>>,
+    #[serde(default)]
+    pub ks: Vec<KeySpec<Rgb>>,
+    /// Materials only: 0–1.
+    #[serde(default)]
+    pub reflectivity: Vec<KeySpec<f64>>,
+    /// Materials only: 0–1, 1 opaque.
+    #[serde(default)]
+    pub opacity: Vec<KeySpec<f64>>,
+    /// Materials only: index of refraction, > 0.
+    #[serde(default)]
+    pub ior: Vec<KeySpec<f64>>,
+    /// Shapes and composites: shown (`true`) or not, stepped.
+    #[serde(default)]
+    pub visible: Vec<KeySpec<bool>>,
     /// Repeat the keys (period: last key time − first key time). Default: the spec's `looping`.
     #[serde(default)]
     pub looping: Option<bool>,
+    /// What the keys do outside their span (`Repeat` is `looping: true`).
+    #[serde(default)]
+    pub cycle: Option<Cycle>,
+    /// How many times a cycling track plays its keys (default: forever).
+    #[serde(default)]
+    pub cycles: Option<f64>,
+    /// Seconds by which every key of the track plays later.
+    #[serde(default)]
+    pub offset: f64,
+}
+
+impl TrackSpec {
+    /// The times of every key the track itself writes.
+    pub fn key_times(&self) -> impl Iterator<Item = f64> + '_ {
+        key_times(&self.translate)
+            .chain(key_times(&self.rotate))
+            .chain(key_times(&self.scale))
+            .chain(key_times(&self.orient))
+            .chain(key_times(&self.roll))
+            .chain(key_times(&self.brightness))
+            .chain(key_times(&self.color))
+            .chain(key_times(&self.fov))
+            .chain(key_times(&self.ka))
+            .chain(key_times(&self.kd))
+            .chain(key_times(&self.ks))
+            .chain(key_times(&self.reflectivity))
+            .chain(key_times(&self.opacity))
+            .chain(key_times(&self.ior))
+            .chain(key_times(&self.visible))
+            .chain(match &self.look_at {
+                Some(AimSpec::Keys(k)) => k.iter().map(|k| k.at).collect::<Vec<_>>(),
+                _ => Vec::new(),
+            })
+    }
+}
+
+/// An orientation key's value.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Orientation {
+    /// Degrees about x, y and z, applied in the track's `euler_order`.
+    Euler(f64, f64, f64),
+    /// `(axis, degrees)`, right-handed.
+    AxisAngle(V3, f64),
+    /// A unit quaternion (normalised when it is not), its parts named.
+    Quat { x: f64, y: f64, z: f64, w: f64 },
+}
+
+/// What `look_at` aims at.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum AimSpec {
+    Point(V3),
+    Keys(Vec<KeySpec<V3>>),
+    /// A shape or composite: its centre, wherever the tracks move it.
+    Object(String),
 }
 
 #[derive(Debug, Deserialize)]

@@ -74,6 +74,22 @@ impl Source {
         }
     }
 
+    /// A warning at the value found at the first existing path of `paths`.
+    pub fn warning(&self, paths: &[&str], message: impl Into<String>) -> Diagnostic {
+        match self.locations.first(paths) {
+            Some((pos, width)) => self.at_pos(Severity::Warning, pos, width, message),
+            None => Diagnostic::new(
+                Severity::Warning,
+                Loc {
+                    file: self.path.clone(),
+                    line: 1,
+                    col: 1,
+                },
+                message,
+            ),
+        }
+    }
+
     /// Turns ron's error into a located diagnostic in the user's terms.
     pub fn ron_error(&self, e: &ron::error::SpannedError) -> Diagnostic {
         use ron::error::Error as E;
@@ -98,6 +114,24 @@ impl Source {
             ),
             None => (pos, message, width),
         };
+        if let Some(open) = unclosed_bracket(&self.text, pos) {
+            let close = match open.bracket {
+                '(' => ')',
+                '[' => ']',
+                _ => '}',
+            };
+            return self
+                .at_pos(
+                    Severity::Error,
+                    open.pos,
+                    1,
+                    format!("this `{}` is never closed", open.bracket),
+                )
+                .with_help(format!(
+                    "the spec could not be read past {}:{} ({message}): add `{close}` where this `{}` should end",
+                    pos.line, pos.col, open.bracket
+                ));
+        }
         let message = match self.locations_at(pos) {
             Some((path, _)) if !names_a_name && !path.is_empty() => {
                 format!("{message} (in `{path}`)")
@@ -148,6 +182,82 @@ impl Source {
     /// The deepest value starting exactly at `pos`.
     fn locations_at(&self, pos: Pos) -> Option<(String, u32)> {
         self.locations.starting_at(pos)
+    }
+}
+
+/// An opening bracket and where it stands.
+struct Open {
+    bracket: char,
+    pos: Pos,
+}
+
+/// The bracket left open where reading stopped at `stop`: the innermost open bracket, when
+/// the text there closes a different kind of bracket or ends. Strings, characters and
+/// comments are passed over.
+fn unclosed_bracket(text: &str, stop: Pos) -> Option<Open> {
+    let chars: Vec<char> = text.chars().collect();
+    let (mut line, mut col, mut i) = (1u32, 1u32, 0usize);
+    let mut open: Vec<Open> = Vec::new();
+    let advance = |i: &mut usize, line: &mut u32, col: &mut u32| {
+        if chars[*i] == '\n' {
+            *line += 1;
+            *col = 1;
+        } else {
+            *col += 1;
+        }
+        *i += 1;
+    };
+    while i < chars.len() && (line, col) < (stop.line, stop.col) {
+        let c = chars[i];
+        let next = chars.get(i + 1).copied();
+        match c {
+            '(' | '[' | '{' => open.push(Open {
+                bracket: c,
+                pos: Pos { line, col },
+            }),
+            ')' | ']' | '}' => {
+                open.pop();
+            }
+            '/' if next == Some('/') => {
+                while i < chars.len() && chars[i] != '\n' {
+                    advance(&mut i, &mut line, &mut col);
+                }
+                continue;
+            }
+            '/' if next == Some('*') => {
+                while i < chars.len() && !(chars[i] == '*' && chars.get(i + 1) == Some(&'/')) {
+                    advance(&mut i, &mut line, &mut col);
+                }
+                advance(&mut i, &mut line, &mut col);
+            }
+            '"' => {
+                advance(&mut i, &mut line, &mut col);
+                while i < chars.len() && chars[i] != '"' {
+                    if chars[i] == '\\' {
+                        advance(&mut i, &mut line, &mut col);
+                    }
+                    if i < chars.len() {
+                        advance(&mut i, &mut line, &mut col);
+                    }
+                }
+            }
+            _ => {}
+        }
+        if i < chars.len() {
+            advance(&mut i, &mut line, &mut col);
+        }
+    }
+    let innermost = open.pop()?;
+    let closes = |b: char, c: char| matches!((b, c), ('(', ')') | ('[', ']') | ('{', '}'));
+    let rest = chars[i.min(chars.len())..]
+        .iter()
+        .find(|c| !c.is_whitespace());
+    match rest {
+        None => Some(innermost),
+        Some(&c) if matches!(c, ')' | ']' | '}') && !closes(innermost.bracket, c) => {
+            Some(innermost)
+        }
+        _ => None,
     }
 }
 

@@ -1,0 +1,211 @@
+//! Where things are at a time: each target's placement by its tracks, the centre of a moving
+//! object (what `look_at: Object(…)` follows), and the turn of a track that looks at
+//! something. The rules are documented for users in `docs/animation.md` ("Aim").
+
+use super::base::{ops_transform, BaseScene};
+use super::motion::TrackPose;
+use super::orbit::Pose;
+use super::rotation::{can_look, facing, rolled_up};
+use super::spec::{Aim, AimTarget, Animation, TargetKind};
+use super::tidy::tidy3;
+use anim_core::limits;
+use anim_core::math::Transform;
+use anim_core::sdf::ast::StatementKind;
+use glam::{DMat4, DQuat, DVec3};
+
+/// Places the targets of one animation's tracks.
+pub struct Placer<'a> {
+    pub base: &'a BaseScene,
+    pub anim: &'a Animation,
+    /// Each track's pivot: its own or the default.
+    pub pivots: Vec<DVec3>,
+}
+
+impl<'a> Placer<'a> {
+    pub fn new(base: &'a BaseScene, anim: &'a Animation) -> Self {
+        let pivots = anim
+            .tracks
+            .iter()
+            .map(|t| t.pivot.unwrap_or_else(|| base.default_pivot(&t.target)))
+            .collect();
+        Placer { base, anim, pivots }
+    }
+
+    /// Where track `i` puts its target at time `t`; an aimed object turned to face its
+    /// target. `Err` says why an aim cannot be taken.
+    pub fn pose(&self, i: usize, t: f64) -> Result<TrackPose, String> {
+        let track = &self.anim.tracks[i];
+        let mut pose = TrackPose::at(track, t);
+        let Some(aim) = track
+            .aim
+            .as_ref()
+            .filter(|_| track.kind != TargetKind::Camera)
+        else {
+            return Ok(pose);
+        };
+        let from = self.pivot_at(i, t) + pose.translate;
+        let to = self.world_to_parent(&track.target, self.aim_point(aim, t), t);
+        let roll = aim.roll.as_ref().and_then(|r| r.at(t)).unwrap_or(0.0);
+        pose.orient = facing(aim.forward, to - from, aim.up, roll).ok_or_else(|| {
+            if (to - from).length() <= 1e-12 {
+                format!("'{}' would look at a point where it stands", track.target)
+            } else {
+                format!(
+                    "'{}' would look straight along its up direction {}",
+                    track.target,
+                    fmt3(aim.up)
+                )
+            }
+        })?;
+        Ok(pose)
+    }
+
+    /// Track `i`'s pivot at time `t`. An aimed track's pivot moves with its target as the
+    /// earlier tracks on it move it, so that the object turns where it is; other tracks keep
+    /// the pivot where the base scene puts it (docs/animation.md, "Several tracks").
+    pub fn pivot_at(&self, i: usize, t: f64) -> DVec3 {
+        let track = &self.anim.tracks[i];
+        if track.aim.is_none() {
+            return self.pivots[i];
+        }
+        self.placed_by(&track.target, i, t).point(self.pivots[i])
+    }
+
+    /// The transform by which the first `end` tracks place `target` at time `t`, without the
+    /// turns of aims (which follow from the placement, not the other way).
+    fn placed_by(&self, target: &str, end: usize, t: f64) -> Transform {
+        self.anim.tracks[..end]
+            .iter()
+            .enumerate()
+            .filter(|(_, tr)| tr.target == target && tr.moves())
+            .fold(Transform::IDENTITY, |m, (j, tr)| {
+                let ops = TrackPose::at(tr, t).ops(self.pivot_at(j, t), tr.axis);
+                ops_transform(&ops).then_after(&m)
+            })
+    }
+
+    /// World from the frame of `name`'s parent at time `t`: the placements of the composites
+    /// above it (the first that lists it, at each level).
+    fn parent_frame(&self, name: &str, t: f64) -> DMat4 {
+        let mut m = DMat4::IDENTITY;
+        let mut child = name.to_string();
+        for _ in 0..limits::MAX_NESTING {
+            let Some(parent) = self.base.parents(&child).first().map(|p| p.to_string()) else {
+                break;
+            };
+            let placed = self
+                .placed_by(&parent, self.anim.tracks.len(), t)
+                .then_after(&self.base.own_transform(&parent));
+            m = placed.world_from_object * m;
+            child = parent;
+        }
+        m
+    }
+
+    fn world_to_parent(&self, name: &str, p: DVec3, t: f64) -> DVec3 {
+        let m = self.parent_frame(name, t);
+        if m == DMat4::IDENTITY {
+            return p;
+        }
+        m.inverse().transform_point3(p)
+    }
+
+    /// The centre of `name` in the world at time `t`: the centre of its box where the base
+    /// scene puts it, carried by its tracks and by the composites above it.
+    pub fn centre_at(&self, name: &str, t: f64) -> DVec3 {
+        let local = self
+            .placed_by(name, self.anim.tracks.len(), t)
+            .point(self.base.default_pivot(name));
+        self.parent_frame(name, t).transform_point3(local)
+    }
+
+    /// The point an aim looks at, in the world, at time `t`.
+    fn aim_point(&self, aim: &Aim, t: f64) -> DVec3 {
+        match &aim.target {
+            AimTarget::Point(p) => *p,
+            AimTarget::Keys(k) => k.at(t).unwrap_or(DVec3::ZERO),
+            AimTarget::Object(o) => self.centre_at(o, t),
+        }
+    }
+
+    /// The aimed camera `name`'s pose at time `t`, if a track aims it: its eye where the base
+    /// scene and the tracks' translations put it, looking at the target. `Err` says why it
+    /// cannot look there.
+    pub fn camera_pose(&self, name: &str, t: f64) -> Option<Result<Pose, String>> {
+        let aim = self
+            .anim
+            .tracks
+            .iter()
+            .filter(|tr| tr.target == name && tr.kind == TargetKind::Camera)
+            .find_map(|tr| tr.aim.as_ref())?;
+        let eye0 = self
+            .base
+            .statements
+            .iter()
+            .rev()
+            .find_map(|s| match &s.kind {
+                StatementKind::Camera(c) if c.name == name => Some(c.eye),
+                _ => None,
+            })?;
+        let moved: DVec3 = self
+            .anim
+            .tracks
+            .iter()
+            .filter(|tr| tr.target == name)
+            .filter_map(|tr| tr.translate.as_ref().and_then(|c| c.at(t)))
+            .map(tidy3)
+            .sum();
+        let eye = self.base.own_transform(name).point(eye0) + moved;
+        let target = self.aim_point(aim, t);
+        let roll = aim.roll.as_ref().and_then(|r| r.at(t)).unwrap_or(0.0);
+        if !can_look(eye, target, aim.up) {
+            let why = if (target - eye).length() <= 1e-12 {
+                format!("camera '{name}' would look at the point where its eye is")
+            } else {
+                format!(
+                    "camera '{name}' would look straight along its up direction {}",
+                    fmt3(aim.up)
+                )
+            };
+            return Some(Err(why));
+        }
+        let dir = target - eye;
+        Some(Ok(Pose {
+            eye,
+            dir,
+            up: rolled_up(dir, aim.up, roll),
+        }))
+    }
+
+    /// How far (degrees) anything turns by orientations and aims over `[t0, t1]`, along its
+    /// path: aims and slerps are followed by the frames' motion lines, not by `rotate`.
+    pub fn degrees_turned(&self, t0: f64, t1: f64) -> f64 {
+        let steps = limits::MOTION_TURN_SAMPLES;
+        let at = |k: usize| t0 + (t1 - t0) * k as f64 / steps as f64;
+        let path = |orientation: &dyn Fn(f64) -> Option<DQuat>| {
+            (0..steps)
+                .filter_map(|k| Some((orientation(at(k))?, orientation(at(k + 1))?)))
+                .map(|(a, b)| super::rotation::angle_between(a, b))
+                .sum::<f64>()
+        };
+        let mut most = 0.0f64;
+        for (i, track) in self.anim.tracks.iter().enumerate() {
+            let turned = if track.kind == TargetKind::Camera && track.aim.is_some() {
+                path(&|t| {
+                    let pose = self.camera_pose(&track.target, t)?.ok()?;
+                    facing(-DVec3::Z, pose.dir, pose.up, 0.0)
+                })
+            } else if track.aim.is_some() || track.orient.is_some() {
+                path(&|t| self.pose(i, t).ok().map(|p| p.orient))
+            } else {
+                0.0
+            };
+            most = most.max(turned);
+        }
+        most
+    }
+}
+
+fn fmt3(v: DVec3) -> String {
+    format!("({}, {}, {})", v.x, v.y, v.z)
+}

@@ -1,0 +1,209 @@
+//! The collector of problems that the checks of a spec share, and the checks of keyed values:
+//! every key's time and value, each problem at its place in the spec.
+
+use super::model::Channel;
+use super::raw::KeySpec;
+use super::source::Source;
+use crate::keyframe::interp::{Key, Timing};
+use crate::keyframe::locate::{field, index};
+use anim_core::diag::Diagnostic;
+use anim_core::limits::{self, MAX_DIAGNOSTICS};
+use anim_core::load::not_shown;
+use glam::DVec3;
+
+/// What is wrong with a keyed value, seen as a vector (a number as `x`), to follow the
+/// channel's name in the message.
+pub type ValueCheck = fn(DVec3) -> Option<String>;
+
+pub fn non_negative(v: DVec3) -> Option<String> {
+    (v.x < 0.0).then(|| "must not be negative".to_string())
+}
+
+pub fn non_negative3(v: DVec3) -> Option<String> {
+    v.cmplt(DVec3::ZERO)
+        .any()
+        .then(|| "must not be negative".to_string())
+}
+
+pub fn non_zero3(v: DVec3) -> Option<String> {
+    v.cmpeq(DVec3::ZERO)
+        .any()
+        .then(|| "must not be 0 on any axis (a scale of 0 cannot be undone)".to_string())
+}
+
+pub fn valid_fov(v: DVec3) -> Option<String> {
+    (!limits::fov_is_valid(v.x)).then(|| format!("must be {}", limits::FOV_RULE))
+}
+
+pub fn unit_interval(v: DVec3) -> Option<String> {
+    (!(0.0..=1.0).contains(&v.x)).then(|| "must lie in 0..1".to_string())
+}
+
+pub fn positive(v: DVec3) -> Option<String> {
+    (v.x <= 0.0).then(|| "must be more than 0".to_string())
+}
+
+pub fn rgb(v: &super::raw::Rgb) -> DVec3 {
+    v.0
+}
+
+pub fn number(v: &f64) -> f64 {
+    *v
+}
+
+pub fn names_list(names: &[&str]) -> String {
+    names
+        .iter()
+        .map(|c| format!("'{c}'"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Collects errors and warnings while the spec is checked part by part.
+pub struct Checker<'a> {
+    /// The animation's length in seconds, once known: keys must fall inside it.
+    pub duration: f64,
+    pub src: &'a Source,
+    pub errors: Vec<Diagnostic>,
+    pub warnings: Vec<Diagnostic>,
+    /// Errors found past the first `MAX_DIAGNOSTICS`, counted but not made (quoting a line
+    /// costs its length, and a spec may hold a million bad keys).
+    unshown: usize,
+}
+
+impl<'a> Checker<'a> {
+    pub fn new(src: &'a Source) -> Self {
+        Checker {
+            duration: 0.0,
+            src,
+            errors: Vec::new(),
+            warnings: Vec::new(),
+            unshown: 0,
+        }
+    }
+
+    pub fn err(&mut self, paths: &[&str], msg: String) {
+        if !self.full() {
+            self.errors.push(self.src.error(paths, msg));
+        }
+    }
+
+    pub fn warn(&mut self, paths: &[&str], msg: String) {
+        if self.warnings.len() < MAX_DIAGNOSTICS {
+            self.warnings.push(self.src.warning(paths, msg));
+        }
+    }
+
+    /// Whether as many errors as are listed are found already; counts the one about to be.
+    pub fn full(&mut self) -> bool {
+        let full = self.errors.len() >= MAX_DIAGNOSTICS;
+        self.unshown += usize::from(full);
+        full
+    }
+
+    /// The errors listed, and one counting those that were not.
+    pub fn into_errors(mut self) -> Vec<Diagnostic> {
+        if self.unshown > 0 {
+            self.errors.push(not_shown(&self.src.path, self.unshown, 0));
+        }
+        self.errors
+    }
+
+    /// The keys at `path` as a channel, each key's time, value and curve checked. `check`
+    /// sees each value as a vector (numbers as `x`) and names what is wrong.
+    pub fn channel<S, T: Copy + Into3>(
+        &mut self,
+        keys: &[KeySpec<S>],
+        path: &str,
+        timing: Timing,
+        value: impl Fn(&S) -> T,
+        check: Option<ValueCheck>,
+    ) -> Option<Channel<T>> {
+        if keys.is_empty() {
+            return None;
+        }
+        let what = path.rsplit('.').next().unwrap_or(path);
+        let mut out = Vec::with_capacity(keys.len());
+        for (i, k) in keys.iter().enumerate() {
+            let key_path = index(path, i);
+            let previous = i.checked_sub(1).map(|p| keys[p].at);
+            self.key_time(k.at, previous, &key_path);
+            self.key_curve(k, &key_path);
+            let v = value(&k.value).into3();
+            let value_path = field(&key_path, "value");
+            if !v.is_finite() {
+                self.err(
+                    &[&value_path, &key_path],
+                    format!("the {what} value must be finite"),
+                );
+            } else if let Some(problem) = check.and_then(|c| c(v)) {
+                self.err(&[&value_path, &key_path], format!("{what} {problem}"));
+            }
+            out.push(Key {
+                at: k.at,
+                value: value(&k.value),
+                interp: k.interp,
+            });
+        }
+        Some(Channel {
+            keys: out,
+            timing,
+            path: path.to_string(),
+        })
+    }
+
+    /// A key's curve parameters.
+    pub fn key_curve<S>(&mut self, k: &KeySpec<S>, key_path: &str) {
+        if let Some(problem) = k.interp.problem() {
+            self.err(&[&field(key_path, "interp"), key_path], problem);
+        }
+    }
+
+    /// A key's time: finite, inside the animation, after the key before it.
+    pub fn key_time(&mut self, at: f64, previous: Option<f64>, key_path: &str) {
+        let paths = [field(key_path, "at"), key_path.to_string()];
+        let paths = [paths[0].as_str(), paths[1].as_str()];
+        if !at.is_finite() {
+            self.err(
+                &paths,
+                "a key's time must be a finite number of seconds".into(),
+            );
+        } else if at < 0.0 {
+            self.err(
+                &paths,
+                format!("the key at {at} s is before the start of the animation (0 s)"),
+            );
+        } else if at > self.duration + 1e-9 {
+            self.err(
+                &paths,
+                format!(
+                    "the key at {at} s is after the end of the animation ({} s)",
+                    self.duration
+                ),
+            );
+        }
+        if let Some(p) = previous.filter(|&p| at <= p) {
+            self.err(
+                &paths,
+                format!("keys must be in time order: this key at {at} s follows a key at {p} s"),
+            );
+        }
+    }
+}
+
+/// Numbers seen as vectors for the shared value checks.
+pub trait Into3 {
+    fn into3(self) -> DVec3;
+}
+
+impl Into3 for f64 {
+    fn into3(self) -> DVec3 {
+        DVec3::splat(self)
+    }
+}
+
+impl Into3 for DVec3 {
+    fn into3(self) -> DVec3 {
+        self
+    }
+}

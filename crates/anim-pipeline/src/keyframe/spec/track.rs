@@ -1,0 +1,828 @@
+//! The checks of tracks and named curves: each channel's keys, what the target is and which
+//! channels fit it, the timing of the keys, orientations and aims.
+
+use super::checker::{
+    names_list, non_negative, non_negative3, non_zero3, number, positive, rgb, unit_interval,
+    valid_fov, Checker,
+};
+use super::model::{
+    Aim, AimTarget, Channel, MaterialChannels, OrientChannel, SceneNames, TargetKind, Track,
+};
+use super::raw::{AimSpec, KeySpec, Orientation, Scale, SpecFile, TrackSpec, V3};
+use crate::keyframe::interp::{Cycle, Interp, Key, Timing};
+use crate::keyframe::locate::{field, index};
+use crate::keyframe::rotation::{euler, EulerOrder};
+use anim_core::diag::suggest;
+use glam::{DQuat, DVec3};
+
+/// Where a track's channels come from: its own keys, else those of the curve it uses.
+struct Sources<'s> {
+    track: &'s TrackSpec,
+    path: String,
+    curve: Option<(&'s TrackSpec, String)>,
+}
+
+impl<'s> Sources<'s> {
+    /// The keys of channel `name` and their path in the spec.
+    fn keys<S>(
+        &self,
+        name: &str,
+        get: impl Fn(&'s TrackSpec) -> &'s [KeySpec<S>],
+    ) -> (&'s [KeySpec<S>], String) {
+        let own = get(self.track);
+        match &self.curve {
+            Some((curve, path)) if own.is_empty() => (get(curve), field(path, name)),
+            _ => (own, field(&self.path, name)),
+        }
+    }
+
+    /// A per-track setting: the track's own, else its curve's.
+    fn setting<T>(&self, get: impl Fn(&'s TrackSpec) -> Option<T>) -> Option<(T, String)> {
+        get(self.track).map(|v| (v, self.path.clone())).or_else(|| {
+            let (curve, path) = self.curve.as_ref()?;
+            get(curve).map(|v| (v, path.clone()))
+        })
+    }
+
+    fn either(&self, keyed: impl Fn(&TrackSpec) -> bool) -> bool {
+        keyed(self.track) || self.curve.as_ref().is_some_and(|(c, _)| keyed(c))
+    }
+}
+
+/// Which channels a kind of target accepts, by field name.
+fn fits(kind: TargetKind, channel: &str) -> bool {
+    const MOTION: [&str; 5] = ["translate", "rotate", "scale", "orient", "pivot"];
+    let moving = MOTION.contains(&channel);
+    match kind {
+        TargetKind::Shape | TargetKind::Composite => {
+            moving || matches!(channel, "look_at" | "visible")
+        }
+        TargetKind::Camera => moving || matches!(channel, "look_at" | "fov"),
+        TargetKind::Light => moving || matches!(channel, "brightness" | "color"),
+        TargetKind::Material => matches!(
+            channel,
+            "ka" | "kd" | "ks" | "reflectivity" | "opacity" | "ior"
+        ),
+    }
+}
+
+/// The kinds that accept a channel, for messages.
+fn kinds_for(channel: &str) -> String {
+    let kinds = [
+        TargetKind::Shape,
+        TargetKind::Composite,
+        TargetKind::Camera,
+        TargetKind::Light,
+        TargetKind::Material,
+    ];
+    let nouns: Vec<String> = kinds
+        .into_iter()
+        .filter(|k| fits(*k, channel))
+        .map(|k| format!("{}s", k.noun()))
+        .collect();
+    match nouns.as_slice() {
+        [one] => one.clone(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
+        [] => String::new(),
+    }
+}
+
+/// Every channel field of a track, with whether it keys anything.
+fn keyed_channels(t: &TrackSpec) -> [(&'static str, bool); 17] {
+    [
+        ("translate", !t.translate.is_empty()),
+        ("rotate", !t.rotate.is_empty()),
+        ("scale", !t.scale.is_empty()),
+        ("orient", !t.orient.is_empty()),
+        ("look_at", t.look_at.is_some()),
+        ("brightness", !t.brightness.is_empty()),
+        ("color", !t.color.is_empty()),
+        ("fov", !t.fov.is_empty()),
+        ("ka", !t.ka.is_empty()),
+        ("kd", !t.kd.is_empty()),
+        ("ks", !t.ks.is_empty()),
+        ("reflectivity", !t.reflectivity.is_empty()),
+        ("opacity", !t.opacity.is_empty()),
+        ("ior", !t.ior.is_empty()),
+        ("visible", !t.visible.is_empty()),
+        ("roll", !t.roll.is_empty()),
+        ("pivot", t.pivot.is_some()),
+    ]
+}
+
+impl Checker<'_> {
+    /// Every track whose target exists, checked; the curves checked where they are used.
+    pub fn tracks(
+        &mut self,
+        spec: &SpecFile,
+        names: &dyn SceneNames,
+        orbit_camera: Option<&str>,
+    ) -> Vec<Track> {
+        let curves = self.curve_names(spec);
+        let tracks: Vec<Track> = spec
+            .tracks
+            .iter()
+            .enumerate()
+            .filter_map(|(i, t)| {
+                let path = index("tracks", i);
+                let curve = self.used_curve(t, &path, spec, &curves);
+                let sources = Sources {
+                    track: t,
+                    path,
+                    curve,
+                };
+                self.track(&sources, spec.looping, names, orbit_camera)
+            })
+            .collect();
+        self.aims_fit(&tracks, names);
+        tracks
+    }
+
+    /// The curves' names, each checked; a curve with no name cannot be used.
+    fn curve_names(&mut self, spec: &SpecFile) -> Vec<Option<String>> {
+        let mut seen: Vec<Option<String>> = Vec::new();
+        for (i, c) in spec.curves.iter().enumerate() {
+            let path = index("curves", i);
+            if c.target.is_some() {
+                self.err(
+                    &[&field(&path, "target"), &path],
+                    "a curve has a `name`, not a `target`: tracks name their targets and use the curve with `curve: \"…\"`".into(),
+                );
+            }
+            if c.curve.is_some() {
+                self.err(
+                    &[&field(&path, "curve"), &path],
+                    "a curve cannot use another curve".into(),
+                );
+            }
+            match &c.name {
+                None => self.err(&[&path], "this curve has no `name`".into()),
+                Some(n) if seen.iter().flatten().any(|s| s == n) => self.err(
+                    &[&field(&path, "name"), &path],
+                    format!("a curve named '{n}' is defined already"),
+                ),
+                Some(_) => {}
+            }
+            seen.push(c.name.clone());
+        }
+        seen
+    }
+
+    /// The curve track `t` uses, with its path.
+    fn used_curve<'s>(
+        &mut self,
+        t: &TrackSpec,
+        path: &str,
+        spec: &'s SpecFile,
+        curves: &[Option<String>],
+    ) -> Option<(&'s TrackSpec, String)> {
+        let name = t.curve.as_ref()?;
+        match curves.iter().position(|c| c.as_deref() == Some(name)) {
+            Some(i) => Some((&spec.curves[i], index("curves", i))),
+            None => {
+                let d = self.src.error(
+                    &[&field(path, "curve"), path],
+                    format!("the spec defines no curve named '{name}'"),
+                );
+                let known = curves.iter().flatten().map(String::as_str);
+                let d = match suggest(name, known) {
+                    Some(s) => d.with_help(format!("did you mean '{s}'?")),
+                    None => d.with_help("define it under `curves: [(name: \"…\", …)]`"),
+                };
+                if !self.full() {
+                    self.errors.push(d);
+                }
+                None
+            }
+        }
+    }
+
+    /// A track, if its target exists.
+    fn track(
+        &mut self,
+        s: &Sources,
+        default_looping: bool,
+        names: &dyn SceneNames,
+        orbit_camera: Option<&str>,
+    ) -> Option<Track> {
+        let t = s.track;
+        let path = s.path.clone();
+        if t.name.is_some() {
+            self.err(
+                &[&field(&path, "name"), &path],
+                "`name` belongs to curves: a track says which thing it moves with `target`".into(),
+            );
+        }
+        let kind = self.target_kind(t, &path, names);
+        let timing = self.timing(s, default_looping);
+        let translate = self.keys(s, "translate", |t| &t.translate, timing, |v: &V3| v.0);
+        let (rotate_keys, rotate_path) = s.keys("rotate", |t| &t.rotate);
+        let rotate = self.channel(rotate_keys, &rotate_path, timing, number, None);
+        let (scale_keys, scale_path) = s.keys("scale", |t| &t.scale);
+        let scale = self.channel(
+            scale_keys,
+            &scale_path,
+            timing,
+            |v: &Scale| v.0,
+            Some(non_zero3),
+        );
+        let orient = self.orient(s, timing);
+        let aim = self.aim(s, timing, kind);
+        let (brightness, color, fov) = self.parameters(s, timing);
+        let material = self.material(s, timing);
+        let visible = self.visible(s, timing);
+        let axis = self.axis_and_pivot(s);
+        if !keyed_channels(t).iter().any(|(_, keyed)| *keyed) && s.curve.is_none() {
+            self.err(
+                &[&field(&path, "target"), &path],
+                format!("the track for '{}' keys nothing", target_name(t)),
+            );
+        }
+        let kind = kind?;
+        self.channels_fit(s, kind);
+        if kind == TargetKind::Camera && orbit_camera == t.target.as_deref() {
+            self.not_moved_off_orbit(s);
+        }
+        Some(Track {
+            target: target_name(t).to_string(),
+            kind,
+            translate,
+            rotate,
+            axis,
+            scale,
+            pivot: s.setting(|t| t.pivot).map(|(p, _)| p.0),
+            brightness,
+            color,
+            fov,
+            orient,
+            aim,
+            material,
+            visible,
+            path,
+        })
+    }
+
+    /// A channel of 3-vectors that takes any finite value.
+    fn keys<S>(
+        &mut self,
+        s: &Sources,
+        name: &str,
+        get: impl for<'t> Fn(&'t TrackSpec) -> &'t [KeySpec<S>],
+        timing: Timing,
+        value: impl Fn(&S) -> DVec3,
+    ) -> Option<Channel<DVec3>> {
+        let (keys, path) = s.keys(name, get);
+        self.channel(keys, &path, timing, value, None)
+    }
+
+    /// Light and camera parameters: brightness, colour, field of view.
+    #[allow(clippy::type_complexity)]
+    fn parameters(
+        &mut self,
+        s: &Sources,
+        timing: Timing,
+    ) -> (
+        Option<Channel<f64>>,
+        Option<Channel<DVec3>>,
+        Option<Channel<f64>>,
+    ) {
+        let (keys, path) = s.keys("brightness", |t| &t.brightness);
+        let brightness = self.channel(keys, &path, timing, number, Some(non_negative));
+        let (keys, path) = s.keys("color", |t| &t.color);
+        let color = self.channel(keys, &path, timing, rgb, Some(non_negative3));
+        let (keys, path) = s.keys("fov", |t| &t.fov);
+        let fov = self.channel(keys, &path, timing, number, Some(valid_fov));
+        (brightness, color, fov)
+    }
+
+    fn material(&mut self, s: &Sources, timing: Timing) -> MaterialChannels {
+        let colour = |c: &mut Self, name: &str, get: fn(&TrackSpec) -> &[KeySpec<_>]| {
+            let (keys, path) = s.keys(name, get);
+            c.channel(keys, &path, timing, rgb, Some(non_negative3))
+        };
+        let ka = colour(self, "ka", |t| &t.ka);
+        let kd = colour(self, "kd", |t| &t.kd);
+        let ks = colour(self, "ks", |t| &t.ks);
+        let (keys, path) = s.keys("reflectivity", |t| &t.reflectivity);
+        let reflectivity = self.channel(keys, &path, timing, number, Some(unit_interval));
+        let (keys, path) = s.keys("opacity", |t| &t.opacity);
+        let opacity = self.channel(keys, &path, timing, number, Some(unit_interval));
+        let (keys, path) = s.keys("ior", |t| &t.ior);
+        let ior = self.channel(keys, &path, timing, number, Some(positive));
+        MaterialChannels {
+            ka,
+            kd,
+            ks,
+            reflectivity,
+            opacity,
+            ior,
+        }
+    }
+
+    /// `visible` keys: 1 shown, 0 hidden, always stepped (a thing is there or it is not).
+    fn visible(&mut self, s: &Sources, timing: Timing) -> Option<Channel<f64>> {
+        let (keys, path) = s.keys("visible", |t| &t.visible);
+        let mut channel = self.channel(
+            keys,
+            &path,
+            timing,
+            |v: &bool| f64::from(u8::from(*v)),
+            None,
+        )?;
+        for (i, (key, raw)) in channel.keys.iter_mut().zip(keys).enumerate() {
+            if !matches!(raw.interp, Interp::Linear | Interp::Step) {
+                self.err(
+                    &[&field(&index(&path, i), "interp"), &index(&path, i)],
+                    "`visible` steps from key to key: it takes no easing".into(),
+                );
+            }
+            key.interp = Interp::Step;
+        }
+        Some(channel)
+    }
+
+    /// When the keys play: the cycle (`looping` is `cycle: Repeat`), its count and the offset.
+    fn timing(&mut self, s: &Sources, default_looping: bool) -> Timing {
+        let looping = s.setting(|t| t.looping);
+        let cycle = match (s.setting(|t| t.cycle), looping) {
+            (Some((c, p)), Some((l, _))) if (c == Cycle::Repeat) != l => {
+                self.err(
+                    &[&field(&p, "cycle"), &p],
+                    format!("`cycle: {c:?}` and `looping: {l}` say different things: keep one"),
+                );
+                c
+            }
+            (Some((c, _)), _) => c,
+            (None, Some((l, _))) => Timing::looping(l).cycle,
+            (None, None) => Timing::looping(default_looping).cycle,
+        };
+        let count = match s.setting(|t| t.cycles) {
+            None => None,
+            Some((n, p)) => {
+                let at = [field(&p, "cycles"), p.clone()];
+                if cycle == Cycle::Hold {
+                    self.err(
+                        &[&at[0], &at[1]],
+                        "`cycles` counts the repeats of a `cycle`: give one (Repeat, PingPong or RepeatOffset)".into(),
+                    );
+                }
+                if !(n.fract() == 0.0 && (1.0..=f64::from(u32::MAX)).contains(&n)) {
+                    self.err(
+                        &[&at[0], &at[1]],
+                        format!("cycles must be a whole number, at least 1, not {n}"),
+                    );
+                    None
+                } else {
+                    Some(n as u32)
+                }
+            }
+        };
+        let offset = s.track.offset + s.curve.as_ref().map_or(0.0, |(c, _)| c.offset);
+        if !offset.is_finite() {
+            self.err(
+                &[&field(&s.path, "offset"), &s.path],
+                "the offset must be a finite number of seconds".into(),
+            );
+        }
+        Timing {
+            offset: if offset.is_finite() { offset } else { 0.0 },
+            cycle,
+            count,
+        }
+    }
+
+    /// Orientation keys as quaternions.
+    fn orient(&mut self, s: &Sources, timing: Timing) -> Option<OrientChannel> {
+        let (keys, path) = s.keys("orient", |t| &t.orient);
+        if keys.is_empty() {
+            return None;
+        }
+        let order = s
+            .setting(|t| t.euler_order)
+            .map_or(EulerOrder::XYZ, |(o, _)| o);
+        let mut out = Vec::with_capacity(keys.len());
+        for (i, k) in keys.iter().enumerate() {
+            let key_path = index(&path, i);
+            self.key_time(k.at, i.checked_sub(1).map(|p| keys[p].at), &key_path);
+            self.key_curve(k, &key_path);
+            if k.interp.is_spline() {
+                self.err(
+                    &[&field(&key_path, "interp"), &key_path],
+                    format!(
+                        "orientations turn by slerp: `{:?}` is for numbers; use Linear or an easing",
+                        k.interp
+                    ),
+                );
+            }
+            let value_path = field(&key_path, "value");
+            let value = match self.orientation(k.value, order) {
+                Ok(q) => q,
+                Err(why) => {
+                    self.err(&[&value_path, &key_path], why);
+                    DQuat::IDENTITY
+                }
+            };
+            out.push(Key {
+                at: k.at,
+                value,
+                interp: k.interp,
+            });
+        }
+        Some(Channel {
+            keys: out,
+            timing,
+            path,
+        })
+    }
+
+    fn orientation(&self, o: Orientation, order: EulerOrder) -> Result<DQuat, String> {
+        match o {
+            Orientation::Euler(x, y, z) => {
+                let v = DVec3::new(x, y, z);
+                v.is_finite()
+                    .then(|| euler(v, order))
+                    .ok_or_else(|| "Euler angles must be finite".to_string())
+            }
+            Orientation::AxisAngle(axis, degrees) => match axis.0.try_normalize() {
+                Some(a) if degrees.is_finite() => {
+                    Ok(DQuat::from_axis_angle(a, degrees.to_radians()))
+                }
+                _ => Err("AxisAngle needs a non-zero axis and a finite angle".into()),
+            },
+            Orientation::Quat { x, y, z, w } => {
+                let q = DQuat::from_xyzw(x, y, z, w);
+                match q.length() {
+                    l if l.is_finite() && l > 1e-12 => Ok(q / l),
+                    _ => Err("a quaternion must be finite and not zero".into()),
+                }
+            }
+        }
+    }
+
+    /// The track's `look_at`, with its `up`, `forward` and `roll`.
+    fn aim(&mut self, s: &Sources, timing: Timing, kind: Option<TargetKind>) -> Option<Aim> {
+        let Some((spec, path)) = s.setting(|t| t.look_at.as_ref()) else {
+            for extra in ["up", "forward", "roll"] {
+                let given = match extra {
+                    "up" => s.either(|t| t.up.is_some()),
+                    "forward" => s.either(|t| t.forward.is_some()),
+                    _ => s.either(|t| !t.roll.is_empty()),
+                };
+                if given {
+                    self.err(
+                        &[&field(&s.path, extra), &s.path],
+                        format!("`{extra}` goes with `look_at`, which this track does not have"),
+                    );
+                }
+            }
+            return None;
+        };
+        let path = field(&path, "look_at");
+        let target = match spec {
+            AimSpec::Point(p) => {
+                if !p.0.is_finite() {
+                    self.err(&[&path], "the point looked at must be finite".into());
+                }
+                AimTarget::Point(p.0)
+            }
+            AimSpec::Keys(keys) => AimTarget::Keys(
+                self.channel(keys, &index(&path, 0), timing, |v: &V3| v.0, None)
+                    .unwrap_or(Channel {
+                        keys: Vec::new(),
+                        timing,
+                        path: path.clone(),
+                    }),
+            ),
+            AimSpec::Object(name) => AimTarget::Object(name.clone()),
+        };
+        if let AimTarget::Keys(ch) = &target {
+            if ch.keys.is_empty() {
+                self.err(
+                    &[&path],
+                    "`look_at: Keys([…])` needs at least one key".into(),
+                );
+            }
+        }
+        let direction = |c: &mut Self, what: &str, v: Option<(V3, String)>, default: DVec3| {
+            let Some((v, p)) = v else {
+                return default;
+            };
+            if !(v.0.is_finite() && v.0.length_squared() > 0.0) {
+                c.err(
+                    &[&field(&p, what), &p],
+                    format!("`{what}` must be a non-zero direction"),
+                );
+                return default;
+            }
+            v.0
+        };
+        let up = direction(self, "up", s.setting(|t| t.up), DVec3::Y);
+        let forward = direction(self, "forward", s.setting(|t| t.forward), DVec3::NEG_Z);
+        if kind == Some(TargetKind::Camera) && s.either(|t| t.forward.is_some()) {
+            self.err(
+                &[&field(&s.path, "forward"), &s.path],
+                "a camera faces along its view direction: `forward` is for objects".into(),
+            );
+        }
+        let (keys, roll_path) = s.keys("roll", |t| &t.roll);
+        let roll = self.channel(keys, &roll_path, timing, number, None);
+        Some(Aim {
+            target,
+            up,
+            forward,
+            roll,
+            path,
+        })
+    }
+
+    /// What the track's target is; `None` (reported) if the base scene has no such name.
+    fn target_kind(
+        &mut self,
+        t: &TrackSpec,
+        path: &str,
+        names: &dyn SceneNames,
+    ) -> Option<TargetKind> {
+        let Some(target) = &t.target else {
+            self.err(
+                &[path],
+                "this track has no `target`: name the shape, composite, camera, light or material it keys".into(),
+            );
+            return None;
+        };
+        let kind = names.kind_of(target);
+        if kind.is_none() && !self.full() {
+            let d = self.src.error(
+                &[&field(path, "target"), path],
+                format!(
+                    "the base scene has no shape, composite, camera, light or material named '{target}'"
+                ),
+            );
+            let d = match suggest(target, names.names()) {
+                Some(s) => d.with_help(format!("did you mean '{s}'?")),
+                None => d,
+            };
+            self.errors.push(d);
+        }
+        kind
+    }
+
+    /// The rotation axis (default +y), with the axis and pivot checked.
+    fn axis_and_pivot(&mut self, s: &Sources) -> DVec3 {
+        let axis = s.setting(|t| t.axis);
+        let at = |p: &str, f: &str| [field(p, f), p.to_string()];
+        if let Some((a, p)) = &axis {
+            if !(a.0.is_finite() && a.0.length_squared() > 0.0) {
+                let at = at(p, "axis");
+                self.err(
+                    &[&at[0], &at[1]],
+                    "the rotation axis must be a non-zero vector".into(),
+                );
+            }
+            if !s.either(|t| !t.rotate.is_empty()) {
+                let at = at(p, "axis");
+                self.err(
+                    &[&at[0], &at[1]],
+                    "`axis` without `rotate` keys does nothing".into(),
+                );
+            }
+        }
+        if let Some((pivot, p)) = s.setting(|t| t.pivot) {
+            if !pivot.0.is_finite() {
+                let at = at(&p, "pivot");
+                self.err(&[&at[0], &at[1]], "the pivot must be finite".into());
+            }
+        }
+        axis.map_or(DVec3::Y, |(a, _)| a.0)
+    }
+
+    /// Each channel only on the kinds of target it means something for.
+    fn channels_fit(&mut self, s: &Sources, kind: TargetKind) {
+        let target = target_name(s.track).to_string();
+        let mut sources = vec![(s.track, s.path.clone())];
+        sources.extend(s.curve.iter().map(|(c, p)| (*c, p.clone())));
+        for (spec, path) in sources {
+            for (channel, keyed) in keyed_channels(spec) {
+                if keyed && !fits(kind, channel) && channel != "roll" {
+                    let why = if kind == TargetKind::Light && channel == "look_at" {
+                        format!("'{target}' is a point light, which shines every way: it has nothing to aim")
+                    } else {
+                        format!(
+                            "'{target}' is a {}: `{channel}` can only be keyed on {}",
+                            kind.noun(),
+                            kinds_for(channel)
+                        )
+                    };
+                    self.err(&[&field(&path, channel), &path], why);
+                }
+            }
+        }
+        let aimed = s.either(|t| t.look_at.is_some());
+        let turned = ["rotate", "orient", "scale"]
+            .into_iter()
+            .find(|c| s.either(|t| keyed_channels(t).iter().any(|(n, k)| n == c && *k)));
+        match turned {
+            Some(c) if aimed && (kind == TargetKind::Camera || c != "scale") => self.err(
+                &[&field(&s.path, c), &s.path],
+                format!("`look_at` turns '{target}' to face its target: `{c}` would turn it away"),
+            ),
+            _ => {}
+        }
+    }
+
+    /// The orbit sets its camera's pose outright: keyed motion would fight it.
+    fn not_moved_off_orbit(&mut self, s: &Sources) {
+        let moving = ["translate", "rotate", "scale", "orient", "look_at"]
+            .into_iter()
+            .find(|c| s.either(|t| keyed_channels(t).iter().any(|(n, k)| n == c && *k)));
+        if let Some(channel) = moving {
+            self.err(
+                &[&field(&s.path, channel), &s.path],
+                format!(
+                    "camera '{}' follows the orbit; moving it too would take it off the orbit",
+                    target_name(s.track)
+                ),
+            );
+        }
+    }
+
+    /// What the aims need of the whole animation: an object to look at that exists, one aim
+    /// per target, and a camera that no other track turns.
+    fn aims_fit(&mut self, tracks: &[Track], names: &dyn SceneNames) {
+        for (i, track) in tracks.iter().enumerate() {
+            let Some(aim) = &track.aim else {
+                continue;
+            };
+            if let AimTarget::Object(name) = &aim.target {
+                self.aimed_at(track, aim, name, names);
+            }
+            let same: Vec<&Track> = tracks.iter().filter(|t| t.target == track.target).collect();
+            if same.iter().filter(|t| t.aim.is_some()).count() > 1
+                && tracks[..i]
+                    .iter()
+                    .any(|t| t.target == track.target && t.aim.is_some())
+            {
+                self.err(
+                    &[&aim.path],
+                    format!(
+                        "'{}' has a `look_at` in an earlier track already",
+                        track.target
+                    ),
+                );
+            }
+            let turned = same
+                .iter()
+                .find(|t| t.rotate.is_some() || t.orient.is_some());
+            if let Some(other) = turned.filter(|t| t.path != track.path) {
+                self.err(
+                    &[&other.path],
+                    format!(
+                        "'{}' looks at its target (`look_at` in {}): this track would turn it away",
+                        track.target, track.path
+                    ),
+                );
+            }
+        }
+    }
+
+    fn aimed_at(&mut self, track: &Track, aim: &Aim, name: &str, names: &dyn SceneNames) {
+        let at = [index(&aim.path, 0), aim.path.clone()];
+        match names.kind_of(name) {
+            _ if name == track.target => {
+                self.err(&[&at[0], &at[1]], format!("'{name}' cannot look at itself"))
+            }
+            Some(TargetKind::Shape | TargetKind::Composite | TargetKind::Light) => {}
+            Some(kind) => self.err(
+                &[&at[0], &at[1]],
+                format!(
+                    "'{name}' is a {}: `look_at: Object(…)` follows a shape, composite or light",
+                    kind.noun()
+                ),
+            ),
+            None => {
+                let objects: Vec<&str> = names
+                    .names()
+                    .into_iter()
+                    .filter(|n| {
+                        matches!(
+                            names.kind_of(n),
+                            Some(TargetKind::Shape | TargetKind::Composite)
+                        )
+                    })
+                    .collect();
+                let d = self.src.error(
+                    &[&at[0], &at[1]],
+                    format!("the base scene has no object named '{name}' to look at"),
+                );
+                let d = match suggest(name, objects.iter().copied()) {
+                    Some(s) => d.with_help(format!("did you mean '{s}'?")),
+                    None if objects.len() <= 12 && !objects.is_empty() => {
+                        d.with_help(format!("its objects: {}", names_list(&objects)))
+                    }
+                    None => d,
+                };
+                if !self.full() {
+                    self.errors.push(d);
+                }
+            }
+        }
+    }
+}
+
+impl Checker<'_> {
+    /// Warns, at the key, of every last key that no frame shows: the last frame of a cyclic
+    /// animation is one step before `length`. A channel that ends where it began is a loop,
+    /// whose last key the next first frame shows, and is left alone.
+    pub fn unshown_last_keys(
+        &mut self,
+        tracks: &[Track],
+        ambient: &Option<Channel<DVec3>>,
+        background: &Option<Channel<DVec3>>,
+        last_frame: f64,
+    ) {
+        let mut late = Vec::new();
+        never_shown(&mut late, ambient, last_frame);
+        never_shown(&mut late, background, last_frame);
+        for t in tracks {
+            never_shown(&mut late, &t.translate, last_frame);
+            // A turn that ends a whole number of turns from where it began is back at its start.
+            let whole_turns = t
+                .rotate
+                .as_ref()
+                .and_then(|c| Some((c.keys.last()?.value - c.keys.first()?.value) % 360.0 == 0.0));
+            if whole_turns != Some(true) {
+                never_shown(&mut late, &t.rotate, last_frame);
+            }
+            never_shown(&mut late, &t.scale, last_frame);
+            never_shown(&mut late, &t.brightness, last_frame);
+            never_shown(&mut late, &t.color, last_frame);
+            never_shown(&mut late, &t.fov, last_frame);
+            never_shown(&mut late, &t.visible, last_frame);
+            let m = &t.material;
+            for c in [&m.ka, &m.kd, &m.ks] {
+                never_shown(&mut late, c, last_frame);
+            }
+            for c in [&m.reflectivity, &m.opacity, &m.ior] {
+                never_shown(&mut late, c, last_frame);
+            }
+            if let Some(aim) = &t.aim {
+                never_shown(&mut late, &aim.roll, last_frame);
+                if let AimTarget::Keys(k) = &aim.target {
+                    never_shown(&mut late, &Some(k.clone()), last_frame);
+                }
+            }
+            if let Some(o) = &t.orient {
+                let ends = o.keys.first().zip(o.keys.last());
+                let returns = ends.is_some_and(|(a, b)| a.value.abs_diff_eq(b.value, 1e-12));
+                let shown = o.orientation(last_frame) == o.keys.last().map(|k| k.value);
+                if let Some(last) = o.keys.last().filter(|_| !returns && !shown) {
+                    let played = last.at + o.timing.offset;
+                    if o.timing.cycle == Cycle::Hold && played > last_frame + 1e-9 {
+                        late.push((index(&o.path, o.keys.len() - 1), played));
+                    }
+                }
+            }
+        }
+        for (path, at) in late {
+            let at_path = field(&path, "at");
+            self.warn(
+                &[&at_path, &path],
+                format!(
+                    "this key at {} s comes after the last frame ({} s), so no frame shows it",
+                    crate::keyframe::tidy::tidy(at),
+                    crate::keyframe::tidy::tidy(last_frame)
+                ),
+            );
+            if let Some(w) = self.warnings.pop() {
+                self.warnings.push(w.with_help(
+                    "`end: Inclusive` adds a frame at `length` that shows the last keys; the default, `end: Cyclic`, stops one frame short so that loops do not show one pose twice",
+                ));
+            }
+        }
+    }
+}
+
+/// Adds channel `c`'s last key to `late` if no frame up to `last_frame` shows it.
+fn never_shown<T: crate::keyframe::interp::Keyable + PartialEq>(
+    late: &mut Vec<(String, f64)>,
+    c: &Option<Channel<T>>,
+    last_frame: f64,
+) {
+    let Some(c) = c else {
+        return;
+    };
+    let (Some(first), Some(last)) = (c.keys.first(), c.keys.last()) else {
+        return;
+    };
+    let played = last.at + c.timing.offset;
+    let loops_back = c.keys.len() > 1 && first.value == last.value;
+    if c.timing.cycle != Cycle::Hold || played <= last_frame + 1e-9 || loops_back {
+        return;
+    }
+    if c.at(last_frame) != Some(last.value) {
+        late.push((index(&c.path, c.keys.len() - 1), played));
+    }
+}
+
+fn target_name(t: &TrackSpec) -> &str {
+    t.target.as_deref().unwrap_or("")
+}
