@@ -9,10 +9,13 @@
 //!   resuming, shards and failures.
 //! - `holds`: frames of one scene rendered once and copied, byte for byte.
 //! - `bench`: `anim bench` at its tiny size, and the files it writes.
+//! - `animator`: aim, orientation keys, the inclusive end, curves kept in range, materials,
+//!   visibility, reuse, the early check of the base scene, and the example specs' frames.
 
 #[path = "../common/mod.rs"]
 mod common;
 
+mod animator;
 mod bench;
 mod frames;
 mod holds;

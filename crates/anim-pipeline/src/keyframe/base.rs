@@ -7,12 +7,13 @@ use anim_core::math::Transform;
 use anim_core::scene::Geometry;
 use anim_core::sdf::ast::{Statement, StatementKind, TransformOp};
 use glam::DVec3;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// The base scene: its statements without render lines, and what each name is.
 pub struct BaseScene {
     pub statements: Vec<Statement>,
     kinds: BTreeMap<String, TargetKind>,
+    materials: BTreeSet<String>,
     /// Each composite's children, as its last definition lists them.
     children: BTreeMap<String, Vec<String>>,
     default_camera: Option<String>,
@@ -22,7 +23,7 @@ impl BaseScene {
     pub fn new(statements: Vec<Statement>) -> BaseScene {
         let mut kinds = BTreeMap::new();
         let mut children = BTreeMap::new();
-        let mut materials = Vec::new();
+        let mut materials = BTreeSet::new();
         let mut render_camera = None;
         let mut first_camera = None;
         for s in &statements {
@@ -33,7 +34,7 @@ impl BaseScene {
                     Some((name, TargetKind::Composite))
                 }
                 StatementKind::Material(m) => {
-                    materials.push(m.name.clone());
+                    materials.insert(m.name.clone());
                     None
                 }
                 StatementKind::Light(l) => Some((&l.name, TargetKind::Light)),
@@ -54,8 +55,8 @@ impl BaseScene {
         }
         // A material that shares its name with a thing is reached through the thing: tracks
         // that key materials name materials of their own.
-        for m in materials {
-            kinds.entry(m).or_insert(TargetKind::Material);
+        for m in &materials {
+            kinds.entry(m.clone()).or_insert(TargetKind::Material);
         }
         let default_camera = render_camera
             .filter(|c| kinds.get(c) == Some(&TargetKind::Camera))
@@ -67,6 +68,7 @@ impl BaseScene {
         BaseScene {
             statements,
             kinds,
+            materials,
             children,
             default_camera,
         }
@@ -153,6 +155,10 @@ impl SceneNames for BaseScene {
 
     fn default_camera(&self) -> Option<&str> {
         self.default_camera.as_deref()
+    }
+
+    fn has_material(&self, name: &str) -> bool {
+        self.materials.contains(name)
     }
 }
 

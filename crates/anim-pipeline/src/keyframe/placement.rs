@@ -173,7 +173,7 @@ impl<'a> Placer<'a> {
         Some(Ok(Pose {
             eye,
             dir,
-            up: rolled_up(dir, aim.up, roll),
+            up: tidy3(rolled_up(dir, aim.up, roll)),
         }))
     }
 

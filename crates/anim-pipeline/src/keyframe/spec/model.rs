@@ -340,4 +340,7 @@ pub trait SceneNames {
     fn names(&self) -> Vec<&str>;
     /// The camera used when the spec names none.
     fn default_camera(&self) -> Option<&str>;
+    /// Whether the base scene defines a material named `name` (a thing of the same name
+    /// shadows it for tracks that key the thing's own channels).
+    fn has_material(&self, name: &str) -> bool;
 }

@@ -213,7 +213,20 @@ impl Checker<'_> {
                 "`name` belongs to curves: a track says which thing it moves with `target`".into(),
             );
         }
-        let kind = self.target_kind(t, &path, names);
+        let kind = self.target_kind(t, &path, names).map(|kind| {
+            // A material that shares its name with a thing: a track that keys only
+            // material channels means the material.
+            let keyed = keyed_channels(t).into_iter().filter(|(_, k)| *k);
+            let material_only = keyed.clone().count() > 0
+                && keyed
+                    .into_iter()
+                    .all(|(c, _)| fits(TargetKind::Material, c));
+            if material_only && names.has_material(target_name(t)) {
+                TargetKind::Material
+            } else {
+                kind
+            }
+        });
         let timing = self.timing(s, default_looping);
         let translate = self.keys(s, "translate", |t| &t.translate, timing, |v: &V3| v.0);
         let (rotate_keys, rotate_path) = s.keys("rotate", |t| &t.rotate);
