@@ -4,10 +4,11 @@
 #
 #   scripts/animate.sh animations/orbit.ron [OUT.mp4]
 #
-# OUT defaults to animation.mp4. Frames go to frames/<spec name>/ (override with FRAMES_DIR);
-# extra `anim render` options can be passed in ANIM_RENDER_ARGS, e.g.
+# OUT defaults to animation.mp4. Frames go where `anim generate` puts them: the spec's
+# `frames_dir`, else frames/<spec name>/ beside the spec (override with FRAMES_DIR); extra
+# `anim render` options can be passed in ANIM_RENDER_ARGS, e.g.
 #   ANIM_RENDER_ARGS="--spp 16" scripts/animate.sh animations/orbit.ron
-# ANIM=/path/to/anim uses that build instead of building one.
+# ANIM=/path/to/anim uses that build instead of building one (cargo is then not needed).
 # Re-running is cheap: unchanged frames are not rendered again.
 set -euo pipefail
 
@@ -24,18 +25,14 @@ if [ ! -f "$spec" ]; then
   exit 1
 fi
 # Fail before the long part if a tool is missing.
-if ! command -v cargo >/dev/null 2>&1; then
-  echo "error: cargo is not installed; install Rust from https://rustup.rs" >&2
+if [ -z "${ANIM:-}" ] && ! command -v cargo >/dev/null 2>&1; then
+  echo "error: cargo is not installed; install Rust from https://rustup.rs, or set ANIM to a built anim" >&2
   exit 127
 fi
 if ! command -v ffmpeg >/dev/null 2>&1; then
   echo "error: ffmpeg is not installed (Debian/Ubuntu: sudo apt-get install -y ffmpeg; macOS: brew install ffmpeg)" >&2
   exit 127
 fi
-
-stem=$(basename -- "$spec")
-stem=${stem%.*}
-frames=${FRAMES_DIR:-frames/$stem}
 
 if [ -n "${ANIM:-}" ]; then
   # A given build (the test suite passes its own), used as it is.
@@ -53,8 +50,13 @@ if [ ! -x "$anim" ]; then
   exit 1
 fi
 
-echo "==> generating $spec into $frames"
-"$anim" generate "$spec" -o "$frames"
+echo "==> generating $spec"
+# anim prints the frame directory it used: FRAMES_DIR, else the spec's own choice.
+if [ -n "${FRAMES_DIR:-}" ]; then
+  frames=$("$anim" generate "$spec" -o "$FRAMES_DIR" --print-dir)
+else
+  frames=$("$anim" generate "$spec" --print-dir)
+fi
 
 echo "==> rendering $frames"
 # shellcheck disable=SC2086  # ANIM_RENDER_ARGS is a list of options, split on purpose.

@@ -145,6 +145,10 @@ pub struct GenerateArgs {
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Print the frame directory, alone, on stdout (the summary goes to stderr): for scripts
+    /// that render what the spec generated, wherever its `frames_dir` puts it.
+    #[arg(long)]
+    pub print_dir: bool,
 }
 
 #[derive(Args, Debug, Clone)]

@@ -12,6 +12,7 @@ fn main() -> ExitCode {
             app::Command::Generate {
                 config: args.config(),
                 quiet: args.quiet,
+                print_dir: args.print_dir,
             },
             None,
         ),

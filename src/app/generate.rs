@@ -4,8 +4,9 @@ use anim_pipeline::keyframe::{self, GenerateConfig};
 use std::process::ExitCode;
 
 /// Prints warnings (unless `quiet`: once the spec and the base scene are checked, before any
-/// frame is written), errors and what was written.
-pub fn run(config: &GenerateConfig, quiet: bool) -> ExitCode {
+/// frame is written), errors and what was written; with `print_dir`, the frame directory
+/// alone on stdout and the rest on stderr.
+pub fn run(config: &GenerateConfig, quiet: bool, print_dir: bool) -> ExitCode {
     let print_warnings = |warnings: &[anim_core::diag::Diagnostic]| {
         if !quiet {
             for w in warnings {
@@ -42,7 +43,14 @@ pub fn run(config: &GenerateConfig, quiet: bool) -> ExitCode {
                         if report.removed == 1 { "" } else { "s" }
                     );
                 }
-                println!("{line}");
+                if print_dir {
+                    eprintln!("{line}");
+                } else {
+                    println!("{line}");
+                }
+            }
+            if print_dir {
+                println!("{}", report.dir.display());
             }
             ExitCode::SUCCESS
         }

@@ -28,6 +28,8 @@ pub enum Command {
     Generate {
         config: GenerateConfig,
         quiet: bool,
+        /// Print the frame directory alone on stdout, the summary on stderr.
+        print_dir: bool,
     },
     /// The time-against-error benchmark, or with `stress` the numerical stress table; files
     /// go to `out`.
@@ -61,7 +63,11 @@ pub fn run(command: Command, threads: Option<u32>) -> ExitCode {
     pool.install(|| match &command {
         Command::Render(config) => render::run(config),
         Command::Check(config) => check::run(config),
-        Command::Generate { config, quiet } => generate::run(config, *quiet),
+        Command::Generate {
+            config,
+            quiet,
+            print_dir,
+        } => generate::run(config, *quiet, *print_dir),
         Command::Bench {
             config,
             stress,

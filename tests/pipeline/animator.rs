@@ -485,3 +485,55 @@ fn the_new_example_specs_generate_frames_that_load_without_warnings() {
         );
     }
 }
+
+#[test]
+fn animate_sh_uses_a_built_anim_without_cargo_and_the_spec_s_frames_dir() {
+    let have_ffmpeg = std::process::Command::new("ffmpeg")
+        .arg("-version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !have_ffmpeg {
+        use std::io::Write as _;
+        let _ = writeln!(
+            std::io::stderr(),
+            "SKIPPED animate_sh_uses_a_built_anim_without_cargo_and_the_spec_s_frames_dir: ffmpeg is not installed (apt-get install ffmpeg); CI installs it"
+        );
+        return;
+    }
+    let spec = "(scene: File(\"base.sdf\"), fps: 4, length: Frames(3), resolution: (16, 8),
+  frames_dir: \"shots/one\",
+  tracks: [(target: \"ball\", translate: [(at: 0, value: (0, 0, 0)), (at: 0.5, value: (1, 0, 0))])])";
+    let dir = project(&[("base.sdf", BALL), ("shot.ron", spec)]);
+    // A PATH with the system's tools (ffmpeg, sed, find) but not cargo's directory.
+    let path = "/usr/local/bin:/usr/bin:/bin";
+    if let Some(dir) = path
+        .split(':')
+        .find(|d| Path::new(d).join("cargo").exists())
+    {
+        use std::io::Write as _;
+        let _ = writeln!(
+            std::io::stderr(),
+            "SKIPPED animate_sh_uses_a_built_anim_without_cargo_and_the_spec_s_frames_dir: cargo is installed in {dir}, so a PATH without it cannot be made"
+        );
+        return;
+    }
+    let run = std::process::Command::new(repo().join("scripts/animate.sh"))
+        .arg(dir.path().join("shot.ron"))
+        .arg(dir.path().join("shot.mp4"))
+        .current_dir(dir.path())
+        .env("PATH", path)
+        .env("ANIM", env!("CARGO_BIN_EXE_anim"))
+        .env_remove("FRAMES_DIR")
+        .output()
+        .expect("run animate.sh");
+    assert!(
+        run.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let shots = dir.path().join("shots/one");
+    assert_eq!(frames(&shots).len(), 3);
+    assert!(shots.join("frame_0002.png").is_file());
+    assert!(dir.path().join("shot.mp4").metadata().expect("video").len() > 0);
+}
