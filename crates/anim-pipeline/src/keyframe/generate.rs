@@ -1,7 +1,7 @@
 //! Frame generation: the base scene's statements, with the tracks applied at each frame's
 //! time, written back out as one complete SDF file per frame.
 //!
-//! How keyed motion composes with the base file (documented in README.md): a track's
+//! How keyed motion composes with the base file (documented in docs/animation.md): a track's
 //! translate `T`, rotate `R` (about `axis`) and scale `S` at time t, with pivot `p`, give
 //!
 //! ```text

@@ -1,10 +1,12 @@
-//! Keyframe animation: a RON spec (see `README.md`) turned into one complete SDF
+//! Keyframe animation: a RON spec (see `docs/animation.md`) turned into one complete SDF
 //! file per frame.
 //!
-//! [`spec`] reads and checks the spec, [`interp`] samples keyed values, [`orbit`] places the
-//! turntable camera, [`motion`] describes motion during a blurred frame's exposure and
-//! [`generate`] writes the frames. Imports run one way: `generate` → `motion` → `orbit` →
-//! `spec` → {`interp`, `locate`, `tidy`}.
+//! [`spec`] reads and checks the spec, [`interp`] samples keyed values, [`rotation`] handles
+//! orientations, [`base`] knows the base scene, [`orbit`] places the turntable camera,
+//! [`motion`] turns a track into transforms (and motion during a blurred frame's exposure),
+//! [`placement`] places things at a time (centres, pivots, aims), [`keyed`] writes keyed
+//! values into definitions, [`ranges`] keeps ranged values in range between frames, and
+//! [`generate`] writes the frames.
 
 pub mod base;
 pub mod generate;

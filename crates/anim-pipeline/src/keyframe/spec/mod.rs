@@ -2,7 +2,7 @@
 //! position of every value (`source`), and the checks ([`validate`]) that turn them into an
 //! [`Animation`] (`model`) whose every problem is reported at its line and column.
 //!
-//! The format is documented for users in `README.md`.
+//! The format is documented for users in `docs/animation.md`.
 
 mod checker;
 mod model;
