@@ -6,6 +6,7 @@ use anim_core::limits;
 use anim_core::math::Transform;
 use anim_core::scene::Geometry;
 use anim_core::sdf::ast::{Statement, StatementKind, TransformOp};
+use anim_core::util::FastMap;
 use glam::DVec3;
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -14,6 +15,11 @@ pub struct BaseScene {
     pub statements: Vec<Statement>,
     kinds: BTreeMap<String, TargetKind>,
     materials: BTreeSet<String>,
+    /// Where each thing's last definition stands in `statements`, and its transform
+    /// statements: a default pivot asks for them once per descendant, and a scene can hold a
+    /// hundred thousand things.
+    definitions: FastMap<String, usize>,
+    transforms: FastMap<String, Vec<usize>>,
     /// Each composite's children, as its last definition lists them.
     children: BTreeMap<String, Vec<String>>,
     default_camera: Option<String>,
@@ -61,12 +67,33 @@ impl BaseScene {
         let default_camera = render_camera
             .filter(|c| kinds.get(c) == Some(&TargetKind::Camera))
             .or(first_camera);
-        let statements = statements
+        let statements: Vec<Statement> = statements
             .into_iter()
             .filter(|s| !matches!(s.kind, StatementKind::Render(_)))
             .collect();
+        let mut definitions = FastMap::default();
+        let mut transforms: FastMap<String, Vec<usize>> = FastMap::default();
+        for (i, s) in statements.iter().enumerate() {
+            match &s.kind {
+                StatementKind::Shape { name, .. } | StatementKind::Composite { name, .. } => {
+                    definitions.insert(name.clone(), i);
+                }
+                StatementKind::Light(l) => {
+                    definitions.insert(l.name.clone(), i);
+                }
+                StatementKind::Camera(c) => {
+                    definitions.insert(c.name.clone(), i);
+                }
+                StatementKind::Transform { target, .. } => {
+                    transforms.entry(target.name.clone()).or_default().push(i);
+                }
+                _ => {}
+            }
+        }
         BaseScene {
             statements,
+            definitions,
+            transforms,
             kinds,
             materials,
             children,
@@ -77,8 +104,9 @@ impl BaseScene {
     /// `name`'s own transform statements composed as the scene builder composes them for
     /// generated frames (`TransformOrder::World`: each applies after the ones before it).
     pub fn own_transform(&self, name: &str) -> Transform {
-        let ops = self.statements.iter().flat_map(|s| match &s.kind {
-            StatementKind::Transform { target, ops } if target.name == name => ops.as_slice(),
+        let at = self.transforms.get(name).map_or(&[][..], Vec::as_slice);
+        let ops = at.iter().flat_map(|&i| match &self.statements[i].kind {
+            StatementKind::Transform { ops, .. } => ops.as_slice(),
             _ => &[],
         });
         ops.filter_map(op_transform)
@@ -101,18 +129,7 @@ impl BaseScene {
 
     /// The last definition of `name` (later definitions replace earlier ones).
     fn definition(&self, name: &str) -> Option<&StatementKind> {
-        self.statements
-            .iter()
-            .rev()
-            .map(|s| &s.kind)
-            .find(|k| match k {
-                StatementKind::Shape { name: n, .. } | StatementKind::Composite { name: n, .. } => {
-                    n == name
-                }
-                StatementKind::Light(l) => l.name == name,
-                StatementKind::Camera(c) => c.name == name,
-                _ => false,
-            })
+        Some(&self.statements.get(*self.definitions.get(name)?)?.kind)
     }
 
     /// Bounding box of `name` in its parent's frame: its geometry (or its children) under

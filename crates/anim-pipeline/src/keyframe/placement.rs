@@ -12,13 +12,22 @@ use anim_core::limits;
 use anim_core::math::Transform;
 use anim_core::sdf::ast::StatementKind;
 use glam::{DMat4, DQuat, DVec3};
+use std::collections::BTreeMap;
 
-/// Places the targets of one animation's tracks.
+/// Places the targets of one animation's tracks. What the base scene says of them (centres,
+/// the composites above them, the cameras' eyes) is looked up once here: a frame asks for it
+/// many times, and finding it in the statements costs their number.
 pub struct Placer<'a> {
-    pub base: &'a BaseScene,
     pub anim: &'a Animation,
     /// Each track's pivot: its own or the default.
     pub pivots: Vec<DVec3>,
+    /// The centre of each object looked at, in its parent's frame, as the base scene puts it.
+    centres: BTreeMap<String, DVec3>,
+    /// The composites above each object aimed or looked at, nearest first, with their own
+    /// transforms (the first composite that lists it, at each level).
+    ancestors: BTreeMap<String, Vec<(String, Transform)>>,
+    /// Each aimed camera's eye where the base scene puts it.
+    eyes: BTreeMap<String, DVec3>,
 }
 
 impl<'a> Placer<'a> {
@@ -28,7 +37,35 @@ impl<'a> Placer<'a> {
             .iter()
             .map(|t| t.pivot.unwrap_or_else(|| base.default_pivot(&t.target)))
             .collect();
-        Placer { base, anim, pivots }
+        let (mut centres, mut ancestors, mut eyes) =
+            (BTreeMap::new(), BTreeMap::new(), BTreeMap::new());
+        for track in &anim.tracks {
+            let Some(aim) = &track.aim else {
+                continue;
+            };
+            if let AimTarget::Object(name) = &aim.target {
+                centres.insert(name.clone(), base.default_pivot(name));
+                ancestors.insert(name.clone(), ancestors_of(base, name));
+            }
+            ancestors.insert(track.target.clone(), ancestors_of(base, &track.target));
+            if track.kind == TargetKind::Camera {
+                let eye = base.statements.iter().rev().find_map(|s| match &s.kind {
+                    StatementKind::Camera(c) if c.name == track.target => Some(c.eye),
+                    _ => None,
+                });
+                if let Some(eye) = eye {
+                    let placed = base.own_transform(&track.target).point(eye);
+                    eyes.insert(track.target.clone(), placed);
+                }
+            }
+        }
+        Placer {
+            anim,
+            pivots,
+            centres,
+            ancestors,
+            eyes,
+        }
     }
 
     /// Where track `i` puts its target at time `t`; an aimed object turned to face its
@@ -85,21 +122,15 @@ impl<'a> Placer<'a> {
     }
 
     /// World from the frame of `name`'s parent at time `t`: the placements of the composites
-    /// above it (the first that lists it, at each level).
+    /// above it.
     fn parent_frame(&self, name: &str, t: f64) -> DMat4 {
-        let mut m = DMat4::IDENTITY;
-        let mut child = name.to_string();
-        for _ in 0..limits::MAX_NESTING {
-            let Some(parent) = self.base.parents(&child).first().map(|p| p.to_string()) else {
-                break;
-            };
+        let chain = self.ancestors.get(name).map_or(&[][..], Vec::as_slice);
+        chain.iter().fold(DMat4::IDENTITY, |m, (parent, own)| {
             let placed = self
-                .placed_by(&parent, self.anim.tracks.len(), t)
-                .then_after(&self.base.own_transform(&parent));
-            m = placed.world_from_object * m;
-            child = parent;
-        }
-        m
+                .placed_by(parent, self.anim.tracks.len(), t)
+                .then_after(own);
+            placed.world_from_object * m
+        })
     }
 
     fn world_to_parent(&self, name: &str, p: DVec3, t: f64) -> DVec3 {
@@ -115,7 +146,7 @@ impl<'a> Placer<'a> {
     pub fn centre_at(&self, name: &str, t: f64) -> DVec3 {
         let local = self
             .placed_by(name, self.anim.tracks.len(), t)
-            .point(self.base.default_pivot(name));
+            .point(self.centres.get(name).copied().unwrap_or(DVec3::ZERO));
         self.parent_frame(name, t).transform_point3(local)
     }
 
@@ -138,15 +169,7 @@ impl<'a> Placer<'a> {
             .iter()
             .filter(|tr| tr.target == name && tr.kind == TargetKind::Camera)
             .find_map(|tr| tr.aim.as_ref())?;
-        let eye0 = self
-            .base
-            .statements
-            .iter()
-            .rev()
-            .find_map(|s| match &s.kind {
-                StatementKind::Camera(c) if c.name == name => Some(c.eye),
-                _ => None,
-            })?;
+        let eye0 = *self.eyes.get(name)?;
         let moved: DVec3 = self
             .anim
             .tracks
@@ -155,7 +178,7 @@ impl<'a> Placer<'a> {
             .filter_map(|tr| tr.translate.as_ref().and_then(|c| c.at(t)))
             .map(tidy3)
             .sum();
-        let eye = self.base.own_transform(name).point(eye0) + moved;
+        let eye = eye0 + moved;
         let target = self.aim_point(aim, t);
         let roll = aim.roll.as_ref().and_then(|r| r.at(t)).unwrap_or(0.0);
         if !can_look(eye, target, aim.up) {
@@ -204,6 +227,24 @@ impl<'a> Placer<'a> {
         }
         most
     }
+}
+
+/// The composites above `name`, nearest first, with their own transforms: at each level the
+/// first composite that lists it.
+fn ancestors_of(base: &BaseScene, name: &str) -> Vec<(String, Transform)> {
+    let mut chain: Vec<(String, Transform)> = Vec::new();
+    let mut child = name.to_string();
+    while chain.len() < limits::MAX_NESTING {
+        let Some(parent) = base.parents(&child).first().map(|p| p.to_string()) else {
+            break;
+        };
+        if parent == name || chain.iter().any(|(p, _)| *p == parent) {
+            break;
+        }
+        chain.push((parent.clone(), base.own_transform(&parent)));
+        child = parent;
+    }
+    chain
 }
 
 fn fmt3(v: DVec3) -> String {
