@@ -17,7 +17,7 @@
 use anim_core::load::load_str;
 use anim_core::sdf::{LoadOptions, MaterialField, TransformOrder};
 use anim_core::util::SplitMix64;
-use anim_pipeline::keyframe::generate::BaseScene;
+use anim_pipeline::keyframe::generate::{BaseScene, Generator};
 use anim_pipeline::keyframe::spec::{self, Source};
 use std::panic::{self, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
@@ -429,7 +429,15 @@ fn execute(target: Target, input: &[u8], variant: u64, base: &BaseScene) {
                     }
                     spec::SceneSource::File(_) => None,
                 };
-                let _ = spec::validate(&file, names.as_ref().unwrap_or(base), &src);
+                let scene = names.as_ref().unwrap_or(base);
+                if let Ok(anim) = spec::validate(&file, scene, &src) {
+                    // A valid spec's first and last frames are made as `anim generate` makes
+                    // them (aims, orientations, ranges, visibility), in memory.
+                    let generator = Generator::new(scene, &anim, &src);
+                    for i in [0, anim.frames.saturating_sub(1)] {
+                        let _ = generator.frame_text(i);
+                    }
+                }
             }
         }
     }
@@ -442,6 +450,9 @@ fn base_scene(repo: &Path) -> BaseScene {
     for f in [
         "animations/showcase.sdf",
         "animations/motion.sdf",
+        "animations/flyby.sdf",
+        "animations/logo.sdf",
+        "animations/crowd.sdf",
         "scenes/assignment.sdf",
     ] {
         text.push_str(&std::fs::read_to_string(repo.join(f)).unwrap_or_default());

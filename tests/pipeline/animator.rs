@@ -537,3 +537,17 @@ fn animate_sh_uses_a_built_anim_without_cargo_and_the_spec_s_frames_dir() {
     assert!(shots.join("frame_0002.png").is_file());
     assert!(dir.path().join("shot.mp4").metadata().expect("video").len() > 0);
 }
+
+#[test]
+fn an_object_whose_forward_is_its_up_is_refused_before_any_frame() {
+    let spec = "(scene: File(\"base.sdf\"), length: Frames(2), resolution: (16, 9),
+  tracks: [(target: \"ball\", look_at: Point((0, 0, 5)), forward: (0, 1, 0))])";
+    let dir = project(&[("base.sdf", BALL), ("up.ron", spec)]);
+    let (ok, stderr) = generate(&dir.path().join("up.ron"), &dir.path().join("f"));
+    assert!(!ok);
+    assert!(
+        stderr.contains("up.ron:2:65: error: `forward` (0, 1, 0) and `up` (0, 1, 0) are parallel"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("f").exists());
+}

@@ -537,6 +537,16 @@ impl Checker<'_> {
                 "a camera faces along its view direction: `forward` is for objects".into(),
             );
         }
+        let object = matches!(kind, Some(TargetKind::Shape | TargetKind::Composite));
+        if object && forward.cross(up).length() <= 1e-9 * forward.length() * up.length() {
+            self.err(
+                &[&field(&s.path, "up"), &field(&s.path, "forward"), &s.path],
+                format!(
+                    "`forward` ({}, {}, {}) and `up` ({}, {}, {}) are parallel: up must say which way the object is turned about its line of sight",
+                    forward.x, forward.y, forward.z, up.x, up.y, up.z
+                ),
+            );
+        }
         let (keys, roll_path) = s.keys("roll", |t| &t.roll);
         let roll = self.channel(keys, &roll_path, timing, number, None);
         Some(Aim {
