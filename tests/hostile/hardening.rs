@@ -523,3 +523,50 @@ fn a_generate_that_fails_midway_takes_back_the_frames_it_added() {
     left.sort();
     assert_eq!(left, ["f_0002.sdf"], "{stderr}");
 }
+
+#[test]
+fn hdr_never_replaces_a_radiance_file_that_anim_did_not_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write(
+        dir.path(),
+        "s.sdf",
+        &format!("{SPHERE}render cam s.png 8 6\n"),
+    );
+    let users = dir.path().join("s.pfm");
+    std::fs::write(&users, b"the user's own radiance file").unwrap();
+    let render = || {
+        anim()
+            .arg("render")
+            .arg(&scene)
+            .args(["--spp", "1", "--hdr"])
+            .output()
+            .unwrap()
+    };
+    let out = render();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("s.sdf:5:1: error: with --hdr, the radiance file")
+            && stderr.contains("would replace a file that anim did not write"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read(&users).unwrap(),
+        b"the user's own radiance file"
+    );
+    assert!(
+        !dir.path().join("s.png").exists(),
+        "nothing is written after an error"
+    );
+
+    // Once the user's file is gone, anim writes its own, and may replace it on the next run
+    // (its mark vouches for it) but not once someone else has changed it.
+    std::fs::remove_file(&users).unwrap();
+    assert!(render().status.success());
+    let first = std::fs::read(&users).unwrap();
+    assert!(first.starts_with(b"PF\n"));
+    assert!(render().status.success());
+    std::fs::write(&users, b"edited by hand").unwrap();
+    assert!(!render().status.success());
+    assert_eq!(std::fs::read(&users).unwrap(), b"edited by hand");
+}

@@ -377,6 +377,8 @@ fn hdr_writes_the_radiance_beside_each_image() {
     assert_eq!(
         names,
         [
+            // The marks that vouch for the radiance files anim wrote.
+            ".anim-cache",
             "image.pfm",
             "image.png",
             "other.bmp",

@@ -5,6 +5,7 @@
 
 mod cache;
 mod dir;
+mod hdr;
 mod scene_file;
 mod shard;
 

@@ -1,6 +1,7 @@
 //! One scene file from text to image files: load it, render every image its render lines ask
 //! for, and write each atomically (a reader never sees a half-written image).
 
+use super::hdr;
 use anim_core::diag::{Diagnostic, Severity};
 use anim_core::limits;
 use anim_core::load::probe;
@@ -201,23 +202,29 @@ pub fn copy_scene_file(
             return Some(Err(warnings));
         }
     };
-    let paths: Vec<PathBuf> = targets
+    // Each path, and whether it is a radiance file (which gets its mark).
+    let paths: Vec<(PathBuf, bool)> = targets
         .into_iter()
         .flat_map(|(out, _)| {
-            let hdr = settings.hdr.then(|| film::hdr_path(&out));
-            std::iter::once(out).chain(hdr)
+            let hdr = settings.hdr.then(|| (film::hdr_path(&out), true));
+            std::iter::once((out, false)).chain(hdr)
         })
         .collect();
     if paths.len() != source.outputs.len() {
         return None;
     }
     let mut outputs = Vec::with_capacity(paths.len());
-    for (to, from) in paths.into_iter().zip(&source.outputs) {
+    for ((to, is_radiance), from) in paths.into_iter().zip(&source.outputs) {
         let bytes = std::fs::read(&from.path).ok()?;
         if bytes.len() as u64 != from.bytes.len || Fnv64::of(&bytes) != from.bytes.hash {
             return None;
         }
-        if let Err(e) = write_atomically(&to, |w| w.write_all(&bytes)) {
+        let written = write_atomically(&to, |w| w.write_all(&bytes));
+        let marked = written.and_then(|()| match is_radiance {
+            true => hdr::mark_written(&to, &from.bytes),
+            false => Ok(()),
+        });
+        if let Err(e) = marked {
             warnings.push(Diagnostic::file_error(
                 path,
                 format!("cannot write '{}': {e}", to.display()),
@@ -290,6 +297,23 @@ fn resolve_targets(
                     film::hdr_path(&out).display()
                 ),
             ));
+            continue;
+        }
+        let pfm = film::hdr_path(&out);
+        if settings.hdr && !hdr::may_replace(&pfm) {
+            errors.push(
+                job_error(
+                    path,
+                    job,
+                    format!(
+                        "with --hdr, the radiance file '{}' would replace a file that anim did not write",
+                        pfm.display()
+                    ),
+                )
+                .with_help(
+                    "move that file away or name the image differently (or, if an interrupted render wrote it, delete it)",
+                ),
+            );
             continue;
         }
         match ImageFormat::for_path(&out, settings.ppm_ascii) {
@@ -385,7 +409,10 @@ fn render_jobs(
         let hdr = settings.hdr.then(|| film::hdr_path(&out));
         outputs.push(Output { path: out, bytes });
         if let Some(pfm) = hdr {
-            match film::write_pfm(&pfm, &image) {
+            match film::write_pfm(&pfm, &image).and_then(|bytes| {
+                hdr::mark_written(&pfm, &bytes)?;
+                Ok(bytes)
+            }) {
                 Ok(bytes) => outputs.push(Output { path: pfm, bytes }),
                 Err(e) => {
                     diagnostics.push(job_error(
