@@ -11,7 +11,7 @@
 //! are complete, so an interrupted run never leaves a record for an image that is not
 //! finished: the next run renders that frame again.
 
-use super::scene_file::Output;
+use super::output::Output;
 use anim_core::render::RenderSettings;
 use anim_core::sdf::LoadOptions;
 use anim_core::util::{write_atomically, Fnv64};

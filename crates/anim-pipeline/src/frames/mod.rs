@@ -6,6 +6,7 @@
 mod cache;
 mod dir;
 mod hdr;
+mod output;
 mod scene_file;
 mod shard;
 

@@ -2,24 +2,18 @@
 //! for, and write each atomically (a reader never sees a half-written image).
 
 use super::hdr;
+pub use super::output::Output;
 use anim_core::diag::{Diagnostic, Severity};
 use anim_core::limits;
 use anim_core::load::probe;
 use anim_core::render::camera::CameraError;
-use anim_core::render::film::{self, ImageBytes, ImageFormat};
+use anim_core::render::film::{self, ImageFormat};
 use anim_core::render::{render_prepared, Prepared, RayCounts, RenderSettings, Rendered};
 use anim_core::scene::RenderJob;
 use anim_core::sdf::LoadOptions;
 use anim_core::util::{human_bytes, write_atomically, Fnv64};
 use std::io::Write as _;
 use std::path::{Component, Path, PathBuf};
-
-/// An image file written, with what was written to it.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Output {
-    pub path: PathBuf,
-    pub bytes: ImageBytes,
-}
 
 /// What rendering one scene file produced.
 #[derive(Clone, Debug)]
