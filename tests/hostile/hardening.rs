@@ -570,3 +570,31 @@ fn hdr_never_replaces_a_radiance_file_that_anim_did_not_write() {
     assert!(!render().status.success());
     assert_eq!(std::fs::read(&users).unwrap(), b"edited by hand");
 }
+
+#[test]
+fn an_image_the_process_cannot_get_memory_for_is_refused_even_over_the_budget() {
+    // `--max-memory` lets anim take 100 GiB; `ulimit -v` lets the process have about 4 GB.
+    // The image is refused with its located message instead of aborting mid-render.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write(
+        dir.path(),
+        "huge.sdf",
+        &format!("{SPHERE}render cam huge.png 16384 16384\n"),
+    );
+    let start = Instant::now();
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -v 4000000 && exec \"$0\" render \"$1\" --max-memory 100G")
+        .arg(env!("CARGO_BIN_EXE_anim"))
+        .arg(&scene)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("huge.sdf:5:1: error: a 16384×16384 image needs about")
+            && stderr.contains("more than the system will give this process now"),
+        "{stderr}"
+    );
+    assert!(start.elapsed() < Duration::from_secs(10));
+}

@@ -250,6 +250,17 @@ pub fn physical_memory() -> Option<u64> {
     kib.checked_mul(1024)
 }
 
+/// Whether the process can be given `bytes` more memory now: asked for and given back at once
+/// (address space only; no page is touched). A budget says what anim may take; this says
+/// what the system will give, which a limit set after start or a strict overcommit policy can
+/// make less, and a refused allocation would otherwise end the process.
+pub fn can_allocate(bytes: u64) -> bool {
+    let Ok(bytes) = usize::try_from(bytes) else {
+        return false;
+    };
+    Vec::<u8>::new().try_reserve_exact(bytes).is_ok()
+}
+
 /// The memory this process may use, in bytes: the least of the machine's physical memory,
 /// the address-space limit it runs under (`ulimit -v`, `RLIMIT_AS`) and the memory limit of
 /// its control group (cgroup v2 `memory.max`, v1 `memory.limit_in_bytes`); `None` when the

@@ -237,6 +237,24 @@ pub fn copy_scene_file(
     }))
 }
 
+/// Why an image that needs `needed` bytes cannot be made, and what would let it: more than
+/// the budget allows, or more than the process can be given now.
+fn memory_refusal(needed: u64, budget: u64) -> Option<(String, &'static str)> {
+    if needed > budget {
+        Some((
+            format!("more than the {} allowed", human_bytes(budget)),
+            "--max-memory raises the limit",
+        ))
+    } else if !anim_core::util::can_allocate(needed) {
+        Some((
+            "more than the system will give this process now".to_string(),
+            "a limit on the process (`ulimit -v`, a container's memory) is lower than --max-memory",
+        ))
+    } else {
+        None
+    }
+}
+
 /// Where each of `jobs` writes its image, and in which format. A path confined to its folder
 /// warns in `warnings` (or is an error under `strict`); `Err` holds every error, in the order
 /// of the render lines.
@@ -260,20 +278,20 @@ fn resolve_targets(
         }
         let (width, height, _) = settings.resolve(job);
         let needed = limits::image_memory(width, height);
-        if needed > settings.max_memory {
+        let refused = memory_refusal(needed, settings.max_memory);
+        if let Some((why, raise)) = refused {
             errors.push(
                 job_error(
                     path,
                     job,
                     format!(
-                        "a {width}×{height} image needs about {} to render, more than the {} allowed",
-                        human_bytes(needed),
-                        human_bytes(settings.max_memory)
+                        "a {width}×{height} image needs about {} to render, {why}",
+                        human_bytes(needed)
                     ),
                 )
-                .with_help(
-                    "render it smaller, or in tiles (several cameras, each seeing part of the view); --max-memory raises the limit",
-                ),
+                .with_help(format!(
+                    "render it smaller, or in tiles (several cameras, each seeing part of the view); {raise}"
+                )),
             );
             continue;
         }

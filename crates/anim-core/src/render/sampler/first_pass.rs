@@ -294,3 +294,23 @@ pub(super) fn around(
     (y.saturating_sub(1)..(y + 2).min(h))
         .map(move |ny| ny * w + x.saturating_sub(1)..ny * w + (x + 2).min(w))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::mem::size_of;
+
+    /// The memory budget's cost of a pixel (`limits::IMAGE_BYTES_PER_PIXEL`) covers every
+    /// buffer the adaptive sampler keeps per pixel at its peak.
+    #[test]
+    fn the_budget_per_pixel_covers_the_sampler_s_buffers() {
+        let first_pass = size_of::<(Vec3A, u32)>() + size_of::<Vec3A>() + size_of::<u32>();
+        let refined = size_of::<glam::Vec3>() + size_of::<u8>();
+        let motion = size_of::<Sweep>() + size_of::<Vec3A>();
+        let per_pixel = (first_pass + refined + motion) as u64;
+        assert!(
+            per_pixel <= crate::limits::IMAGE_BYTES_PER_PIXEL,
+            "{per_pixel} bytes a pixel"
+        );
+    }
+}
