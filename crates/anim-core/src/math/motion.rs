@@ -105,17 +105,28 @@ impl MotionKeys {
     /// `None` without keys, with instants out of order or not finite, or with a singular
     /// transform.
     pub fn new(centre: DVec3, keys: &[(f64, Transform)]) -> Option<MotionKeys> {
-        if keys.is_empty()
-            || keys.iter().any(|(u, _)| !u.is_finite())
-            || keys.windows(2).any(|w| w[0].0 >= w[1].0)
-        {
+        Self::from_keys(centre, keys.iter().map(|(u, t)| (*u, *t)))
+    }
+
+    /// [`MotionKeys::new`] of keys made one at a time: a file may key a million instants,
+    /// and only their decomposed form is kept.
+    pub fn from_keys(
+        centre: DVec3,
+        keys: impl IntoIterator<Item = (f64, Transform)>,
+    ) -> Option<MotionKeys> {
+        let keys = keys.into_iter();
+        let mut out = Vec::with_capacity(keys.size_hint().0);
+        for (u, t) in keys {
+            let in_order = out.last().is_none_or(|(last, _)| *last < u);
+            if !(u.is_finite() && in_order) {
+                return None;
+            }
+            out.push((u, Decomposed::of(&t.world_from_object, centre)?));
+        }
+        if out.is_empty() {
             return None;
         }
-        let keys = keys
-            .iter()
-            .map(|(u, t)| Some((*u, Decomposed::of(&t.world_from_object, centre)?)))
-            .collect::<Option<Vec<_>>>()?;
-        Some(MotionKeys { centre, keys })
+        Some(MotionKeys { centre, keys: out })
     }
 
     /// The transform at `u`: interpolated between the keys around it, held before the first

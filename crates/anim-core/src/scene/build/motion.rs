@@ -42,14 +42,13 @@ impl MotionLines<'_> {
     /// space `own` maps from); `None` when it has no lines, or keys that do not interpolate.
     fn keys(&self, key: (Space, &str), own: &Transform, centre: DVec3) -> Option<MotionKeys> {
         let lines = self.by_target.get(&key)?;
-        let keyed: Vec<(f64, Transform)> = lines
-            .iter()
-            .map(|(u, ops)| (*u, ops.then_after(own)))
-            .collect();
-        if !keyed.iter().all(|(_, t)| finite_transform(t)) {
+        // Placed one key at a time, twice (checked, then decomposed), rather than held: a
+        // file may key a million instants.
+        let keyed = || lines.iter().map(|(u, ops)| (*u, ops.then_after(own)));
+        if !keyed().all(|(_, t)| finite_transform(&t)) {
             return None;
         }
-        MotionKeys::new(centre, &keyed).filter(|k| !k.is_still())
+        MotionKeys::from_keys(centre, keyed()).filter(|k| !k.is_still())
     }
 }
 
