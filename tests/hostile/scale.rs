@@ -180,3 +180,97 @@ fn the_reader_reads_two_million_lines_a_second() {
     );
     assert!(rate >= 2e6, "{:.2} M lines/s", rate / 1e6);
 }
+
+/// `n` statements of one kind (`kind`), numbered `i`, after a header that makes them valid.
+fn statements_of_kind(kind: &str, n: usize) -> String {
+    let mut text = String::from(HEAD);
+    for i in 0..n {
+        let (x, y, z) = (
+            (i % 100) as f64,
+            (i / 100 % 100) as f64,
+            -5.0 - (i / 10_000) as f64,
+        );
+        let line = match kind {
+            "material" => format!("define material m{i} 0.2 0 0 0.8 0.1 0.1 0.5 0.5 0.5 20"),
+            "sphere" => format!("define shape sphere s{i} {x} {y} {z} 0.3 red"),
+            "box" => format!(
+                "define shape box s{i} {x} {y} {z} {} {} {} red",
+                x + 0.5,
+                y + 0.5,
+                z + 0.5
+            ),
+            "triangle" => format!(
+                "define shape triangle s{i} {x} {y} {z} {} {y} {z} {x} {} {z} red",
+                x + 0.5,
+                y + 0.5
+            ),
+            "light" => format!("define light l{i} {x} 5 5 0.001 0.001 0.001 1"),
+            "camera" => format!("define camera c{i} 60 0 0 {x} 0 0 -1 0 1 0"),
+            "transform" => format!(
+                "define shape sphere s{i} {x} {y} {z} 0.3 red\ntransform s{i} translate 0 0 -1"
+            ),
+            "composite" => {
+                format!("define shape sphere s{i} {x} {y} {z} 0.3 red\ndefine shape composite c{i} s{i}")
+            }
+            "render" => format!("render eye img{i}.png 8 6"),
+            "ambient" => "ambient 0.1 0.1 0.1".to_string(),
+            "motion" => format!(
+                "motion s0 {} translate {} 0 0",
+                i as f64 / n as f64,
+                i as f64 / n as f64
+            ),
+            other => panic!("no statement kind {other}"),
+        };
+        if i == 0 && kind == "motion" {
+            text.push_str("define shape sphere s0 0 0 -5 1 red\n");
+        }
+        text.push_str(&line);
+        text.push('\n');
+    }
+    text
+}
+
+/// Loading is linear in the number of statements of every kind: ten times as many statements
+/// take at most 30 times the CPU time of the loading thread (a quadratic step would take about
+/// 100 times). A measurement, as timing belongs to benchmarks:
+/// `cargo test --release --test hostile -- --ignored --nocapture scale::every_statement_kind`.
+#[test]
+#[ignore]
+fn every_statement_kind_loads_in_linear_time() {
+    let kinds = [
+        "material",
+        "sphere",
+        "box",
+        "triangle",
+        "light",
+        "camera",
+        "transform",
+        "composite",
+        "render",
+        "ambient",
+        "motion",
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let opts = anim_core::sdf::LoadOptions::default();
+    let mut slow = Vec::new();
+    for kind in kinds {
+        let mut seconds = [0.0; 2];
+        for (slot, n) in [100_000, 1_000_000].into_iter().enumerate() {
+            let path = dir.path().join(format!("{kind}-{n}.sdf"));
+            std::fs::write(&path, statements_of_kind(kind, n)).unwrap();
+            let start = cpu_time::ThreadTime::now();
+            let loaded = anim_core::load::load_file(&path, &opts);
+            seconds[slot] = start.elapsed().as_secs_f64();
+            assert!(loaded.is_ok(), "{kind} × {n} does not load");
+        }
+        let ratio = seconds[1] / seconds[0].max(1e-6);
+        println!(
+            "{kind:>10}: 10^5 in {:.3} CPU-s, 10^6 in {:.3} CPU-s: ×{ratio:.1}",
+            seconds[0], seconds[1]
+        );
+        if ratio > 30.0 {
+            slow.push(format!("{kind}: ×{ratio:.1}"));
+        }
+    }
+    assert!(slow.is_empty(), "not linear: {slow:?}");
+}
