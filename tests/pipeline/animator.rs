@@ -551,3 +551,24 @@ fn an_object_whose_forward_is_its_up_is_refused_before_any_frame() {
     );
     assert!(!dir.path().join("f").exists());
 }
+
+#[test]
+fn an_aimed_camera_may_only_be_moved_by_other_tracks() {
+    let spec = "(scene: File(\"base.sdf\"), length: Frames(2), resolution: (16, 9),
+  tracks: [
+    (target: \"cam\", look_at: Object(\"ball\")),
+    (target: \"cam\", scale: [(at: 0, value: 2)]),
+    (target: \"cam\", look_at: Point((0, 0, 0))),
+  ])";
+    let dir = project(&[("base.sdf", BALL), ("cam.ron", spec)]);
+    let (ok, stderr) = generate(&dir.path().join("cam.ron"), &dir.path().join("f"));
+    assert!(!ok);
+    assert!(
+        stderr.contains("cam.ron:4:5: error: 'cam' looks at its target (`look_at` in tracks[0]): this track would turn it away"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("cam.ron:5:30: error: 'cam' has a `look_at` in an earlier track already"),
+        "{stderr}"
+    );
+}

@@ -679,10 +679,9 @@ impl Checker<'_> {
                 self.aimed_at(track, aim, name, names);
             }
             let same: Vec<&Track> = tracks.iter().filter(|t| t.target == track.target).collect();
-            if same.iter().filter(|t| t.aim.is_some()).count() > 1
-                && tracks[..i]
-                    .iter()
-                    .any(|t| t.target == track.target && t.aim.is_some())
+            if tracks[..i]
+                .iter()
+                .any(|t| t.target == track.target && t.aim.is_some())
             {
                 self.err(
                     &[&aim.path],
@@ -692,9 +691,11 @@ impl Checker<'_> {
                     ),
                 );
             }
-            let turned = same
-                .iter()
-                .find(|t| t.rotate.is_some() || t.orient.is_some());
+            // An aimed camera's eye moves by translations only: its pose is set outright.
+            let camera = track.kind == TargetKind::Camera;
+            let turned = same.iter().find(|t| {
+                t.rotate.is_some() || t.orient.is_some() || (camera && t.scale.is_some())
+            });
             if let Some(other) = turned.filter(|t| t.path != track.path) {
                 self.err(
                     &[&other.path],
