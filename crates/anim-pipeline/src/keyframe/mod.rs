@@ -25,6 +25,7 @@ use anim_core::diag::{Diagnostic, Loc};
 use anim_core::sdf::LoadOptions;
 use anim_core::util::write_atomically;
 use generate::{BaseScene, Generator};
+use rayon::prelude::*;
 use spec::{Animation, SceneSource, Source};
 use std::collections::HashSet;
 use std::io::Write as _;
@@ -157,12 +158,17 @@ fn write_frames(
     src: &Source,
     dir: &Path,
 ) -> Result<(usize, usize), Vec<Diagnostic>> {
-    // Every frame is made and checked before any is written, so an invalid spec writes
-    // nothing; then they are made again one at a time as they are written, so memory holds
-    // one frame, however long the animation.
+    // Every frame is made and checked (loaded as the renderer will) before any is written,
+    // so an invalid spec writes nothing: in parallel, as the frames are independent, and the
+    // earliest frame that fails is the one reported. Then they are made again one at a time
+    // as they are written, so memory holds one frame a thread, however long the animation;
+    // generation is deterministic, so what is written is what was checked.
     let generator = Generator::new(base, anim, src);
-    for i in 0..anim.frames {
-        checked_frame_text(&generator, anim, src, dir, i)?;
+    let first_failure = (0..anim.frames)
+        .into_par_iter()
+        .find_map_first(|i| checked_frame_text(&generator, anim, src, dir, i).err());
+    if let Some(errors) = first_failure {
+        return Err(errors);
     }
     let fail = |path: &Path, what: &str, e: std::io::Error| {
         vec![Diagnostic::file_error(path, format!("{what}: {e}"))]
@@ -187,8 +193,7 @@ fn write_frames(
         e
     };
     for i in 0..anim.frames {
-        let text =
-            checked_frame_text(&generator, anim, src, dir, i).map_err(|e| undo(&created, e))?;
+        let text = generator.frame_text(i).map_err(|e| undo(&created, e))?;
         let name = anim.output.sdf(i, anim.digits());
         let path = dir.join(&name);
         manifest.push_str(&name);
