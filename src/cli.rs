@@ -178,7 +178,7 @@ pub struct PreviewArgs {
 
 #[derive(Args, Debug, Clone)]
 pub struct BenchArgs {
-    /// Write bench.csv, bench.md and one time-vs-error-SCENE.png per scene here
+    /// Write bench.csv, bench.md, calibration.tsv and one time-vs-error-SCENE.png per scene here
     /// (stress.csv and stress.md with --stress).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,

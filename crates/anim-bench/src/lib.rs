@@ -222,6 +222,9 @@ pub struct BenchReport {
     pub rows: Vec<Row>,
     /// Things a reader must know: skipped renderers or settings, and why.
     pub notes: Vec<String>,
+    /// Per scene and adaptive setting: the per-pixel error estimate against the error
+    /// measured against the reference (`calibration.tsv`).
+    pub calibration: Vec<(String, String, Vec<metrics::CalibrationBin>)>,
 }
 
 /// A bench scene: its name, file, bytes (for the cache key) and first render job.
@@ -302,6 +305,8 @@ pub fn cache_key(parts: &[&[u8]]) -> u64 {
 pub struct Timed {
     pub rgb: Vec<u8>,
     pub hdr: render::HdrImage,
+    /// Adaptive sampling's per-pixel error estimates (`Rendered::error_estimates`).
+    pub error_estimates: Vec<f32>,
     pub rays: RayCounts,
     pub dropped: usize,
     pub cpu_s: f64,
@@ -324,6 +329,7 @@ pub fn render_measured(job: &RenderJob, settings: &RenderSettings) -> Result<Tim
     Ok(Timed {
         rgb: film::to_rgb8(&r.image),
         hdr: r.image,
+        error_estimates: r.error_estimates,
         rays: r.rays,
         dropped: r.dropped.len(),
         cpu_s,
@@ -420,6 +426,7 @@ pub fn run(config: &BenchConfig, progress: &mut dyn FnMut(&str)) -> Result<Bench
         scenes: Vec::new(),
         rows: Vec::new(),
         notes,
+        calibration: Vec::new(),
     };
     for scene in &scenes {
         let (reference, anim_ref) = anim_reference(scene, config, progress)?;
@@ -446,6 +453,18 @@ pub fn run(config: &BenchConfig, progress: &mut dyn FnMut(&str)) -> Result<Bench
                 error: metrics::compare_rgb8(&t.rgb, &reference),
             };
             progress(&row_line(&row));
+            if !t.error_estimates.is_empty() {
+                let bins = metrics::calibration(&t.rgb, &reference, &t.error_estimates);
+                progress(&format!(
+                    "{}: {} estimated against measured error per pixel: {}",
+                    scene.name,
+                    setting.label(),
+                    metrics::calibration_line(&bins)
+                ));
+                report
+                    .calibration
+                    .push((scene.name.clone(), setting.label(), bins));
+            }
             report.rows.push(row);
         }
         if let Some(tools) = &pov_tools {

@@ -89,3 +89,106 @@ mod tests {
         assert!((psnr(1.0) - 48.1308).abs() < 1e-3);
     }
 }
+
+/// Pixels of one range of adaptive sampling's error estimate, with the error measured there.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CalibrationBin {
+    /// The range of estimates, in 8-bit levels (`None`: pixels that kept their centre sample,
+    /// for which nothing was estimated).
+    pub estimate: Option<(f32, f32)>,
+    pub pixels: usize,
+    /// Mean estimate of the bin's pixels (NaN for the unestimated).
+    pub mean_estimate: f64,
+    /// Root-mean-square of the measured per-pixel error against the reference, in levels.
+    pub measured_rms: f64,
+}
+
+/// Upper ends of the estimate ranges (levels); the last range is open.
+const CALIBRATION_EDGES: [f32; 6] = [0.5, 1.0, 2.0, 4.0, 8.0, f32::INFINITY];
+
+/// How well the per-pixel error estimate predicts the error measured against the reference:
+/// pixels binned by estimate, each bin with its mean estimate and measured RMS error (a pixel's
+/// error is the RMS over its three channels). Bins without pixels are left out.
+pub fn calibration(image: &[u8], reference: &[u8], estimates: &[f32]) -> Vec<CalibrationBin> {
+    assert_eq!(image.len(), reference.len());
+    assert_eq!(image.len(), estimates.len() * 3);
+    // (pixels, sum of estimates, sum of squared errors) per bin; bin 0: not estimated.
+    let mut sums = [(0usize, 0.0f64, 0.0f64); CALIBRATION_EDGES.len() + 1];
+    let pixels = image.chunks_exact(3).zip(reference.chunks_exact(3));
+    for ((p, q), &e) in pixels.zip(estimates) {
+        let sq: f64 = p
+            .iter()
+            .zip(q)
+            .map(|(&a, &b)| f64::from(a.abs_diff(b)).powi(2))
+            .sum::<f64>()
+            / 3.0;
+        let bin = if e.is_nan() {
+            0
+        } else {
+            1 + CALIBRATION_EDGES
+                .iter()
+                .position(|&hi| e < hi)
+                .unwrap_or(CALIBRATION_EDGES.len() - 1)
+        };
+        let s = &mut sums[bin];
+        s.0 += 1;
+        s.1 += if e.is_finite() { f64::from(e) } else { 0.0 };
+        s.2 += sq;
+    }
+    sums.iter()
+        .enumerate()
+        .filter(|(_, s)| s.0 > 0)
+        .map(|(bin, &(n, est, sq))| CalibrationBin {
+            estimate: (bin > 0).then(|| {
+                let lo = if bin == 1 {
+                    0.0
+                } else {
+                    CALIBRATION_EDGES[bin - 2]
+                };
+                (lo, CALIBRATION_EDGES[bin - 1])
+            }),
+            pixels: n,
+            mean_estimate: if bin == 0 { f64::NAN } else { est / n as f64 },
+            measured_rms: (sq / n as f64).sqrt(),
+        })
+        .collect()
+}
+
+/// The calibration as one line: `kept n: rms; est lo–hi n: mean → rms; …`.
+pub fn calibration_line(bins: &[CalibrationBin]) -> String {
+    bins.iter()
+        .map(|b| match b.estimate {
+            None => format!(
+                "kept centre ({} px): measured {:.2}",
+                b.pixels, b.measured_rms
+            ),
+            Some((lo, hi)) => format!(
+                "est {lo}–{hi} ({} px, mean {:.2}): measured {:.2}",
+                b.pixels, b.mean_estimate, b.measured_rms
+            ),
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+#[cfg(test)]
+mod calibration_tests {
+    use super::*;
+
+    #[test]
+    fn pixels_fall_in_the_bins_of_their_estimates() {
+        // Three pixels: kept (off by 3 in every channel), estimated 0.7 (off by 0), estimated
+        // 5 (off by 6 in one channel: RMS over channels √(36/3) = √12).
+        let image = [3, 3, 3, 10, 10, 10, 6, 0, 0];
+        let reference = [0, 0, 0, 10, 10, 10, 0, 0, 0];
+        let bins = calibration(&image, &reference, &[f32::NAN, 0.7, 5.0]);
+        assert_eq!(bins.len(), 3);
+        assert_eq!((bins[0].estimate, bins[0].pixels), (None, 1));
+        assert!((bins[0].measured_rms - 3.0).abs() < 1e-12);
+        assert_eq!(bins[1].estimate, Some((0.5, 1.0)));
+        assert_eq!(bins[1].measured_rms, 0.0);
+        assert_eq!(bins[2].estimate, Some((4.0, 8.0)));
+        assert!((bins[2].measured_rms - 12f64.sqrt()).abs() < 1e-12);
+        assert!((bins[2].mean_estimate - 5.0).abs() < 1e-12);
+    }
+}

@@ -113,11 +113,34 @@ pub fn markdown(report: &BenchReport) -> String {
     out
 }
 
-/// Writes `bench.csv`, `bench.md` and `time-vs-error-<scene>.png` into `dir`; returns the
-/// files written.
+/// The per-pixel error estimate against the measured error, one line a bin: scene, setting,
+/// the estimate's range (`kept`: not estimated), pixels, mean estimate, measured RMS.
+fn calibration_tsv(report: &BenchReport) -> String {
+    let mut out = String::from("scene\tsetting\testimate\tpixels\tmean_estimate\tmeasured_rms\n");
+    for (scene, setting, bins) in &report.calibration {
+        for b in bins {
+            let range = b
+                .estimate
+                .map_or("kept".to_string(), |(lo, hi)| format!("{lo}-{hi}"));
+            out.push_str(&format!(
+                "{scene}\t{setting}\t{range}\t{}\t{:.3}\t{:.3}\n",
+                b.pixels, b.mean_estimate, b.measured_rms
+            ));
+        }
+    }
+    out
+}
+
+/// Writes `bench.csv`, `bench.md`, `calibration.tsv` and `time-vs-error-<scene>.png` into
+/// `dir`; returns the files written.
 pub fn write_outputs(report: &BenchReport, dir: &Path) -> Result<Vec<PathBuf>, String> {
     let mut written = Vec::new();
-    for (name, text) in [("bench.csv", csv(report)), ("bench.md", markdown(report))] {
+    let outputs = [
+        ("bench.csv", csv(report)),
+        ("bench.md", markdown(report)),
+        ("calibration.tsv", calibration_tsv(report)),
+    ];
+    for (name, text) in outputs {
         let path = dir.join(name);
         write_text(&path, &text)?;
         written.push(path);

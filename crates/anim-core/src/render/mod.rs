@@ -87,6 +87,12 @@ pub struct Rendered {
     pub mean_spp: f64,
     /// Shapes that became degenerate once transformed (in f32) and were left out.
     pub dropped: Vec<Dropped>,
+    /// Adaptive sampling's estimate of each pixel's error, in 8-bit levels of its tone-mapped
+    /// mean, where the pixel stopped taking samples (row-major): NaN for a pixel that kept
+    /// its centre sample (nothing estimated), infinite for one stopped by `max_spp` before
+    /// an estimate. A pixel that motion's third pass resumed keeps its second-pass estimate.
+    /// Empty for uniform sampling. `anim bench` sets it against the measured error.
+    pub error_estimates: Vec<f32>,
 }
 
 /// A job made ready to render: its scene and camera moved (in f64) so that the eye sits at
@@ -196,16 +202,18 @@ pub fn render_prepared(
         integrator: &integrator,
         size: (width as usize, height as usize),
     };
-    let (pixels, counts) = sampler::render(&frame, sampling, on_pixels);
+    let sampled = sampler::render(&frame, sampling, on_pixels);
+    let counts = sampled.rays;
     Ok(Rendered {
         image: HdrImage {
             width,
             height,
-            pixels,
+            pixels: sampled.pixels,
         },
         mean_spp: counts.primary as f64 / (width as f64 * height as f64),
         rays: counts,
         dropped: prepared.dropped.clone(),
+        error_estimates: sampled.error_estimates,
     })
 }
 

@@ -28,11 +28,14 @@
 
 use super::first_pass::{around, FirstPass};
 use super::pattern::{self, tone3, Moments, PixelPattern, MOTION_MIN_SAMPLES};
-use super::Frame;
+use super::{Frame, Sampled};
 use crate::render::integrator::{PixelPrior, TraceState};
 use crate::render::RayCounts;
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
+
+/// Pass 2's result: pixels, samples taken, error estimates, rays.
+type Refined = (Vec<Vec3>, Vec<u8>, Vec<f32>, RayCounts);
 
 /// Adaptive sampling of one frame.
 pub(super) struct Adaptive<'f> {
@@ -46,14 +49,18 @@ pub(super) struct Adaptive<'f> {
 impl Adaptive<'_> {
     /// The frame's pixels and the rays traced; `on_pixels(n)` is called as each row of `n`
     /// pixels is refined.
-    pub fn render(&self, on_pixels: &(dyn Fn(u64) + Sync)) -> (Vec<Vec3>, RayCounts) {
+    pub fn render(&self, on_pixels: &(dyn Fn(u64) + Sync)) -> Sampled {
         let (first, mut counts) = FirstPass::trace(self.frame);
-        let (mut pixels, taken, refined) = self.refine(&first, on_pixels);
+        let (mut pixels, taken, estimates, refined) = self.refine(&first, on_pixels);
         counts += refined;
         if self.frame.shutter.is_some() && self.max_spp > 1 {
             counts += self.recheck_motion(&first, &mut pixels, &taken);
         }
-        (pixels, counts)
+        Sampled {
+            pixels,
+            rays: counts,
+            error_estimates: estimates,
+        }
     }
 
     /// Sample `i` of pixel (x, y)'s own pattern: its radiance.
@@ -76,41 +83,42 @@ impl Adaptive<'_> {
     }
 
     /// Pass 2: every pixel, its centre kept or refined. Per pixel also the samples it took,
-    /// up to 255 (0: it kept its centre), for pass 3.
-    fn refine(
-        &self,
-        first: &FirstPass,
-        on_pixels: &(dyn Fn(u64) + Sync),
-    ) -> (Vec<Vec3>, Vec<u8>, RayCounts) {
+    /// up to 255 (0: it kept its centre), for pass 3, and the estimate of its error where it
+    /// stopped (NaN: it kept its centre, and nothing was estimated).
+    fn refine(&self, first: &FirstPass, on_pixels: &(dyn Fn(u64) + Sync)) -> Refined {
         let (w, h) = self.frame.size;
         let mut pixels = vec![Vec3::ZERO; w * h];
         let mut taken = vec![0u8; w * h];
+        let mut estimates = vec![f32::NAN; w * h];
         let counts = pixels
             .par_chunks_mut(w)
             .zip(taken.par_chunks_mut(w))
+            .zip(estimates.par_chunks_mut(w))
             .enumerate()
-            .map(|(y, (row, taken_row))| {
+            .map(|(y, ((row, taken_row), estimate_row))| {
                 let mut st = TraceState::refining();
-                for (x, (out, taken)) in row.iter_mut().zip(taken_row).enumerate() {
-                    (*out, *taken) = self.refine_pixel(first, (x, y), &mut st);
+                let cells = row.iter_mut().zip(taken_row).zip(estimate_row);
+                for (x, ((out, taken), estimate)) in cells.enumerate() {
+                    (*out, *taken, *estimate) = self.refine_pixel(first, (x, y), &mut st);
                 }
                 on_pixels(row.len() as u64);
                 st.counts
             })
             .reduce(RayCounts::default, RayCounts::sum);
-        (pixels, taken, counts)
+        (pixels, taken, estimates, counts)
     }
 
-    /// Pixel (x, y) after pass 2, and the samples it took (0: it kept its centre).
+    /// Pixel (x, y) after pass 2, the samples it took (0: it kept its centre) and the
+    /// estimate of its error where it stopped (NaN when it kept its centre).
     fn refine_pixel(
         &self,
         first: &FirstPass,
         (x, y): (usize, usize),
         st: &mut TraceState,
-    ) -> (Vec3, u8) {
+    ) -> (Vec3, u8, f32) {
         let (w, max_spp) = (self.frame.size.0, self.max_spp);
         let Some((contrast, moving)) = first.refinement(x, y).filter(|_| max_spp > 1) else {
-            return (Vec3::from(first.centres[y * w + x].0), 0);
+            return (Vec3::from(first.centres[y * w + x].0), 0, f32::NAN);
         };
         let mut at_least = pattern::min_samples(contrast, self.error, max_spp);
         if moving {
@@ -127,7 +135,8 @@ impl Adaptive<'_> {
             }
         }
         st.counts.primary += m.n as u64;
-        (Vec3::from(m.mean()), m.n.min(u8::MAX as u32) as u8)
+        let taken = m.n.min(u8::MAX as u32) as u8;
+        (Vec3::from(m.mean()), taken, m.error())
     }
 
     /// Pass 3, in a frame with motion. A pixel that motion touches and whose samples all

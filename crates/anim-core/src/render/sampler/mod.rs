@@ -33,15 +33,32 @@ pub(super) struct Frame<'a> {
     pub size: (usize, usize),
 }
 
-/// The pixels of `frame` (linear radiance, row-major from the top) sampled as `sampling`
-/// says, and the rays traced; `on_pixels(n)` is called as each band of `n` pixels finishes.
+/// What a sampler made of a frame.
+pub(super) struct Sampled {
+    /// Linear radiance, row-major from the top.
+    pub pixels: Vec<Vec3>,
+    pub rays: RayCounts,
+    /// Adaptive sampling's estimate of each pixel's error (see `Rendered::error_estimates`);
+    /// empty for uniform sampling.
+    pub error_estimates: Vec<f32>,
+}
+
+/// The pixels of `frame` sampled as `sampling` says, and the rays traced; `on_pixels(n)` is
+/// called as each band of `n` pixels finishes.
 pub(super) fn render(
     frame: &Frame,
     sampling: Sampling,
     on_pixels: &(dyn Fn(u64) + Sync),
-) -> (Vec<Vec3>, RayCounts) {
+) -> Sampled {
     match sampling {
-        Sampling::Uniform(spp) => uniform::render(frame, spp, on_pixels),
+        Sampling::Uniform(spp) => {
+            let (pixels, rays) = uniform::render(frame, spp, on_pixels);
+            Sampled {
+                pixels,
+                rays,
+                error_estimates: Vec::new(),
+            }
+        }
         Sampling::Adaptive { error, max_spp } => adaptive::Adaptive {
             frame,
             error,
