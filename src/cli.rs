@@ -149,6 +149,10 @@ pub struct GenerateArgs {
     /// that render what the spec generated, wherever its `frames_dir` puts it.
     #[arg(long)]
     pub print_dir: bool,
+    /// Write each frame file whole, as a scene of its own, rather than including the part of
+    /// the scene that no frame changes from static.sdfi in the frame directory.
+    #[arg(long)]
+    pub standalone: bool,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -405,6 +409,7 @@ impl GenerateArgs {
         GenerateConfig {
             spec: self.spec.clone(),
             out: self.out.clone(),
+            standalone: self.standalone,
         }
     }
 }
@@ -455,8 +460,10 @@ impl SceneArgs {
             infer_transform_order: self.transform_order == TransformOrderArg::Auto,
             max_input: self.max_input,
             max_memory: self.max_memory(),
-            // One cache for the whole command: every frame it renders shares the meshes.
+            // One cache of each for the whole command: every frame it renders shares the
+            // meshes and the included files.
             meshes: MeshCache::default(),
+            includes: Default::default(),
         }
     }
 

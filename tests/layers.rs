@@ -41,7 +41,7 @@ const CRATES: &[(&str, &[&[&str]])] = &[
             &["shape"],
             &["accel"],
             &["math"],
-            &["limits"],
+            &["limits", "input"],
             &["diag", "util"],
         ],
     ),

@@ -16,5 +16,6 @@ mod common;
 
 mod corpus;
 mod diagnostics;
+mod include;
 mod intent;
 mod intent_forms;

@@ -44,12 +44,17 @@ fn manifest_lines(label: &str, scene: &Path) -> String {
     let name = scene.file_name().unwrap();
     let copy = dir.join(name);
     std::fs::copy(scene, &copy).unwrap();
-    // Meshes a scene reads (`define shape obj`) sit beside it.
+    // Meshes a scene reads (`define shape obj`) and the static part a generated frame
+    // includes sit beside it.
     for entry in std::fs::read_dir(scene.parent().unwrap())
         .unwrap()
         .flatten()
     {
-        if entry.path().extension().is_some_and(|e| e == "obj") {
+        if entry
+            .path()
+            .extension()
+            .is_some_and(|e| e == "obj" || e == "sdfi")
+        {
             std::fs::copy(entry.path(), dir.join(entry.file_name())).unwrap();
         }
     }

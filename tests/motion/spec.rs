@@ -28,9 +28,10 @@ fn frames_hash(dir: &Path) -> (usize, u64) {
     (names.len(), h.finish())
 }
 
+/// `anim generate SPEC -o OUT --standalone`: whole frame files, which the tests read.
 fn generate(spec: &Path, out: &Path) -> std::process::Output {
     anim()
-        .arg("generate")
+        .args(["generate", "--standalone"])
         .arg(spec)
         .arg("-o")
         .arg(out)

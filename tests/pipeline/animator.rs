@@ -14,10 +14,11 @@ fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// Runs `anim generate SPEC -o OUT`; (success, stderr).
+/// Runs `anim generate SPEC -o OUT --standalone` (whole frame files, which the tests read);
+/// (success, stderr).
 fn generate(spec: &Path, out: &Path) -> (bool, String) {
     let run = common::anim()
-        .args(["generate"])
+        .args(["generate", "--standalone"])
         .arg(spec)
         .arg("-o")
         .arg(out)
@@ -330,6 +331,7 @@ define camera cam 60 0 0 10 0 0 -1 0 1 0
     let config = anim_pipeline::keyframe::GenerateConfig {
         spec: dir.path().join("spec.ron"),
         out: Some(out.clone()),
+        standalone: false,
     };
     anim_pipeline::keyframe::run_generate_reporting(&config, |warnings| {
         let written = std::fs::read_dir(&out).map_or(0, |d| d.count());

@@ -609,6 +609,7 @@ fn frames_keep_the_materials_of_a_base_scene_in_another_layout() {
     let config = anim_pipeline::keyframe::GenerateConfig {
         spec: dir.path().join("spec.ron"),
         out: Some(dir.path().join("frames")),
+        standalone: false,
     };
     anim_pipeline::keyframe::run_generate(&config).unwrap_or_else(|e| panic!("{e:?}"));
     let frame = dir.path().join("frames/frame_0000.sdf");

@@ -20,3 +20,4 @@ mod bench;
 mod frames;
 mod holds;
 mod keyframe_spec;
+mod split;

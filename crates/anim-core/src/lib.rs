@@ -11,6 +11,7 @@
 
 pub mod accel;
 pub mod diag;
+pub mod input;
 pub mod limits;
 pub mod load;
 pub mod math;

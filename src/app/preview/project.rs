@@ -93,6 +93,7 @@ impl Project {
         let report = run_generate(&GenerateConfig {
             spec: self.input.clone(),
             out: Some(self.frames_dir.clone()),
+            standalone: false,
         })
         .map_err(text)?;
         let paths = list_frames(&report.dir)

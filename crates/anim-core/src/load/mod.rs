@@ -4,6 +4,8 @@
 //! diagnostic capped and quoted.
 
 pub mod probe;
+
+pub use crate::input::read_input;
 #[cfg(test)]
 mod scale_tests;
 #[cfg(test)]
@@ -16,11 +18,7 @@ use crate::sdf::ast::{Statement, StatementKind};
 use crate::sdf::{self, finish_diagnostics, LoadOptions, TransformOrder};
 use std::borrow::Cow;
 use std::collections::HashMap;
-use std::io::Read;
-use std::path::Path;
-
-/// How much of the start of a file is looked at for NUL bytes, which text never holds.
-const TEXT_SNIFF_BYTES: usize = 8 << 10;
+use std::path::{Path, PathBuf};
 
 /// A successfully loaded file: its images to render and the warnings met on the way.
 #[derive(Clone, Debug)]
@@ -60,69 +58,6 @@ pub fn load_file(path: &Path, opts: &LoadOptions) -> Result<Loaded, Vec<Diagnost
     finish_load(parsed, path, opts, again)
 }
 
-/// Reads a whole text file of at most `limit` bytes. Larger files are refused from their
-/// size when the file system knows it, else after reading `limit + 1` bytes (pipes, devices),
-/// so memory never grows past the limit. A file with a NUL byte in its first
-/// `TEXT_SNIFF_BYTES` is "not a text file", found before the rest is read (`/dev/zero`
-/// fails at once). `what` names the file in messages ("file", "the spec").
-pub fn read_input(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Vec<Diagnostic>> {
-    read_bounded(path, limit, what).map_err(|d| vec![*d])
-}
-
-fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, Box<Diagnostic>> {
-    let cannot =
-        |e: std::io::Error| Diagnostic::file_error(path, format!("cannot read {what}: {e}"));
-    let too_big = |size: String| Box::new(Diagnostic::too_large(path, &size, limit));
-    let file = open_without_waiting(path).map_err(cannot)?;
-    let meta = file.metadata().map_err(cannot)?;
-    // Regular files tell their length; devices and pipes say 0 and are bounded by `take`.
-    if meta.is_file() && meta.len() > limit {
-        return Err(too_big(format!("{} bytes", meta.len())));
-    }
-    let expected = if meta.is_file() { meta.len() } else { 0 };
-    let mut bytes = Vec::with_capacity(usize::try_from(expected.min(limit)).unwrap_or(0));
-    let mut input = file.take(limit.saturating_add(1));
-    (&mut input)
-        .take(TEXT_SNIFF_BYTES as u64)
-        .read_to_end(&mut bytes)
-        .map_err(cannot)?;
-    if bytes.contains(&0) {
-        return Err(Box::new(Diagnostic::file_error(
-            path,
-            "not a text file (it holds NUL bytes)",
-        )));
-    }
-    input.read_to_end(&mut bytes).map_err(cannot)?;
-    if bytes.len() as u64 > limit {
-        return Err(too_big("it goes on past the limit".to_string()));
-    }
-    Ok(bytes)
-}
-
-/// How long opening a named pipe may wait for a program to write to it.
-const PIPE_WAIT: std::time::Duration = std::time::Duration::from_millis(500);
-
-/// Opens `path` for reading. Opening a named pipe waits until something opens it for
-/// writing, which may be never: a pipe is opened on a thread of its own, and given up (the
-/// thread left waiting) when no writer comes within `PIPE_WAIT`. `/dev/stdin` fed by a
-/// pipe has its writer already.
-fn open_without_waiting(path: &Path) -> std::io::Result<std::fs::File> {
-    use std::os::unix::fs::FileTypeExt;
-    if !std::fs::metadata(path)?.file_type().is_fifo() {
-        return std::fs::File::open(path);
-    }
-    let (sender, opened) = std::sync::mpsc::channel();
-    let pipe = path.to_path_buf();
-    std::thread::spawn(move || {
-        let _ = sender.send(std::fs::File::open(pipe));
-    });
-    opened.recv_timeout(PIPE_WAIT).unwrap_or_else(|_| {
-        Err(std::io::Error::other(
-            "it is a named pipe that nothing writes to",
-        ))
-    })
-}
-
 /// Builds the render jobs of a statement list (from [`sdf::parse`], or made by a program, whose
 /// values are then checked here). `Err` holds every diagnostic when at least one is an error.
 pub fn build(
@@ -131,7 +66,13 @@ pub fn build(
     opts: &LoadOptions,
 ) -> Result<Loaded, Vec<Diagnostic>> {
     let (jobs, diagnostics) = build_jobs(statements, Default::default(), path, opts, None);
-    conclude(jobs, finish_diagnostics(diagnostics, opts), path, || None)
+    conclude(
+        jobs,
+        finish_diagnostics(diagnostics, opts),
+        path,
+        opts.max_input,
+        || None,
+    )
 }
 
 /// Parses and builds a file's text. `Err` holds every diagnostic (warnings too) when at least
@@ -192,7 +133,13 @@ fn finish_load<'t>(
         Some(t) => t,
         None => text.and_then(|read| read()),
     };
-    conclude(jobs, finish_diagnostics(diagnostics, opts), path, text)
+    conclude(
+        jobs,
+        finish_diagnostics(diagnostics, opts),
+        path,
+        opts.max_input,
+        text,
+    )
 }
 
 /// Whether the transform order of the file is worth trying the other way
@@ -306,38 +253,69 @@ fn conclude<'t>(
     jobs: Vec<RenderJob>,
     diagnostics: Vec<Diagnostic>,
     path: &Path,
+    max_input: u64,
     text: impl FnOnce() -> Option<Cow<'t, str>>,
 ) -> Result<Loaded, Vec<Diagnostic>> {
     let failed = diagnostics.iter().any(Diagnostic::is_error);
     let mut diagnostics = cap(diagnostics, path);
-    let mut wanted: Vec<u32> = diagnostics
+    quote_lines(&mut diagnostics, path, text);
+    // Lines of the files a scene includes are quoted from those files.
+    let mut others: Vec<&Path> = diagnostics
         .iter()
         .filter(|d| d.source_line.is_none())
-        .filter_map(|d| d.loc.as_ref().map(|l| l.line))
+        .filter_map(|d| d.loc.as_ref().map(|l| &*l.file))
+        .filter(|&f| f != path)
         .collect();
-    wanted.sort_unstable();
-    wanted.dedup();
-    if let Some(text) = (!wanted.is_empty()).then(text).flatten() {
-        let mut lines: HashMap<u32, &str> = HashMap::with_capacity(wanted.len());
-        let mut next = wanted.iter().peekable();
-        for (i, raw) in sdf::raw_lines(&text).enumerate() {
-            let Some(&&want) = next.peek() else { break };
-            if u32::try_from(i + 1) == Ok(want) {
-                lines.insert(want, raw);
-                next.next();
-            }
-        }
-        for d in &mut diagnostics {
-            let line = d.loc.as_ref().and_then(|l| lines.get(&l.line));
-            if let (None, Some(line)) = (&d.source_line, line) {
-                d.quote(line);
-            }
-        }
+    others.sort_unstable();
+    others.dedup();
+    let others: Vec<PathBuf> = others.into_iter().map(Path::to_path_buf).collect();
+    for file in others {
+        quote_lines(&mut diagnostics, &file, || {
+            read_input(&file, max_input, "file")
+                .ok()
+                .map(|b| Cow::Owned(String::from_utf8_lossy(&b).into_owned()))
+        });
     }
     if failed {
         Err(diagnostics)
     } else {
         Ok(Loaded { jobs, diagnostics })
+    }
+}
+
+/// Quotes its source line in each diagnostic located in `path` that has none, from `text`
+/// (asked for only when some diagnostic needs it).
+fn quote_lines<'t>(
+    diagnostics: &mut [Diagnostic],
+    path: &Path,
+    text: impl FnOnce() -> Option<Cow<'t, str>>,
+) {
+    let in_file = |d: &Diagnostic| {
+        d.source_line.is_none() && d.loc.as_ref().is_some_and(|l| &*l.file == path)
+    };
+    let mut wanted: Vec<u32> = diagnostics
+        .iter()
+        .filter(|d| in_file(d))
+        .filter_map(|d| d.loc.as_ref().map(|l| l.line))
+        .collect();
+    wanted.sort_unstable();
+    wanted.dedup();
+    let Some(text) = (!wanted.is_empty()).then(text).flatten() else {
+        return;
+    };
+    let mut lines: HashMap<u32, &str> = HashMap::with_capacity(wanted.len());
+    let mut next = wanted.iter().peekable();
+    for (i, raw) in sdf::raw_lines(&text).enumerate() {
+        let Some(&&want) = next.peek() else { break };
+        if u32::try_from(i + 1) == Ok(want) {
+            lines.insert(want, raw);
+            next.next();
+        }
+    }
+    for d in diagnostics.iter_mut().filter(|d| in_file(d)) {
+        if let Some(line) = d.loc.as_ref().and_then(|l| lines.get(&l.line)) {
+            d.quote(line);
+        }
     }
 }
 

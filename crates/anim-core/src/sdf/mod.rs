@@ -11,12 +11,11 @@ mod parse;
 pub mod repair;
 
 pub use lexer::{image_names, raw_lines, scene_key, ImageName};
-pub use parse::{default_output, Omissions, Parsed};
+pub use parse::{default_output, included_files, IncludeCache, Omissions, Parsed};
 
-use crate::diag::{Diagnostic, Loc, Severity};
+use crate::diag::{Diagnostic, Severity};
 use crate::shape::MeshCache;
 use std::path::Path;
-use std::sync::Arc;
 
 /// Meaning of the numbers after `m` in a material line (`--material-fields`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -107,6 +106,9 @@ pub struct LoadOptions {
     /// Meshes already read, shared by every clone of these options: the frames of one
     /// `anim render DIR` read each OBJ file once (`MeshCache`).
     pub meshes: MeshCache,
+    /// Included files already read, shared like `meshes`: the frames of one
+    /// `anim render DIR` read and parse the part of the scene they share once.
+    pub includes: IncludeCache,
 }
 
 impl Default for LoadOptions {
@@ -121,6 +123,7 @@ impl Default for LoadOptions {
             max_input: crate::limits::DEFAULT_MAX_INPUT,
             max_memory: crate::limits::default_memory_budget(),
             meshes: MeshCache::default(),
+            includes: IncludeCache::default(),
         }
     }
 }
@@ -153,25 +156,8 @@ pub fn parse_source_whole(text: &str, path: &Path, opts: &LoadOptions) -> Parsed
 }
 
 fn read(text: &str, path: &Path, opts: &LoadOptions, flat: bool) -> Parsed {
-    let mut parsed = parse::parse(text, path, opts, flat);
-    // The lexer keeps only the first tokens of an overlong line; the line is refused here so
-    // that a truncated statement is never taken for what was written.
-    let file: Arc<Path> = Arc::from(path);
-    for (line, count) in std::mem::take(&mut parsed.overlong) {
-        parsed.diagnostics.push(Diagnostic::new(
-            Severity::Error,
-            Loc {
-                file: file.clone(),
-                line,
-                col: 1,
-            },
-            format!(
-                "line holds {count} tokens, more than the {} a line may hold",
-                crate::limits::MAX_TOKENS_PER_LINE
-            ),
-        ));
-    }
-    parsed
+    let chain = parse::Chain::outermost(path, text);
+    parse::parse(text, path, opts, flat, chain)
 }
 
 /// Orders diagnostics by position (file-wide ones last) and applies `--strict`.

@@ -39,13 +39,39 @@ pub fn settings_fingerprint(settings: &RenderSettings, load: &LoadOptions) -> St
     )
 }
 
-pub(super) fn frame_hash(sdf: &[u8], fingerprint: &str) -> u64 {
+/// The hash a frame's record holds: of the settings, the frame's bytes (`sdf`, read from
+/// `path`) and the bytes of every file it includes (`include`), so that a change to the static
+/// part of an animation renders its frames again.
+pub(super) fn frame_hash(sdf: &[u8], path: &Path, fingerprint: &str, max_input: u64) -> u64 {
     let mut h = Fnv64::default();
     h.write(fingerprint.as_bytes());
     // A separator that cannot occur in the fingerprint keeps the two parts apart.
     h.write(&[0]);
     h.write(sdf);
+    hash_included(
+        &mut h,
+        sdf,
+        path,
+        max_input,
+        anim_core::limits::MAX_INCLUDE_DEPTH,
+    );
     h.finish()
+}
+
+/// Adds the files `sdf` includes to `h`, each with its name and length, and what they include,
+/// `depth` files deep at most (deeper, the loader refuses the frame anyway). A file that
+/// cannot be read adds its name alone: the frame then fails to load and is never vouched for.
+fn hash_included(h: &mut Fnv64, sdf: &[u8], path: &Path, max_input: u64, depth: usize) {
+    let Some(depth) = depth.checked_sub(1) else {
+        return;
+    };
+    for file in anim_core::sdf::included_files(&String::from_utf8_lossy(sdf), path) {
+        h.write_part(file.as_os_str().as_encoded_bytes());
+        if let Ok(bytes) = anim_core::load::read_input(&file, max_input, "file") {
+            h.write_part(&bytes);
+            hash_included(h, &bytes, &file, max_input, depth);
+        }
+    }
 }
 
 /// Removes the records of frames whose `.sdf` file is gone from `frames_dir` (an animation
@@ -203,15 +229,26 @@ mod tests {
             .into_iter()
             .map(|s| (s, load.clone()))
             .chain(load_variants(&load).into_iter().map(|l| (base.clone(), l)));
-        let key =
-            |s: &RenderSettings, l: &LoadOptions| frame_hash(b"x", &settings_fingerprint(s, l));
+        let key = |s: &RenderSettings, l: &LoadOptions| {
+            frame_hash(
+                b"x",
+                Path::new("x.sdf"),
+                &settings_fingerprint(s, l),
+                u64::MAX,
+            )
+        };
         let unchanged = key(&base, &load);
         for (s, l) in variants {
             assert_ne!(key(&s, &l), unchanged, "{s:?} {l:?}");
         }
         assert_ne!(
             key(&base, &load),
-            frame_hash(b"y", &settings_fingerprint(&base, &load))
+            frame_hash(
+                b"y",
+                Path::new("y.sdf"),
+                &settings_fingerprint(&base, &load),
+                u64::MAX
+            )
         );
     }
 
@@ -295,6 +332,8 @@ mod tests {
             max_memory: _,
             // The mesh cache decides how often a mesh file is read, never what it renders.
             meshes: _,
+            // Likewise the cache of included files.
+            includes: _,
         } = load.clone();
         vec![
             LoadOptions {

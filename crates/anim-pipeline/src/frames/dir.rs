@@ -230,7 +230,7 @@ fn plan_frames(
                 continue;
             }
         };
-        let hash = frame_hash(&bytes, fingerprint);
+        let hash = frame_hash(&bytes, path, fingerprint, max_input);
         if !options.force && is_up_to_date(out_dir, &name, hash) {
             summary.skipped.push(name);
             continue;

@@ -21,6 +21,7 @@ use super::orbit::{self, Pose};
 use super::placement::Placer;
 use super::ranges;
 use super::spec::{Animation, Source, TargetKind, Track};
+use super::split::{Split, STATIC_FILE};
 use super::tidy::tidy;
 use anim_core::diag::{Diagnostic, Loc};
 use anim_core::limits;
@@ -379,7 +380,12 @@ impl<'a> Generator<'a> {
 
     /// The complete SDF text of frame `i`.
     pub fn frame_text(&self, i: usize) -> Result<String, Vec<Diagnostic>> {
-        let statements = self.frame_statements(i)?;
+        Ok(self.write_frame(i, &self.frame_statements(i)?, None))
+    }
+
+    /// The text of frame `i`, whose statements are `statements`: whole, or with `split`
+    /// its static part included from [`STATIC_FILE`] and the rest written out.
+    pub fn write_frame(&self, i: usize, statements: &[Statement], split: Option<&Split>) -> String {
         let anim = self.anim;
         let mut text = String::new();
         let _ = writeln!(
@@ -405,10 +411,30 @@ impl<'a> Generator<'a> {
             text,
             "# Edit the spec and run `anim generate` again rather than this file."
         );
+        if split.is_some() {
+            let _ = writeln!(text, "include {STATIC_FILE}");
+        }
         for s in statements {
+            if !split.is_some_and(|split| split.is_static(s)) {
+                let _ = writeln!(text, "{s}");
+            }
+        }
+        text
+    }
+
+    /// The text of [`STATIC_FILE`]: the base scene's statements that `split` finds static.
+    pub fn static_text(&self, split: &Split) -> String {
+        let mut text = format!(
+            "# The part of every frame of {} that no track changes, generated {} {}: each frame includes it.\n\
+             # Edit the spec and run `anim generate` again rather than this file.\n",
+            self.spec_name,
+            anim_core::sdf::GENERATED_FRAME_SIGNATURE,
+            env!("CARGO_PKG_VERSION")
+        );
+        for s in self.base.statements.iter().filter(|s| split.is_static(s)) {
             let _ = writeln!(text, "{s}");
         }
-        Ok(text)
+        text
     }
 }
 

@@ -19,15 +19,18 @@ pub mod placement;
 pub mod ranges;
 pub mod rotation;
 pub mod spec;
+pub mod split;
 pub mod tidy;
 
 use anim_core::diag::{Diagnostic, Loc};
+use anim_core::sdf::ast::StatementKind;
 use anim_core::sdf::LoadOptions;
 use anim_core::util::write_atomically;
 use generate::{BaseScene, Generator};
 use rayon::prelude::*;
 use spec::{Animation, SceneSource, Source};
-use std::collections::HashSet;
+use split::{Split, STATIC_FILE};
+use std::collections::{HashMap, HashSet};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -40,6 +43,9 @@ pub struct GenerateConfig {
     /// Where the frames go; default: the spec's `frames_dir`, else `frames/<spec name>`
     /// beside the spec.
     pub out: Option<PathBuf>,
+    /// Whether each frame file holds the whole scene, rather than including the part no
+    /// frame changes from [`split::STATIC_FILE`].
+    pub standalone: bool,
 }
 
 /// What `anim generate` did.
@@ -118,7 +124,7 @@ pub fn run_generate_reporting(
         )]
     })?;
     let result = rebase_mesh_files(&mut base.statements, &base_dir, &dir, &src)
-        .and_then(|()| write_frames(&base, &anim, &src, &dir));
+        .and_then(|()| write_frames(&base, &anim, &src, &dir, config.standalone));
     match result {
         Ok((written, removed)) => Ok(GenerateReport {
             dir,
@@ -150,13 +156,15 @@ fn create_dirs(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
     Ok(missing)
 }
 
-/// Checks every frame, then writes those that changed, trims frames an earlier run wrote that
-/// the animation no longer has, and records the list. Returns (written, removed).
+/// Checks every frame, then writes those that changed (and, unless `standalone`, the static
+/// part they include), trims frames an earlier run wrote that the animation no longer has,
+/// and records the list. Returns (written, removed).
 fn write_frames(
     base: &BaseScene,
     anim: &Animation,
     src: &Source,
     dir: &Path,
+    standalone: bool,
 ) -> Result<(usize, usize), Vec<Diagnostic>> {
     // Every frame is made and checked (loaded as the renderer will) before any is written,
     // so an invalid spec writes nothing: in parallel, as the frames are independent, and the
@@ -164,12 +172,18 @@ fn write_frames(
     // as they are written, so memory holds one frame a thread, however long the animation;
     // generation is deterministic, so what is written is what was checked.
     let generator = Generator::new(base, anim, src);
-    let first_failure = (0..anim.frames)
+    let groups = (!standalone).then(|| split::base_groups(&base.statements));
+    let checked: Vec<Result<HashSet<String>, Vec<Diagnostic>>> = (0..anim.frames)
         .into_par_iter()
-        .find_map_first(|i| checked_frame_text(&generator, anim, src, dir, i).err());
-    if let Some(errors) = first_failure {
-        return Err(errors);
+        .map(|i| check_frame(&generator, anim, src, dir, i, groups.as_ref()))
+        .collect();
+    let mut changed = HashSet::new();
+    for frame in checked {
+        changed.extend(frame?);
     }
+    let split = groups
+        .map(|_| Split::new(&base.statements, changed))
+        .filter(|split| !split.is_empty());
     let fail = |path: &Path, what: &str, e: std::io::Error| {
         vec![Diagnostic::file_error(path, format!("{what}: {e}"))]
     };
@@ -183,7 +197,7 @@ fn write_frames(
     })?;
     let mut written = 0;
     let mut manifest = String::new();
-    // Frames this run adds: a run that fails (a full disk) takes them away again, so that no
+    // Files this run adds: a run that fails (a full disk) takes them away again, so that no
     // frame is left that no list names.
     let mut created: Vec<PathBuf> = Vec::new();
     let undo = |created: &[PathBuf], e: Vec<Diagnostic>| {
@@ -192,31 +206,45 @@ fn write_frames(
         }
         e
     };
-    for i in 0..anim.frames {
-        let text = generator.frame_text(i).map_err(|e| undo(&created, e))?;
-        let name = anim.output.sdf(i, anim.digits());
-        let path = dir.join(&name);
-        manifest.push_str(&name);
+    // Writes one file unless it holds `text` already; whether it was written.
+    let mut put = |name: &str, text: &str, created: &mut Vec<PathBuf>| {
+        let path = dir.join(name);
+        manifest.push_str(name);
         manifest.push('\n');
-        // Unchanged frames are left alone, so their files keep their identity for tools
-        // that look at modification times.
+        // Unchanged files are left alone, so they keep their identity for tools that look
+        // at modification times.
         let before = std::fs::read(&path).ok();
         if before.as_deref() == Some(text.as_bytes()) {
-            continue;
+            return Ok(false);
         }
         write_atomically(&path, |w| w.write_all(text.as_bytes()))
-            .map_err(|e| undo(&created, fail(&path, "cannot write the frame", e)))?;
+            .map_err(|e| undo(created, fail(&path, "cannot write the frame", e)))?;
         if before.is_none() {
             created.push(path);
         }
-        written += 1;
+        Ok::<bool, Vec<Diagnostic>>(true)
+    };
+    if let Some(split) = &split {
+        put(STATIC_FILE, &generator.static_text(split), &mut created)?;
+    }
+    for i in 0..anim.frames {
+        let statements = generator
+            .frame_statements(i)
+            .map_err(|e| undo(&created, e))?;
+        let text = generator.write_frame(i, &statements, split.as_ref());
+        written += usize::from(put(
+            &anim.output.sdf(i, anim.digits()),
+            &text,
+            &mut created,
+        )?);
     }
     let current: HashSet<&str> = manifest.lines().collect();
     let mut removed = 0;
     for stale in previous.iter().filter(|f| !current.contains(f.as_str())) {
         let path = dir.join(stale);
         match std::fs::remove_file(&path) {
-            Ok(()) => removed += 1,
+            // The static part is not a frame.
+            Ok(()) => removed += usize::from(stale != STATIC_FILE),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
             Err(e) => return Err(undo(&created, fail(&path, "cannot remove an old frame", e))),
         }
@@ -386,15 +414,19 @@ fn shift_into_spec(mut d: Diagnostic, src: &Source) -> Diagnostic {
     d
 }
 
-/// Frame `i`'s text, checked by loading it as the renderer will.
-fn checked_frame_text(
+/// Checks frame `i` by loading its whole text as the renderer will; with the base scene's
+/// statements by subject (`groups`), returns the subjects the frame changes
+/// ([`split::changed_subjects`]).
+fn check_frame(
     generator: &Generator,
     anim: &Animation,
     src: &Source,
     dir: &Path,
     i: usize,
-) -> Result<String, Vec<Diagnostic>> {
-    let text = generator.frame_text(i)?;
+    groups: Option<&HashMap<&str, Vec<&StatementKind>>>,
+) -> Result<HashSet<String>, Vec<Diagnostic>> {
+    let statements = generator.frame_statements(i)?;
+    let text = generator.write_frame(i, &statements, None);
     let path: Arc<Path> = Arc::from(dir.join(anim.output.sdf(i, anim.digits())).as_path());
     if let Err(diags) = anim_core::load::load_str(&text, &path, &LoadOptions::default()) {
         // A frame that does not load is a bug or a combination the spec checks missed;
@@ -409,7 +441,7 @@ fn checked_frame_text(
         out.extend(diags.into_iter().filter(Diagnostic::is_error));
         return Err(out);
     }
-    Ok(text)
+    Ok(groups.map_or_else(HashSet::new, |g| split::changed_subjects(g, &statements)))
 }
 
 /// The frame files `anim generate` wrote into a frame directory, one a line. Only files listed

@@ -8,6 +8,7 @@
 //! follow-on errors.
 
 mod camera;
+mod include;
 mod layout;
 mod light;
 mod material;
@@ -17,6 +18,8 @@ mod resolve;
 mod shape;
 mod transform;
 
+pub(super) use include::Chain;
+pub use include::{included_files, IncludeCache};
 pub use resolve::default_output;
 
 use super::ast::{FlatShapes, NameRef, Span, Statement, StatementKind, StatementSpans};
@@ -29,8 +32,9 @@ use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use std::sync::Arc;
 
-const STATEMENT_KEYWORDS: [&str; 6] = [
+const STATEMENT_KEYWORDS: [&str; 7] = [
     "define",
+    "include",
     "transform",
     "render",
     "camera",
@@ -58,8 +62,6 @@ pub struct Parsed {
     pub diagnostics: Vec<Diagnostic>,
     /// What the reader left out that the scene builder must account for.
     pub omissions: Omissions,
-    /// Lines with more tokens than a line may hold: (line, tokens on it).
-    pub(in crate::sdf) overlong: Vec<(u32, usize)>,
 }
 
 /// What the reader left out of the statements that building must still account for: its
@@ -104,8 +106,15 @@ struct Anchor {
 
 /// Reads `text`. With `flat`, the primitive shapes are kept apart in compact form when nothing
 /// in the file refers to a shape by name.
-pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions, flat: bool) -> Parsed {
+pub(super) fn parse(
+    text: &str,
+    path: &Path,
+    opts: &LoadOptions,
+    flat: bool,
+    chain: include::Chain,
+) -> Parsed {
     let mut p = Parser {
+        chain,
         file: Arc::from(path),
         path,
         opts,
@@ -148,6 +157,22 @@ pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions, flat: bool) -> 
     p.prune_skipped_references();
     p.drop_transforms_of_commented_definitions(text, &commented);
     p.resolve_motion(text);
+    // The lexer keeps only the first tokens of an overlong line; the line is refused here so
+    // that a truncated statement is never taken for what was written.
+    for (line, count) in overlong {
+        p.diagnostics.push(Diagnostic::new(
+            Severity::Error,
+            Loc {
+                file: p.file.clone(),
+                line,
+                col: 1,
+            },
+            format!(
+                "line holds {count} tokens, more than the {} a line may hold",
+                crate::limits::MAX_TOKENS_PER_LINE
+            ),
+        ));
+    }
     Parsed {
         statements: p.statements,
         shapes: p.shapes,
@@ -161,11 +186,12 @@ pub(super) fn parse(text: &str, path: &Path, opts: &LoadOptions, flat: bool) -> 
                 .map(|(name, line)| (name.to_string(), line))
                 .collect(),
         },
-        overlong,
     }
 }
 
 struct Parser<'a> {
+    /// The files being read, this one last (for `include`).
+    chain: include::Chain,
     file: Arc<Path>,
     path: &'a Path,
     opts: &'a LoadOptions,
@@ -538,6 +564,7 @@ impl Parser<'_> {
             "ambient" => self.ambient(line, 1),
             "background" => self.background(line, 1),
             "motion" => self.motion(line),
+            "include" => self.include(line),
             other => {
                 let help = if other.starts_with("<<<<<<<")
                     || other.starts_with("=======")

@@ -1,0 +1,133 @@
+//! The part of an animation that no frame changes, written once beside the frames
+//! ([`STATIC_FILE`]) and included by each of them, so that a frame file holds only what is
+//! keyed at its time (docs/animation.md, "Frame files").
+//!
+//! The split is found from the frames themselves, not from what the tracks say they touch:
+//! a statement is about a *subject* (the name it defines or places; the ambient light, the
+//! background, the render lines), and a subject is static when every frame holds exactly the
+//! base scene's statements about it, in the base scene's order. A frame is then its static
+//! statements (included first) followed by the others in the frame's own order. That moves
+//! static statements ahead of keyed ones written before them in the base scene, which changes
+//! nothing unless the two are about a common name (a composite listing a child defined after
+//! it, a shape using a material defined after it): such a static statement is kept in the
+//! frames too, so the frames mean exactly what the whole files would.
+
+use anim_core::sdf::ast::{Statement, StatementKind};
+use std::collections::{HashMap, HashSet};
+
+/// The static part's file name in the frame directory: not `.sdf`, so that `anim render DIR`
+/// does not take it for a frame.
+pub const STATIC_FILE: &str = "static.sdfi";
+
+/// The subject of a statement about no name, written so that no name can equal it.
+const AMBIENT: &str = "\u{0}ambient";
+const BACKGROUND: &str = "\u{0}background";
+const RENDER: &str = "\u{0}render";
+
+/// What a statement is about, then the other names it refers to.
+fn names(kind: &StatementKind) -> Vec<&str> {
+    match kind {
+        StatementKind::Material(m) => vec![&m.name],
+        StatementKind::Shape { name, material, .. } => vec![name, &material.name],
+        StatementKind::Composite { name, children } => {
+            let mut all = vec![name.as_str()];
+            all.extend(children.iter().map(|c| c.name.as_str()));
+            all
+        }
+        StatementKind::Light(l) => vec![&l.name],
+        StatementKind::Ambient(_) | StatementKind::AmbientAdd(_) => vec![AMBIENT],
+        StatementKind::Background(_) => vec![BACKGROUND],
+        StatementKind::Camera(c) => vec![&c.name],
+        StatementKind::Transform { target, .. } => vec![&target.name],
+        StatementKind::Motion(m) => vec![&m.target.name],
+        StatementKind::Render(r) => vec![RENDER, &r.camera.name],
+    }
+}
+
+fn subject(kind: &StatementKind) -> &str {
+    names(kind)[0]
+}
+
+/// The statements about each subject, in order.
+fn by_subject(statements: &[Statement]) -> HashMap<&str, Vec<&StatementKind>> {
+    let mut groups: HashMap<&str, Vec<&StatementKind>> = HashMap::new();
+    for s in statements {
+        groups.entry(subject(&s.kind)).or_default().push(&s.kind);
+    }
+    groups
+}
+
+/// The subjects whose statements in `frame` are not exactly the base scene's (`base`, from
+/// [`base_groups`]).
+pub fn changed_subjects(
+    base: &HashMap<&str, Vec<&StatementKind>>,
+    frame: &[Statement],
+) -> HashSet<String> {
+    let groups = by_subject(frame);
+    let mut changed: HashSet<String> = groups
+        .iter()
+        .filter(|(name, kinds)| base.get(*name) != Some(kinds))
+        .map(|(name, _)| name.to_string())
+        .collect();
+    changed.extend(
+        base.keys()
+            .filter(|name| !groups.contains_key(*name))
+            .map(|name| name.to_string()),
+    );
+    changed
+}
+
+/// The base scene's statements grouped by subject, for [`changed_subjects`].
+pub fn base_groups(base: &[Statement]) -> HashMap<&str, Vec<&StatementKind>> {
+    by_subject(base)
+}
+
+/// The static part of an animation: the subjects no frame changes.
+#[derive(Debug, Default)]
+pub struct Split {
+    static_subjects: HashSet<String>,
+}
+
+impl Split {
+    /// The split of frames made from `base`, given every subject some frame changes.
+    pub fn new(base: &[Statement], mut changed: HashSet<String>) -> Split {
+        // Render lines are the frames' own, always.
+        changed.insert(RENDER.to_string());
+        // A static statement after a kept one about a common name stays in the frames (see
+        // the module doc); that can keep another, so until nothing changes.
+        loop {
+            let mut kept_names: HashSet<&str> = HashSet::new();
+            let mut grew = false;
+            for s in base {
+                let names = names(&s.kind);
+                if !changed.contains(names[0]) && names.iter().any(|n| kept_names.contains(n)) {
+                    changed.insert(names[0].to_string());
+                    grew = true;
+                }
+                if changed.contains(names[0]) {
+                    kept_names.extend(names.iter().copied());
+                }
+            }
+            if !grew {
+                break;
+            }
+        }
+        let static_subjects = base
+            .iter()
+            .map(|s| subject(&s.kind))
+            .filter(|n| !changed.contains(*n))
+            .map(str::to_string)
+            .collect();
+        Split { static_subjects }
+    }
+
+    /// Whether any statement is static.
+    pub fn is_empty(&self) -> bool {
+        self.static_subjects.is_empty()
+    }
+
+    /// Whether a statement belongs to the static part.
+    pub fn is_static(&self, s: &Statement) -> bool {
+        self.static_subjects.contains(subject(&s.kind))
+    }
+}
