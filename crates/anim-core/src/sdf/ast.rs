@@ -73,7 +73,7 @@ const FLAT_CHUNK: usize = 1 << 14;
 /// [`Statement`]s, so that a flat file of a million shapes loads in little memory
 /// (BENCHMARKS.md, "Scale"). Each shape keeps what the scene builder can point at: where its
 /// statement, name and material are written.
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct FlatShapes {
     file: Option<Arc<Path>>,
     chunks: Vec<Vec<FlatShape>>,

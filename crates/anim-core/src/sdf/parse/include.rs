@@ -13,7 +13,7 @@
 use super::{At, Line, Parser};
 use crate::diag::Diagnostic;
 use crate::limits::MAX_INCLUDE_DEPTH;
-use crate::sdf::ast::{Statement, StatementKind};
+use crate::sdf::ast::{FlatShapes, Statement, StatementKind};
 use crate::util::Fnv64;
 use std::cell::{Cell, RefCell};
 use std::collections::{HashMap, HashSet};
@@ -48,10 +48,14 @@ impl FileRead {
 
 /// What reading an included file gave, kept whole so that later scenes splice it in without
 /// reading or parsing it again.
+#[derive(Clone)]
 struct Included {
     /// Every file read for it, itself first, then the files it includes.
     files: Vec<FileRead>,
+    /// Its statements, but for `shapes`.
     statements: Vec<Statement>,
+    /// Its primitive shapes, kept apart when nothing in it refers to a shape by name.
+    shapes: FlatShapes,
     diagnostics: Vec<Diagnostic>,
     skipped: HashSet<String>,
     render_lines: usize,
@@ -66,10 +70,12 @@ impl Included {
 
 /// Included files already read, shared by every clone of one `LoadOptions` (the frames of one
 /// `anim render DIR`). An entry is used again only while every file it read still holds the
-/// same bytes, and never where that would hide a cycle.
+/// same bytes, and never where that would hide a cycle. A file is kept from its second
+/// reading on: a scene rendered alone holds no second copy of what it includes.
 #[derive(Clone, Default)]
 pub struct IncludeCache {
-    entries: Arc<Mutex<HashMap<PathBuf, Arc<Included>>>>,
+    /// `None`: read once, not kept.
+    entries: Arc<Mutex<HashMap<PathBuf, Option<Arc<Included>>>>>,
 }
 
 impl IncludeCache {
@@ -89,16 +95,16 @@ impl IncludeCache {
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .get(path)
-            .cloned()?;
+            .cloned()??;
         let cycle = entry.files.iter().any(|f| chain.files.contains(&f.path));
         (!cycle && entry.files.iter().all(|f| f.unchanged(limit))).then_some(entry)
     }
 
-    fn put(&self, path: PathBuf, included: Arc<Included>) {
-        self.entries
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .insert(path, included);
+    /// Keeps `included` if its file was read before.
+    fn put(&self, path: PathBuf, included: &Arc<Included>) {
+        let mut entries = self.entries.lock().unwrap_or_else(|e| e.into_inner());
+        let kept = entries.contains_key(&path).then(|| included.clone());
+        entries.insert(path, kept);
     }
 }
 
@@ -252,7 +258,7 @@ impl Parser<'_> {
             .deps
             .borrow_mut()
             .extend(included.files.iter().cloned());
-        self.splice(&included);
+        self.splice(included);
     }
 
     /// The resolved path of the file `written` names, relative to `folder`; `None` (with the
@@ -340,40 +346,64 @@ impl Parser<'_> {
         // The files this one includes are limited by what is left after it.
         chain.read.set(chain.read.get() + bytes.len() as u64);
         let deps = chain.deps.clone();
-        let parsed = super::parse(&text, display, self.opts, false, chain);
+        let parsed = super::parse(&text, display, self.opts, true, chain);
         let mut files = vec![FileRead::of(path, &bytes)];
         files.extend(deps.borrow().iter().cloned());
         let included = Arc::new(Included {
             files,
             statements: parsed.statements,
+            shapes: parsed.shapes,
             diagnostics: parsed.diagnostics,
             skipped: parsed.omissions.skipped,
             render_lines: parsed.omissions.render_lines,
             cameras_rejected: parsed.omissions.cameras_rejected,
         });
-        self.opts.includes.put(path.to_path_buf(), included.clone());
+        self.opts.includes.put(path.to_path_buf(), &included);
         Some(included)
     }
 
     /// Puts an included file's statements and problems where its `include` line stands.
-    fn splice(&mut self, included: &Included) {
-        // The included statements may refer to shapes by name: every shape is a statement
-        // from here on, in the order read.
-        self.flat = false;
+    fn splice(&mut self, included: Arc<Included>) {
+        // Taken whole when nothing else holds it (the cache did not keep it), else copied.
+        let included = Arc::try_unwrap(included).unwrap_or_else(|shared| Included::clone(&shared));
         for s in &included.statements {
-            match &s.kind {
-                StatementKind::Material(m) => self.shapes.define_material(&m.name),
-                StatementKind::Camera(c) => self.camera_names.push(c.name.clone()),
-                _ => {}
+            if let StatementKind::Camera(c) = &s.kind {
+                self.camera_names.push(c.name.clone());
             }
         }
-        self.statements.extend(included.statements.iter().cloned());
-        self.diagnostics
-            .extend(included.diagnostics.iter().cloned());
-        self.skipped.extend(included.skipped.iter().cloned());
+        let first = self.statements.is_empty() && self.shapes.is_empty();
+        if self.flat && first {
+            // The include opens a file that keeps its shapes apart (a generated frame): the
+            // included shapes stay compact, their places those of the included file.
+            self.flat = !included.statements.iter().any(|s| breaks_flat(&s.kind));
+            self.shapes = included.shapes;
+            self.statements.extend(included.statements);
+        } else {
+            // Every shape is a statement from here on, in the order read.
+            if self.flat {
+                self.merge_shapes();
+            }
+            self.flat = false;
+            let (all, _) = included.shapes.merge_into(included.statements);
+            self.statements.extend(all);
+        }
+        self.diagnostics.extend(included.diagnostics);
+        self.skipped.extend(included.skipped);
         self.render_lines += included.render_lines;
         self.cameras_rejected |= included.cameras_rejected;
     }
+}
+
+/// Whether a statement means its file refers to shapes by name or holds a shape that is not
+/// kept apart, so that no shape of the file is kept apart.
+fn breaks_flat(kind: &StatementKind) -> bool {
+    matches!(
+        kind,
+        StatementKind::Shape { .. }
+            | StatementKind::Composite { .. }
+            | StatementKind::Transform { .. }
+            | StatementKind::Motion(_)
+    )
 }
 
 /// The files a scene's `include` lines name, resolved against the folder of the scene at
@@ -399,4 +429,69 @@ fn shown(path: &Path, folder: &Path) -> String {
         .unwrap_or(path)
         .display()
         .to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::load::load_file;
+    use crate::sdf::LoadOptions;
+    use std::path::Path;
+
+    fn write(dir: &Path, name: &str, text: &str) {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+
+    const PART: &str = "define material m 0.1 0.1 0.1 0.5 0.5 0.5 0 0 0 1\n\
+                        define light l 0 5 0 1 1 1 1\n\
+                        define shape sphere a 0 0 -5 1 m\n\
+                        define shape sphere b 2 0 -5 1 m\n";
+
+    fn frame(n: u32) -> String {
+        format!(
+            "include part.sdfi\ndefine camera c 60 0 0 {n} 0 0 -1 0 1 0\nrender c f{n}.png 8 8\n"
+        )
+    }
+
+    fn shapes(path: &Path, opts: &LoadOptions) -> usize {
+        let loaded = load_file(path, opts).unwrap_or_else(|e| panic!("{e:?}"));
+        loaded.jobs[0].scene.instances.len()
+    }
+
+    #[test]
+    fn an_included_file_is_kept_from_its_second_reading_while_its_bytes_stay_the_same() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        write(dir, "part.sdfi", PART);
+        for n in 0..3 {
+            write(dir, &format!("f{n}.sdf"), &frame(n));
+        }
+        let opts = LoadOptions::default();
+        assert_eq!(shapes(&dir.join("f0.sdf"), &opts), 2);
+        // Read once: remembered, not kept.
+        assert_eq!(opts.includes.len(), 1);
+        assert!(opts
+            .includes
+            .entries
+            .lock()
+            .unwrap()
+            .values()
+            .all(Option::is_none));
+        assert_eq!(shapes(&dir.join("f1.sdf"), &opts), 2);
+        assert!(opts
+            .includes
+            .entries
+            .lock()
+            .unwrap()
+            .values()
+            .all(Option::is_some));
+        // A clone of the options shares the cache; a changed file is read again.
+        let clone = opts.clone();
+        write(
+            dir,
+            "part.sdfi",
+            &format!("{PART}define shape sphere c 4 0 -5 1 m\n"),
+        );
+        assert_eq!(shapes(&dir.join("f2.sdf"), &clone), 3);
+        assert_eq!(shapes(&dir.join("f0.sdf"), &opts), 3);
+    }
 }
