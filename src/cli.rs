@@ -54,6 +54,10 @@ pub struct SceneArgs {
     /// Largest scene file read, in bytes; larger files are refused unread.
     #[arg(long, value_name = "BYTES", default_value_t = limits::DEFAULT_MAX_INPUT)]
     pub max_input: u64,
+    /// Read meshes and included files wherever a scene names them; by default only files
+    /// inside the scene's folder or the current directory are read.
+    #[arg(long)]
+    pub allow_any_input: bool,
     /// Memory a scene, and each image, may take while it is made, e.g. 512M or 8G (default:
     /// half of what the process may use: the machine's memory, or less under `ulimit -v` or a
     /// cgroup limit). Bigger scenes and images are refused before they are built, with the
@@ -459,6 +463,7 @@ impl SceneArgs {
             },
             infer_transform_order: self.transform_order == TransformOrderArg::Auto,
             max_input: self.max_input,
+            allow_any_input: self.allow_any_input,
             max_memory: self.max_memory(),
             // One cache of each for the whole command: every frame it renders shares the
             // meshes and the included files.

@@ -110,11 +110,11 @@ fn every_bad_include_is_refused_at_its_line() {
         ("include folder\n", "1:9: error: `folder` is a folder"),
         (
             "include /etc/hostname\n",
-            "1:9: error: `/etc/hostname` is an absolute path",
+            "1:9: error: `/etc/hostname` is outside the scene's folder and the current directory",
         ),
         (
             "include ../outside.sdf\n",
-            "1:9: error: `../outside.sdf` is outside the scene's folder",
+            "1:9: error: `../outside.sdf` is outside the scene's folder and the current directory",
         ),
         (
             "include one.sdf\n",
@@ -204,5 +204,53 @@ fn a_named_pipe_is_refused_without_waiting() {
     assert!(
         err.contains("scene.sdf:1:9: error: `pipe.sdfi` is not a regular file"),
         "{err}"
+    );
+}
+
+#[test]
+fn files_outside_the_scene_folder_are_read_from_inside_the_current_directory_or_with_the_flag() {
+    let tmp = tempfile::tempdir().unwrap();
+    let project = tmp.path();
+    write(project, "shared/materials.sdf", MATERIALS);
+    write(
+        project,
+        "shared/tri.obj",
+        "v 0 0 -4\nv 1 0 -4\nv 0 1 -4\nf 1 2 3\n",
+    );
+    write(
+        project,
+        "scenes/scene.sdf",
+        &format!(
+            "include ../shared/materials.sdf\n{SHAPES}define shape obj mesh ../shared/tri.obj red\n{FRAME}"
+        ),
+    );
+    // From the project: both files are inside the current directory.
+    let (code, err) = run(project, &["check", "scenes/scene.sdf"]);
+    assert_eq!(code, 0, "{err}");
+    // From the scene's own folder: both are outside the scene's folder and the current one.
+    let scenes = project.join("scenes");
+    let (code, err) = run(&scenes, &["check", "scene.sdf"]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("scene.sdf:1:9: error: `../shared/materials.sdf` is outside"),
+        "{err}"
+    );
+    let (code, err) = run(&scenes, &["check", "scene.sdf", "--allow-any-input"]);
+    assert_eq!(code, 0, "{err}");
+    // The mesh alone.
+    write(
+        project,
+        "scenes/mesh.sdf",
+        &format!("{MATERIALS}{SHAPES}define shape obj mesh ../shared/tri.obj red\n{FRAME}"),
+    );
+    let (code, err) = run(&scenes, &["check", "mesh.sdf"]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("mesh.sdf:6:1: error: mesh file `../shared/tri.obj` is outside"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("v 0 0 -4"),
+        "the file's content is quoted: {err}"
     );
 }

@@ -411,7 +411,20 @@ fn frames_find_the_base_scenes_mesh_files_wherever_they_are_written() {
             String::from_utf8_lossy(&done.stderr)
         );
         let frames = out.unwrap_or(&default_dir);
-        render(frames, &[]);
+        // Rendered from the project: the mesh is inside the current directory, wherever the
+        // frames are (the frames may read only inside their folder or the current one).
+        let done = Command::cargo_bin("anim")
+            .expect("binary")
+            .current_dir(project.path())
+            .arg("render")
+            .arg(frames)
+            .output()
+            .expect("run");
+        assert!(
+            done.status.success(),
+            "{}",
+            String::from_utf8_lossy(&done.stderr)
+        );
         // The triangle covers the image centre: lit, not background black.
         let img = image::open(frames.join("frame_0000.png"))
             .expect("image")

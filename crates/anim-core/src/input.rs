@@ -75,3 +75,25 @@ fn open_without_waiting(path: &Path) -> std::io::Result<std::fs::File> {
         ))
     })
 }
+
+/// Whether a scene may make anim read the file at `path` (resolved: `canonicalize`d), a mesh or
+/// an included file, when the file given to anim is `scene`: only inside the scene's folder or
+/// the current working directory, each with everything below it, as POV-Ray's read
+/// restrictions confine a scene (docs/scene-language.md §11). `--allow-any-input` lifts the
+/// rule. A scene cannot make anim read, and quote in its messages, a file from elsewhere.
+pub fn may_read(path: &Path, scene: &Path) -> bool {
+    let folder = match scene.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.canonicalize().ok(),
+        _ => std::env::current_dir().ok(),
+    };
+    let cwd = std::env::current_dir()
+        .ok()
+        .and_then(|d| d.canonicalize().ok());
+    [folder, cwd]
+        .iter()
+        .flatten()
+        .any(|root| path.starts_with(root))
+}
+
+/// What an error about a file that [`may_read`] refuses says after its name.
+pub const OUTSIDE_ROOTS: &str = "is outside the scene's folder and the current directory: a scene may read only files inside either (--allow-any-input lifts this)";

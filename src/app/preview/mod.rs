@@ -49,11 +49,16 @@ pub fn run(config: &PreviewConfig, pool: &ThreadPool) -> ExitCode {
         eprintln!("{}: error: no such file", super::shown(&config.input));
         return ExitCode::FAILURE;
     }
-    let project = Project {
+    let mut project = Project {
         input: config.input.clone(),
         frames_dir: temp.path().join("frames"),
         load: config.load.clone(),
     };
+    if project.is_spec() {
+        // The frames in the temporary folder name the base scene's meshes, which were
+        // confined when `anim generate` read the base scene.
+        project.load.allow_any_input = true;
+    }
     let shared = Arc::new(Shared::default());
     {
         let shared = shared.clone();

@@ -100,6 +100,9 @@ pub struct LoadOptions {
     pub infer_transform_order: bool,
     /// Largest input file read, in bytes (`--max-input`); larger files are refused unread.
     pub max_input: u64,
+    /// Whether meshes and included files may be read from anywhere (`--allow-any-input`), not
+    /// only from inside the scene's folder and the current directory (`input::may_read`).
+    pub allow_any_input: bool,
     /// Memory the scene may take, in bytes (`--max-memory`): a scene whose shapes would need
     /// more (`limits::scene_memory`) is refused before it is built.
     pub max_memory: u64,
@@ -121,6 +124,7 @@ impl Default for LoadOptions {
             transform_order: TransformOrder::World,
             infer_transform_order: false,
             max_input: crate::limits::DEFAULT_MAX_INPUT,
+            allow_any_input: false,
             max_memory: crate::limits::default_memory_budget(),
             meshes: MeshCache::default(),
             includes: IncludeCache::default(),

@@ -327,6 +327,8 @@ mod tests {
             infer_transform_order,
             // The input limit decides whether a file is read at all, never what it renders.
             max_input: _,
+            // Which files may be read decides whether a scene is read at all, likewise.
+            allow_any_input: _,
             // The memory budget decides whether a scene is built at all, never what it
             // renders.
             max_memory: _,

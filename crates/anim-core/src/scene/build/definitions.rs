@@ -276,14 +276,25 @@ impl Builder<'_> {
         if m.mesh().is_some() {
             return;
         }
-        let dir = self.path.parent().unwrap_or(Path::new(""));
+        // Relative to the file the statement is written in (an included file's own folder).
+        let written_in: &Path = if stmt.loc.file.as_os_str().is_empty() {
+            self.path
+        } else {
+            &stmt.loc.file
+        };
+        let file = written_in.parent().unwrap_or(Path::new("")).join(&m.file);
+        let outside = file.canonicalize().is_ok_and(|resolved| {
+            !self.opts.allow_any_input && !crate::input::may_read(&resolved, self.path)
+        });
+        if outside {
+            let message = format!("mesh file `{}` {}", m.file, crate::input::OUTSIDE_ROOTS);
+            self.error(At::Statement(stmt), message, None);
+            return;
+        }
         let max_input = self.opts.max_input;
-        let loaded = self
-            .opts
-            .meshes
-            .load(&dir.join(&m.file), max_input, |path| {
-                crate::shape::mesh::load(path, max_input).map(Arc::new)
-            });
+        let loaded = self.opts.meshes.load(&file, max_input, |path| {
+            crate::shape::mesh::load(path, max_input).map(Arc::new)
+        });
         match loaded {
             Ok(mesh) => m.set(mesh),
             Err(d) if d.loc.is_none() => {

@@ -125,8 +125,6 @@ impl fmt::Debug for IncludeCache {
 /// The files being read, from the one the reader was given to the one being read now.
 #[derive(Clone)]
 pub(in crate::sdf) struct Chain {
-    /// The folder of the outermost file (resolved): included files must be inside it.
-    root: Option<PathBuf>,
     /// The files being read (resolved), outermost first.
     files: Vec<PathBuf>,
     /// Bytes read for the outermost file so far, itself and every file it includes.
@@ -150,7 +148,6 @@ impl Chain {
             }
         });
         Chain {
-            root: resolved.parent().map(Path::to_path_buf),
             files: vec![resolved],
             read: Rc::new(Cell::new(text.len() as u64)),
             deps: Rc::default(),
@@ -162,7 +159,6 @@ impl Chain {
         let mut files = self.files.clone();
         files.push(path);
         Chain {
-            root: self.root.clone(),
             files,
             read: self.read.clone(),
             deps: Rc::default(),
@@ -269,15 +265,6 @@ impl Parser<'_> {
             self.error(line, at, "`include` names no file", None);
             return None;
         }
-        if Path::new(written).is_absolute() {
-            self.error(
-                line,
-                at,
-                format!("`{written}` is an absolute path; an included file is named relative to the file that includes it"),
-                None,
-            );
-            return None;
-        }
         let path = match folder.join(written).canonicalize() {
             Ok(path) => path,
             Err(e) => {
@@ -285,16 +272,12 @@ impl Parser<'_> {
                 return None;
             }
         };
-        let inside = self.chain.root.as_ref().is_none_or(|r| path.starts_with(r));
-        if !inside {
-            let root = self.chain.root.clone().unwrap_or_default();
+        let outermost = self.chain.files.first().cloned().unwrap_or_default();
+        if !self.opts.allow_any_input && !crate::input::may_read(&path, &outermost) {
             self.error(
                 line,
                 at,
-                format!(
-                    "`{written}` is outside the scene's folder `{}`: a scene may include only files in its own folder or below",
-                    root.display()
-                ),
+                format!("`{written}` {}", crate::input::OUTSIDE_ROOTS),
                 Some("copy the file beside the scene".into()),
             );
             return None;
