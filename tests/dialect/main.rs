@@ -16,6 +16,7 @@ mod common;
 
 mod corpus;
 mod diagnostics;
+mod forms_more;
 mod include;
 mod intent;
 mod intent_forms;

@@ -42,6 +42,10 @@ pub(super) struct Definitions<'s> {
     pub(super) objects: Vec<Object<'s>>,
     /// Name → index into `objects` of its final definition.
     pub(super) object_index: HashMap<&'s str, usize>,
+    /// Shapes defined again by a later shape of the same name, by their statement's place
+    /// in the list: still drawn (as course renderers that keep every shape in a list draw
+    /// them), but no longer named.
+    pub(super) shadowed: HashMap<*const Statement, usize>,
     pub(super) cameras: Vec<&'s CameraDef>,
     pub(super) camera_index: HashMap<&'s str, usize>,
     pub(super) lights: Vec<&'s LightDef>,
@@ -221,11 +225,13 @@ impl Builder<'_> {
                     let resolved = self
                         .resolve_material(d, &first.materials, index, material)
                         .or_else(|| fallback_of.get(material.name.as_str()).copied());
-                    let Some(&i) = d.object_index.get(name.as_str()) else {
+                    let named = d.object_index.get(name.as_str()).copied();
+                    let Some(i) = d.shadowed.get(&std::ptr::from_ref(stmt)).copied().or(named)
+                    else {
                         continue;
                     };
-                    // Only the final definition of the name is drawn; earlier ones were
-                    // still checked when read.
+                    // The object of this very statement: an earlier definition of a name
+                    // that a composite replaced is checked but not drawn.
                     if std::ptr::eq(d.objects[i].statement, stmt) {
                         d.objects[i].kind = ObjectKind::Shape {
                             geometry,
@@ -252,19 +258,27 @@ impl Builder<'_> {
 
     pub(super) fn define_object<'s>(&mut self, d: &mut Definitions<'s>, object: Object<'s>) {
         if let Some(&i) = d.object_index.get(object.name) {
-            let what = match object.kind {
-                ObjectKind::Shape { .. } => "shape",
-                ObjectKind::Composite { .. } => "composite",
-            };
+            let is_shape = |k: &ObjectKind| matches!(k, ObjectKind::Shape { .. });
             let earlier_line = d.objects[i].statement.loc.line;
-            self.warn(
-                At::Name(object.statement),
+            let message = if is_shape(&object.kind) && is_shape(&d.objects[i].kind) {
+                d.shadowed
+                    .insert(std::ptr::from_ref(d.objects[i].statement), i);
+                format!(
+                    "shape `{}` is already defined (line {earlier_line}); both are drawn, and the name refers to this one",
+                    object.name
+                )
+            } else {
+                let what = if is_shape(&object.kind) {
+                    "shape"
+                } else {
+                    "composite"
+                };
                 format!(
                     "{what} `{}` is already defined (line {earlier_line}); the later definition replaces it",
                     object.name
-                ),
-                None,
-            );
+                )
+            };
+            self.warn(At::Name(object.statement), message, None);
         }
         d.object_index.insert(object.name, d.objects.len());
         d.objects.push(object);

@@ -42,14 +42,12 @@ impl Builder<'_> {
         let state = self.flat_shape_states(&shapes, &resolved, &d, &first_def);
         let mut total = Expansion::default();
         let mut first_root: Option<usize> = None;
-        // What is drawn: neither superseded, nor of a material that cannot be resolved, nor
-        // degenerate.
+        // What is drawn: every shape, but those of a material that cannot be resolved and
+        // the degenerate ones.
         for (k, &st) in state.iter().enumerate() {
-            if st & SUPERSEDED == 0 {
-                first_root.get_or_insert(k);
-                total.nodes += 1;
-                total.shapes += u64::from(st == DRAWABLE);
-            }
+            first_root.get_or_insert(k);
+            total.nodes += 1;
+            total.shapes += u64::from(st == DRAWABLE);
         }
         let snapshots = self.snapshots(statements, &d);
         let fits = match first_root.and_then(|k| shapes.get(k)) {
@@ -85,9 +83,9 @@ impl Builder<'_> {
         self.jobs_of(&d, &snapshots, &flat, &Default::default())
     }
 
-    /// The state of each of `shapes` (`SUPERSEDED`, `DRAWABLE`), found in one walk over
-    /// them, which also points out the names defined again (later definitions replace
-    /// earlier ones) and the materials used before their definition.
+    /// The state of each of `shapes` (`DRAWABLE` or not), found in one walk over them, which
+    /// also points out the names defined again (both definitions are drawn) and the
+    /// materials used before their definition.
     fn flat_shape_states(
         &mut self,
         shapes: &FlatShapes,
@@ -113,15 +111,14 @@ impl Builder<'_> {
                     shapes.get(j).map_or("", |e| shapes.name(e))
                 });
                 k += 1;
-                if let Some((earlier, earlier_line)) =
-                    earlier.and_then(|j| Some((j, shapes.get(j)?.line())))
-                {
-                    state[earlier] |= SUPERSEDED;
+                // Course renderers that keep every shape in a list draw both; nothing here
+                // refers to a shape by name, so nothing needs the name to be one shape's.
+                if let Some(earlier_line) = earlier.and_then(|j| Some(shapes.get(j)?.line())) {
                     let (loc, width) = shapes.name_place(s);
                     self.warn(
                         At::Place(&loc, width),
                         format!(
-                            "shape `{name}` is already defined (line {earlier_line}); the later definition replaces it"
+                            "shape `{name}` is already defined (line {earlier_line}); both are drawn, and the name refers to this one"
                         ),
                         None,
                     );
@@ -213,8 +210,6 @@ fn flat_instances(
     (instances, names)
 }
 
-/// A shape's state in `flat_jobs`: a later shape of the same name replaces it.
-const SUPERSEDED: u8 = 1;
 /// A shape's state in `flat_jobs`: its material resolves and it can be drawn.
 const DRAWABLE: u8 = 2;
 

@@ -464,6 +464,12 @@ fn roots(d: &Definitions) -> Vec<usize> {
         .filter(|(name, _)| !contained.contains(*name))
         .map(|(_, &i)| i)
         .collect();
+    // Shapes whose name a later shape took are drawn where that name would be.
+    roots.extend(
+        d.shadowed
+            .values()
+            .filter(|&&i| !contained.contains(d.objects[i].name)),
+    );
     roots.sort_unstable(); // definition order
     roots
 }

@@ -106,6 +106,17 @@ impl Parser<'_> {
             );
         } else if nums.len() == 3 && is_image_side(nums[1]) && is_image_side(nums[2]) {
             self.read_size_after_fov(line, first, name, &mut nums);
+        } else if nums.len() == 7 && !limits::fov_is_valid(nums[0]) && limits::fov_is_valid(nums[6])
+        {
+            // `[eye] [dir] <fov>`: the first number cannot be a field of view, the last can.
+            self.warn(
+                line,
+                At::Tok(first + 6),
+                "camera written as [eye] [dir] <fov-x>, the field of view last: +y is up",
+                Some(format!("canonical form: `{FORM_CAMERA}`")),
+            );
+            nums.rotate_right(1);
+            nums.extend([0.0, 1.0, 0.0]);
         } else if nums.len() == 7 && is_zero(DVec3::new(nums[4], nums[5], nums[6])) {
             self.read_default_view_angles(line, first, name, &mut nums);
         } else if nums.len() == 7 {
@@ -318,23 +329,21 @@ impl Parser<'_> {
         def.dir = v(4);
         def.up = v(7);
         if is_zero(def.dir) {
-            // Some renderers read these as rotation angles; 0 0 0 then means the default
-            // pose, which is written without them.
-            let eye = format!(
-                "{} {} {}",
-                toks[first + 1].text,
-                toks[first + 2].text,
-                toks[first + 3].text
-            );
-            return Err(self.error(
+            // No direction to look along: the renderers that wrote such lines read the field
+            // of view alone and looked along -z from the origin, and so does this reading.
+            let fov = toks[first].text;
+            self.warn(
                 line,
                 At::Span(first + 4, first + 6),
-                "the camera's viewing direction is zero",
+                "the camera's viewing direction is zero: read as its field of view alone, at the origin looking along -z with +y up",
                 Some(format!(
-                    "to look along -z with +y up, write `define camera {name} {} {eye}`; otherwise `{FORM_CAMERA}`",
-                    toks[first].text
+                    "that is `define camera {name} {fov}`; to place the camera, give a direction: `{FORM_CAMERA}`"
                 )),
-            ));
+            );
+            def.eye = DVec3::ZERO;
+            def.dir = DVec3::NEG_Z;
+            def.up = DVec3::Y;
+            return Ok(());
         }
         if parallel(def.dir, def.up) && !parallel(def.dir, DVec3::Y) && toks.len() > first + 9 {
             // An up vector that is zero or along the view gives no roll: nothing of the
@@ -458,7 +467,8 @@ mod tests {
 
     #[test]
     fn a_broken_camera_skips_only_its_render_lines_when_another_stands() {
-        let text = "define camera good 60\ndefine camera bad 60 0 0 0 0 0 0 0 1 0\n\
+        // Looking along +y with +y up: no reading gives it a roll.
+        let text = "define camera good 60\ndefine camera bad 60 0 0 0 0 1 0 0 1 0\n\
                     render bad a.png 8 8\nrender good b.png 8 8\n";
         let (statements, ds) = parse(text, Path::new("s.sdf"), &LoadOptions::default());
         assert!(ds.iter().all(|d| d.severity == Severity::Warning), "{ds:?}");
@@ -477,7 +487,7 @@ mod tests {
         assert_eq!(renders, ["b.png"]);
         // A render line naming no camera takes the first one: when that one is rejected, the
         // line goes with it.
-        let text = "define camera bad 60 0 0 0 0 0 0 0 1 0\ndefine camera good 60\n\
+        let text = "define camera bad 60 0 0 0 0 1 0 0 1 0\ndefine camera good 60\n\
                     render a.png 8 8\nrender good b.png 8 8\n";
         let (statements, ds) = parse(text, Path::new("s.sdf"), &LoadOptions::default());
         assert!(ds.iter().all(|d| d.severity == Severity::Warning), "{ds:?}");
@@ -490,7 +500,7 @@ mod tests {
             .collect();
         assert_eq!(cameras, ["good"]);
         // As the only render line's camera it stops the file.
-        let text = "define camera bad 60 0 0 0 0 0 0 0 1 0\nrender bad a.png 8 8\n";
+        let text = "define camera bad 60 0 0 0 0 1 0 0 1 0\nrender bad a.png 8 8\n";
         let (_, ds) = parse(text, Path::new("s.sdf"), &LoadOptions::default());
         assert!(ds.iter().any(|d| d.severity == Severity::Error), "{ds:?}");
     }

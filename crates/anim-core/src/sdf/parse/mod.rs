@@ -8,6 +8,7 @@
 //! follow-on errors.
 
 mod camera;
+mod dialect;
 mod include;
 mod layout;
 mod light;
@@ -550,7 +551,19 @@ impl Parser<'_> {
 
     // ----- dispatch ----------------------------------------------------------------------
 
-    fn line(&mut self, line: &Line) {
+    fn line(&mut self, written: &Line) {
+        let normalised;
+        let line = if dialect::may_need_normalising(written) {
+            match self.normalise(written) {
+                Some(l) => {
+                    normalised = l;
+                    &normalised
+                }
+                None => return,
+            }
+        } else {
+            written
+        };
         let Some(first) = line.tokens.first() else {
             return;
         };
@@ -602,6 +615,16 @@ impl Parser<'_> {
             "ambient" => self.ambient(line, 2),
             "background" => self.background(line, 2),
             "backgroundcolor" => self.background(line, 2),
+            "amblight" => {
+                self.variant(
+                    line,
+                    At::Tok(1),
+                    "amblight",
+                    "`define amblight` read as `ambient`".into(),
+                    "the ambient light is set by `ambient <r> <g> <b>`".into(),
+                );
+                self.ambient(line, 2);
+            }
             "transform" => self.transform(line, 2, Some("`define transform` read as `transform`")),
             "render" | "renderer" => {
                 // `define renderer <camera> <file> <w> <h>`: a camera is named like on a

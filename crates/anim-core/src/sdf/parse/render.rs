@@ -171,6 +171,22 @@ impl Parser<'_> {
                     None
                 }
             }
+            (true, 3) if self.is_render_name(toks[from].text, toks[from + 1].text) => {
+                // `render <name> <camera> <file> ...`: renderers that name each render job.
+                self.warn(
+                    line,
+                    At::Tok(from),
+                    format!(
+                        "`{}` is no camera but `{}` is: read as the render job's name, and skipped",
+                        toks[from].text,
+                        toks[from + 1].text
+                    ),
+                    Some(format!("canonical form: `{FORM_RENDER}`")),
+                );
+                camera = RenderCamera::Named;
+                camera_at = Some(from + 1);
+                Some(from + 2..names_end)
+            }
             (true, _) => {
                 camera = RenderCamera::Named;
                 camera_at = Some(from);
@@ -282,6 +298,13 @@ impl Parser<'_> {
     /// The output file name from the tokens `pieces`; a name broken by spaces around its
     /// dot (`image . ppm`, `image .ppm`) is joined with a warning. `None` if the pieces do not
     /// form one name.
+    /// Whether a render line's first two names are a job's name and a camera: the first is no
+    /// camera defined so far, the second is.
+    fn is_render_name(&self, first: &str, second: &str) -> bool {
+        let known = |n: &str| self.camera_names.iter().any(|c| c == n);
+        !known(first) && known(second)
+    }
+
     fn file_name(&mut self, line: &Line, pieces: std::ops::Range<usize>) -> Option<String> {
         let toks = &line.tokens;
         let parts: Vec<&str> = toks[pieces.clone()].iter().map(|t| t.text).collect();

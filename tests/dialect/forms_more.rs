@@ -1,0 +1,178 @@
+//! More forms that other readers of the language accept, each on a small file of our own that
+//! reproduces what real files do: read with a located warning that names the reading, an
+//! error under `--strict`, and an image that shows the scene. Template placeholders, which no
+//! reading can give a value, are a located error that names the placeholder.
+
+use crate::common::{anim, read_ppm};
+use std::path::Path;
+
+const HEAD: &str = "\
+define material red 0.2 0 0 1 0 0 0.5 0.5 0.5 20
+define material green 0 0.2 0 0 1 0 0.5 0.5 0.5 20
+define light sun 0 10 10 1 1 1 1
+ambient 0.2 0.2 0.2
+";
+
+/// `anim ARGS...` in `dir`: (exit code, stderr).
+fn run(dir: &Path, args: &[&str]) -> (i32, String) {
+    let out = anim()
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("anim runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Loads `body` (after the materials and light) with a warning at `at` containing
+/// `reading`, refused under `--strict`; returns the 40×30 image it renders to `image.ppm`.
+fn read_with_warning(body: &str, at: &str, reading: &str) -> crate::common::Rgb8 {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(dir.join("scene.sdf"), format!("{HEAD}{body}")).unwrap();
+    let (code, err) = run(dir, &["check", "scene.sdf"]);
+    assert_eq!(code, 0, "{err}");
+    let wanted = format!("scene.sdf:{at}: warning: ");
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with(&wanted) && l.contains(reading)),
+        "no `{wanted}…{reading}` in\n{err}"
+    );
+    let (code, err) = run(dir, &["check", "scene.sdf", "--strict"]);
+    assert_ne!(code, 0, "--strict accepted it:\n{err}");
+    let (code, err) = run(dir, &["render", "scene.sdf", "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    read_ppm(&dir.join("image.ppm"))
+}
+
+/// Whether the pixel at (x, y) is lit red (the red material), rather than background.
+fn red_at(image: &crate::common::Rgb8, x: usize, y: usize) -> bool {
+    let [r, g, b] = image.at(x, y);
+    r > 60 && g < 40 && b < 40
+}
+
+const CAMERA: &str = "define camera eye 60 0 0 0 0 0 -1 0 1 0\nrender eye image.ppm 40 30\n";
+
+#[test]
+fn numbers_glued_by_a_sign_are_read_as_a_stream_reader_reads_them() {
+    // A box from (-1, -1, -6) to (1, 1, -4): `1-4` would otherwise be refused as a
+    // malformed number.
+    let image = read_with_warning(
+        &format!("define shape box b -1 -1 -6 1 1-4 red\n{CAMERA}"),
+        "5:31",
+        "`1-4` read as 2 numbers, `1` `-4`",
+    );
+    assert!(red_at(&image, 20, 15), "the box is not drawn");
+}
+
+#[test]
+fn dreieck_is_a_triangle() {
+    let image = read_with_warning(
+        &format!("define shape dreieck t -2 -2 -5 2 -2 -5 0 2 -5 red\n{CAMERA}"),
+        "5:14",
+        "`dreieck` read as `triangle`",
+    );
+    assert!(red_at(&image, 20, 16), "the triangle is not drawn");
+}
+
+#[test]
+fn amblight_is_the_ambient_light() {
+    // No light but the ambient one: without it the sphere would be black.
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let text = "define material red 1 0 0 1 0 0 0 0 0 1\n\
+                define shape sphere s 0 0 -5 1 red\n\
+                define amblight 1 1 1\n"
+        .to_string()
+        + CAMERA;
+    std::fs::write(dir.join("scene.sdf"), text).unwrap();
+    let (code, err) = run(dir, &["render", "scene.sdf"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("scene.sdf:3:8: warning: `define amblight` read as `ambient`"),
+        "{err}"
+    );
+    assert!(red_at(&read_ppm(&dir.join("image.ppm")), 20, 15));
+}
+
+#[test]
+fn a_render_line_may_name_its_job_before_the_camera() {
+    let image = read_with_warning(
+        "define shape sphere s 0 0 -5 1 red\n\
+         define camera eye 60 0 0 0 0 0 -1 0 1 0\n\
+         render job1 eye image.ppm 40 30\n",
+        "7:8",
+        "`job1` is no camera but `eye` is",
+    );
+    assert!(red_at(&image, 20, 15));
+}
+
+#[test]
+fn a_camera_with_the_field_of_view_last_after_eye_and_direction() {
+    // `name eye(3) dir(3) fov`, looking along +x at a sphere there.
+    let image = read_with_warning(
+        "define shape sphere s 5 0 0 1 red\n\
+         define camera eye 0 0 0 1 0 0 60\n\
+         render eye image.ppm 40 30\n",
+        "6:31",
+        "the field of view last",
+    );
+    assert!(red_at(&image, 20, 15));
+}
+
+#[test]
+fn a_camera_whose_direction_is_zero_is_its_field_of_view_alone() {
+    // 11 numbers with a zero direction: renderers that read only the fov looked along -z
+    // from the origin.
+    let image = read_with_warning(
+        "define shape sphere s 0 0 -5 1 red\n\
+         define camera eye 60 0 0 3 0 0 0 0 1 0 1\n\
+         render eye image.ppm 40 30\n",
+        "6:28",
+        "read as its field of view alone, at the origin looking along -z",
+    );
+    assert!(red_at(&image, 20, 15));
+}
+
+#[test]
+fn shapes_of_one_name_are_all_drawn_and_the_name_is_the_last() {
+    // Two spheres named `s`; the transform moves the second (green) one only.
+    let image = read_with_warning(
+        &format!(
+            "define shape sphere s -1.5 0 -5 0.8 red\n\
+             define shape sphere s 1.5 0 -5 0.8 green\n\
+             transform s translate 0 10 0\n{CAMERA}"
+        ),
+        "6:21",
+        "both are drawn, and the name refers to this one",
+    );
+    // The red one stays where it was written (left of the centre).
+    assert!(red_at(&image, 11, 15), "the first sphere is not drawn");
+    // The green one moved out of the view.
+    let [_, g, _] = image.at(28, 15);
+    assert!(
+        g < 40,
+        "the transform did not move the last sphere of the name"
+    );
+}
+
+#[test]
+fn a_template_placeholder_is_an_error_that_names_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(
+        dir.join("scene.sdf"),
+        format!(
+            "{HEAD}define shape sphere s 0 0 -5 1 red\ntransform s rotate {{{{ANGLE_0}}}} 0 0 1\n{CAMERA}"
+        ),
+    )
+    .unwrap();
+    let (code, err) = run(dir, &["check", "scene.sdf"]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("scene.sdf:6:20: error: `{{ANGLE_0}}` is a template placeholder"),
+        "{err}"
+    );
+}
