@@ -125,8 +125,10 @@ const ROWS: &[Row] = &[
     row("mesh shapes are skipped, and so are their transforms", concat!(head!(), "define shape obj teapot\ntransform teapot scale 2\n", tail!()),
         Diag(W, at(2, 14), "not supported")),
     // ----- materials -------------------------------------------------------------------
-    row("material with too few numbers", concat!(head!(), "define material m 1 1 1 1 1 1 1 1 1\n", tail!()),
-        Diag(E, at(2, 36), "needs 10 numbers")),
+    row("material with too few numbers", concat!(head!(), "define material m 1 1 1 1 1 1 1 1\n", tail!()),
+        Diag(E, at(2, 34), "needs 10 numbers")),
+    row("material without its exponent", concat!(head!(), "define material m 1 1 1 1 1 1 1 1 1\n", tail!()),
+        Diag(W, at(2, 36), "has no exponent m: read as 0")),
     row("material with too many numbers", concat!(head!(), "define material m 1 1 1 1 1 1 1 1 1 10 0 1 1 0.5\n", tail!()),
         Diag(E, at(2, 46), "too many numbers for a material: 14")),
     row("reflectivity above 1 is clamped", concat!(head!(), "define material m 1 1 1 1 1 1 1 1 1 10 1.5\n", tail!()),

@@ -176,3 +176,27 @@ fn a_template_placeholder_is_an_error_that_names_it() {
         "{err}"
     );
 }
+
+#[test]
+fn a_box_with_an_axis_after_its_corners_is_the_box() {
+    let image = read_with_warning(
+        &format!("define shape box b -1 -1 -6 1 1 -4 0 1 0 red\n{CAMERA}"),
+        "5:36",
+        "three numbers after the box's corners",
+    );
+    assert!(red_at(&image, 20, 15), "the box is not drawn");
+}
+
+#[test]
+fn a_material_without_its_exponent_is_read_with_m_0() {
+    // `[Ka] [Kd] [Ks]` and nothing more: m is what a stream reader leaves, 0.
+    let image = read_with_warning(
+        &format!(
+            "define material bare 0.2 0 0 1 0 0 0 0 0\n\
+             define shape sphere s 0 0 -5 1 bare\n{CAMERA}"
+        ),
+        "5:41",
+        "a material with 9 numbers has no exponent m: read as 0",
+    );
+    assert!(red_at(&image, 20, 15));
+}

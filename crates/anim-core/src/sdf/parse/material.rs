@@ -29,7 +29,17 @@ impl Parser<'_> {
             ));
         }
         let name = toks[2].text.to_string();
-        let nums = self.numbers(line, 3, toks.len())?;
+        let mut nums = self.numbers(line, 3, toks.len())?;
+        if nums.len() == 9 {
+            // What a C++ stream reader leaves in a number it finds no text for.
+            self.warn(
+                line,
+                At::End,
+                "a material with 9 numbers has no exponent m: read as 0, as a C++ stream reader leaves it",
+                Some(format!("canonical form: `{FORM_MATERIAL}`")),
+            );
+            nums.push(0.0);
+        }
         if nums.len() < 10 {
             return Err(self.error(
                 line,

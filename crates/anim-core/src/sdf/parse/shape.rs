@@ -284,7 +284,17 @@ impl Parser<'_> {
                 Some(layout.canonical()),
             ));
         }
-        let nums = self.numbers(line, nums_from, nums_to)?;
+        let mut nums = self.numbers(line, nums_from, nums_to)?;
+        if kind == "box" && nums.len() == BOX_WITH_AXIS {
+            // `[p1] [p2] [axis]`: renderers whose boxes carry an axis they never turn by.
+            self.warn(
+                line,
+                At::Span(nums_from + expected, nums_to - 1),
+                "three numbers after the box's corners (an axis, in renderers that write one) ignored",
+                Some(layout.canonical()),
+            );
+            nums.truncate(expected);
+        }
         if nums.len() != expected && Some(nums.len()) != layout.upright_numbers() {
             let at = if nums.len() > expected {
                 At::Span(nums_from + expected, nums_to - 1)
@@ -438,6 +448,9 @@ struct Layout {
     numbers_meaning: &'static str,
     form: &'static str,
 }
+
+/// Numbers of a box written `[p1] [p2] [axis]`.
+const BOX_WITH_AXIS: usize = 9;
 
 impl Layout {
     fn of(kind: &str) -> Layout {
