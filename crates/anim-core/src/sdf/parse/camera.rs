@@ -9,6 +9,10 @@ use glam::DVec3;
 
 const FORM_CAMERA: &str = "define camera <name> <fov-x> [eye] [dir] [up]";
 
+/// A horizontal field of view above this many degrees is more likely a mistake (a half fov,
+/// another unit) than a view anyone composes: it is warned of.
+const WIDE_FOV_DEG: f64 = 170.0;
+
 /// Whether a camera line's number can be an image side (a whole number of pixels).
 fn is_image_side(v: f64) -> bool {
     v.fract() == 0.0
@@ -298,6 +302,14 @@ impl Parser<'_> {
                 format!("the horizontal field of view must be {FOV_RULE}, found {fov}"),
                 Some(help),
             ));
+        }
+        if fov > WIDE_FOV_DEG {
+            self.warn(
+                line,
+                At::Tok(first),
+                format!("a field of view of {fov}° is nearly a half turn: the picture is stretched to its edges"),
+                Some("the fov is the full horizontal angle in degrees; 60 is a common view".into()),
+            );
         }
         if fov < std::f64::consts::PI {
             self.warn(

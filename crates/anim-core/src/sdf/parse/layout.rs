@@ -221,15 +221,21 @@ fn score(layout: &Layout, materials: &[Vec<f64>]) -> Option<f64> {
     Some(total)
 }
 
-/// Whether `layout` reads the material as a perfect mirror (reflectivity 1).
+/// Whether `layout` reads the material as a mirror that shows almost nothing of its own
+/// colour (reflectivity [`NEAR_PERFECT_MIRROR`] or more): in a file of such mirrors the
+/// image is the mirrors showing each other, black.
 fn perfect_mirror(layout: &Layout, extras: &[f64]) -> bool {
     layout.read(extras.len()).is_some_and(|slots| {
         slots
             .iter()
             .zip(extras)
-            .any(|(&slot, &v)| slot == F(R) && layout.value(slot, v) >= 1.0)
+            .any(|(&slot, &v)| slot == F(R) && layout.value(slot, v) >= NEAR_PERFECT_MIRROR)
     })
 }
+
+/// Reflectivity from which a mirror counts as perfect for the layout's plausibility: a
+/// 0.999 column read as reflectivity leaves a surface a thousandth of its colour.
+const NEAR_PERFECT_MIRROR: f64 = 0.99;
 
 /// Score taken per perfect mirror from a reading that makes most of a file's materials ones.
 const MIRROR_FILE_PENALTY: f64 = 2.0;
@@ -298,6 +304,19 @@ mod tests {
     fn plain_materials_keep_the_default() {
         assert_eq!(best(&[&[20.0], &[100.0]]), default_layout());
         assert_eq!(best(&[&[20.0, 0.5, 1.0, 1.0]]), default_layout());
+    }
+
+    #[test]
+    fn a_file_of_near_perfect_mirrors_is_read_another_way() {
+        // A 0.999 column read as reflectivity would leave every surface a mirror of black;
+        // read as opacity, the surfaces show their colours.
+        let l = best(&[&[20.0, 0.999], &[50.0, 0.999], &[10.0, 0.999]]);
+        assert!(!names(&l).starts_with("m reflectivity"), "{}", names(&l));
+        // One such mirror among plain materials is a showpiece, read as written.
+        assert_eq!(
+            best(&[&[20.0, 0.999], &[50.0, 0.2], &[10.0, 0.0]]),
+            default_layout()
+        );
     }
 
     #[test]
