@@ -200,3 +200,38 @@ fn a_material_without_its_exponent_is_read_with_m_0() {
     );
     assert!(red_at(&image, 20, 15));
 }
+
+#[test]
+fn a_camera_turned_as_the_course_framework_turns_it() {
+    // The assignment's extended example: turned like a shape, this camera looks away from
+    // the sphere; turned the opposite way, it looks at it.
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(
+        dir.join("scene.sdf"),
+        format!(
+            "{HEAD}define shape sphere s 0 0 -100 50 red\n\
+             define camera eye 60\n\
+             transform eye rotate -45 0 1 0\n\
+             transform eye translate 100 0 100\n\
+             render eye image.ppm 40 30\n"
+        ),
+    )
+    .unwrap();
+    let (code, err) = run(dir, &["render", "scene.sdf"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("scene.sdf:7:1: warning: camera `eye` turned the opposite way from a shape"),
+        "{err}"
+    );
+    let image = read_ppm(&dir.join("image.ppm"));
+    let lit = (0..40)
+        .flat_map(|x| (0..30).map(move |y| (x, y)))
+        .filter(|&(x, y)| red_at(&image, x, y))
+        .count();
+    assert!(lit > 40, "the sphere is not in view ({lit} red pixels)");
+    // Asked for by name, the camera turns like a shape and sees nothing.
+    let (code, err) = run(dir, &["check", "scene.sdf", "--transform-order", "world"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("would be blank"), "{err}");
+}

@@ -3,6 +3,7 @@
 //! through each camera with the renderer's own camera and queries: [`probe`]), with every
 //! diagnostic capped and quoted.
 
+mod camera_sense;
 pub mod probe;
 
 pub use crate::input::read_input;
@@ -113,12 +114,21 @@ fn finish_load<'t>(
     // generated frame says what it means), else by `conclude` for quoting.
     let mut text = Some(text);
     let mut text_read = None;
-    if may_need_other_order(&parsed.statements, &jobs, &built, opts) {
+    if may_need_another_reading(&parsed.statements, &jobs, &built, opts) {
         let t = text.take().and_then(|read| read());
         if !t.as_deref().is_some_and(sdf::is_generated_frame) {
-            if let Some(other) =
-                read_in_other_order(&parsed.statements, &parsed.omissions, &jobs, path, opts)
-            {
+            let (statements, omissions) = (&parsed.statements, &parsed.omissions);
+            // The camera's sense first: over the public corpus it shows what the other
+            // order shows, and more (load/camera_sense.rs).
+            let other = camera_sense::read_with_cameras_turned_back(
+                statements, omissions, &jobs, path, opts,
+            )
+            .or_else(|| {
+                is_composed(statements)
+                    .then(|| read_in_other_order(statements, omissions, &jobs, path, opts))
+                    .flatten()
+            });
+            if let Some(other) = other {
                 (jobs, built) = other;
             }
         }
@@ -142,10 +152,10 @@ fn finish_load<'t>(
     )
 }
 
-/// Whether the transform order of the file is worth trying the other way
-/// (`--transform-order auto`, docs/scene-language.md §7): some object has several transform
-/// operations (with one, the orders agree), and an image would be blank.
-fn may_need_other_order(
+/// Whether the file is worth reading another way (`--transform-order auto`,
+/// docs/scene-language.md §7): an image would be blank, and some object has several transform
+/// operations (with one, the orders agree) or some camera is turned.
+fn may_need_another_reading(
     statements: &[Statement],
     jobs: &[RenderJob],
     built: &[Diagnostic],
@@ -154,16 +164,46 @@ fn may_need_other_order(
     if !opts.infer_transform_order || opts.strict || built.iter().any(Diagnostic::is_error) {
         return false;
     }
+    (is_composed(statements) || camera_sense::turns_a_camera(statements))
+        && jobs.iter().any(|job| probe::blank_image(job).is_some())
+}
+
+/// Whether some object has several transform operations, so that their order matters.
+fn is_composed(statements: &[Statement]) -> bool {
     let mut ops: HashMap<&str, usize> = HashMap::new();
-    let composed = statements.iter().any(|s| match &s.kind {
+    statements.iter().any(|s| match &s.kind {
         StatementKind::Transform { target, ops: these } => {
             let n = ops.entry(target.name.as_str()).or_insert(0);
             *n += these.len();
             *n > 1
         }
         _ => false,
-    });
-    composed && jobs.iter().any(|job| probe::blank_image(job).is_some())
+    })
+}
+
+/// When `other` (the same file read another way) leaves fewer images blank than `jobs` and
+/// none blank that was not: the first image of `jobs` that is blank, with why.
+fn first_blank_shown_otherwise<'j>(
+    jobs: &'j [RenderJob],
+    other: &[RenderJob],
+) -> Option<(&'j RenderJob, String)> {
+    let blank: Vec<Option<probe::Blank>> = jobs.iter().map(probe::blank_image).collect();
+    let other_blank: Vec<bool> = other
+        .iter()
+        .map(|job| probe::blank_image(job).is_some())
+        .collect();
+    let newly_blank = blank
+        .iter()
+        .zip(&other_blank)
+        .any(|(was, now)| was.is_none() && *now);
+    let shown_before = blank.iter().filter(|b| b.is_none()).count();
+    let shown_after = other_blank.iter().filter(|&&b| !b).count();
+    if newly_blank || shown_after <= shown_before {
+        return None;
+    }
+    jobs.iter()
+        .zip(blank)
+        .find_map(|(job, b)| b.map(|b| (job, b.reason)))
 }
 
 /// The jobs and diagnostics of the file read in the other transform order, with a warning
@@ -195,24 +235,7 @@ fn read_in_other_order(
     if other_jobs.len() != jobs.len() || built.iter().any(Diagnostic::is_error) {
         return None;
     }
-    let blank: Vec<Option<probe::Blank>> = jobs.iter().map(probe::blank_image).collect();
-    let other_blank: Vec<bool> = other_jobs
-        .iter()
-        .map(|job| probe::blank_image(job).is_some())
-        .collect();
-    let newly_blank = blank
-        .iter()
-        .zip(&other_blank)
-        .any(|(was, now)| was.is_none() && *now);
-    let shown_before = blank.iter().filter(|b| b.is_none()).count();
-    let shown_after = other_blank.iter().filter(|&&b| !b).count();
-    if newly_blank || shown_after <= shown_before {
-        return None;
-    }
-    let (job, reason) = jobs
-        .iter()
-        .zip(&blank)
-        .find_map(|(job, b)| b.as_ref().map(|b| (job, &b.reason)))?;
+    let (job, reason) = first_blank_shown_otherwise(jobs, &other_jobs)?;
     let at = statements
         .iter()
         .find(|s| matches!(s.kind, StatementKind::Transform { .. }))
@@ -394,12 +417,41 @@ render eye image.ppm 48 32
             .any(|d| d.message.contains("transforms composed as M ← M·T"))
     }
 
+    fn camera_turned_back(loaded: &Loaded) -> bool {
+        loaded
+            .diagnostics
+            .iter()
+            .any(|d| d.message.contains("turned the opposite way from a shape"))
+    }
+
+    /// A sphere moved and then turned out of the view, in the standard order; turned in
+    /// place and then moved, in the other.
+    const SHAPE_ORDER: &str = "define material red 1 0 0 1 0 0 1 0 0 10
+define shape sphere s 0 0 0 1 red
+define light sun 0 5 5 1 1 1 1
+define camera eye 60
+transform s translate 0 0 -5
+transform s rotate 90 0 1 0
+render eye image.ppm 48 32
+";
+
     #[test]
     fn a_file_blank_in_the_standard_order_is_read_the_other_way() {
-        let standard = load(EXTENDED, false);
+        let standard = load(SHAPE_ORDER, false);
         assert!(blank(&standard) && !warned(&standard));
-        let inferred = load(EXTENDED, true);
+        let inferred = load(SHAPE_ORDER, true);
         assert!(!blank(&inferred) && warned(&inferred));
+        assert!(!camera_turned_back(&inferred));
+    }
+
+    #[test]
+    fn a_camera_that_sees_nothing_is_turned_the_course_frameworks_way_first() {
+        let standard = load(EXTENDED, false);
+        assert!(blank(&standard) && !camera_turned_back(&standard));
+        let inferred = load(EXTENDED, true);
+        assert!(!blank(&inferred) && camera_turned_back(&inferred));
+        // The other order would show it too; the camera's sense is tried first.
+        assert!(!warned(&inferred));
     }
 
     #[test]
@@ -411,7 +463,7 @@ render eye image.ppm 48 32
         );
         assert_ne!(text, EXTENDED);
         let loaded = load(&text, true);
-        assert!(!warned(&loaded));
+        assert!(!warned(&loaded) && !camera_turned_back(&loaded));
     }
 
     #[test]
@@ -422,6 +474,6 @@ render eye image.ppm 48 32
         );
         assert!(sdf::is_generated_frame(&text));
         let loaded = load(&text, true);
-        assert!(blank(&loaded) && !warned(&loaded));
+        assert!(blank(&loaded) && !warned(&loaded) && !camera_turned_back(&loaded));
     }
 }
