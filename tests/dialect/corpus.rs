@@ -1,5 +1,5 @@
-//! Every real-world scene file of `../shared/corpus/wild` either loads or is rejected with
-//! located errors, and none makes the reader panic.
+//! Every real-world scene file of the public sets (`../shared/corpus/wild` and `wild2`) either
+//! loads or is rejected with located errors, and none makes the reader panic.
 
 use crate::common;
 
@@ -7,6 +7,20 @@ use anim_core::diag::Diagnostic;
 use anim_core::load::load_file;
 use anim_core::sdf::LoadOptions;
 use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// The public sets of real files, below `corpus`.
+const SETS: [&str; 2] = ["wild", "wild2"];
+
+/// Every scene file of the public sets (their MANIFEST.tsv aside), sorted.
+fn corpus_files(corpus: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut files = Vec::new();
+    for set in SETS {
+        common::files_below(&corpus.join(set), &mut files);
+    }
+    files.retain(|f| f.file_name().is_some_and(|n| n != "MANIFEST.tsv"));
+    files.sort();
+    files
+}
 
 /// Whether a file-wide diagnostic (no line) is about reading the file rather than its text.
 fn is_io_problem(d: &Diagnostic) -> bool {
@@ -18,12 +32,9 @@ fn every_corpus_file_loads_or_is_rejected_with_located_errors() {
     let Some(shared) = common::shared_dir("corpus") else {
         return;
     };
-    let corpus = shared.join("corpus/wild");
+    let corpus = shared.join("corpus");
     let dir = corpus.as_path();
-    let mut files = Vec::new();
-    common::files_below(dir, &mut files);
-    files.retain(|f| f.file_name().is_some_and(|n| n != "MANIFEST.tsv"));
-    files.sort();
+    let files = corpus_files(dir);
     assert!(!files.is_empty(), "the corpus folder holds no files");
 
     let opts = LoadOptions::default();
@@ -71,12 +82,9 @@ fn canonical_text_of_corpus_files_loads_to_the_same_jobs() {
     let Some(shared) = common::shared_dir("corpus") else {
         return;
     };
-    let corpus = shared.join("corpus/wild");
+    let corpus = shared.join("corpus");
     let dir = corpus.as_path();
-    let mut files = Vec::new();
-    common::files_below(dir, &mut files);
-    files.retain(|f| f.file_name().is_some_and(|n| n != "MANIFEST.tsv"));
-    files.sort();
+    let files = corpus_files(dir);
     let opts = LoadOptions::default();
     let mut compared = 0;
     for file in &files {
@@ -137,49 +145,58 @@ fn canonical_text_of_corpus_files_loads_to_the_same_jobs() {
     println!("{compared} corpus files round-trip through their canonical text");
 }
 
-/// The corpus summary of `anim check --summary` (BENCHMARKS.md §8) as a regression test: how
-/// many files render an image that is not blank, render blank (each with its reason) or are
-/// rejected, over the 83 distinct files and over all 154 with their `.fake.sdf` twins. A
-/// change in these numbers is a change in what the reader accepts: update them with §8.
+/// The corpus summary of `anim check --summary` (BENCHMARKS.md, "The public corpus") as a
+/// regression test: how many files of each public set render an image that is not blank,
+/// render blank (each with its reason) or are rejected, over its distinct files and over all
+/// of them with their `.fake.sdf` twins. A change in these numbers is a change in what the
+/// reader accepts: update them with BENCHMARKS.md.
 #[test]
 fn corpus_summary_counts() {
     use anim_core::load::probe::{classify, Classification};
     let Some(shared) = common::shared_dir("corpus_summary_counts") else {
         return;
     };
-    let dir = shared.join("corpus/wild");
-    let mut files = Vec::new();
-    common::files_below(&dir, &mut files);
-    files.retain(|f| f.file_name().is_some_and(|n| n != "MANIFEST.tsv"));
     // The command line's defaults: both the material layout and the transform order inferred.
     let opts = LoadOptions {
         material_fields: anim_core::sdf::MaterialLayout::Auto,
         infer_transform_order: true,
         ..LoadOptions::default()
     };
-    // [renders, blank, rejected] over all files, then over the distinct ones.
-    let (mut all, mut distinct) = ([0usize; 3], [0usize; 3]);
-    let mut silent = Vec::new();
-    for file in &files {
-        let k = match classify(file, &opts) {
-            Classification::Renders => 0,
-            Classification::BlankExplained(why) => {
-                if why.is_empty() {
-                    silent.push(file.display().to_string());
+    // Per set, [renders, blank, rejected] of the distinct files, then of all files.
+    let expected = [
+        ("wild", ([73, 8, 2], [136, 13, 5])),
+        ("wild2", ([51, 18, 2], [51, 18, 2])),
+    ];
+    for (set, counts) in expected {
+        let mut files = Vec::new();
+        common::files_below(&shared.join("corpus").join(set), &mut files);
+        files.retain(|f| f.file_name().is_some_and(|n| n != "MANIFEST.tsv"));
+        let (mut all, mut distinct) = ([0usize; 3], [0usize; 3]);
+        let mut silent = Vec::new();
+        for file in &files {
+            let k = match classify(file, &opts) {
+                Classification::Renders => 0,
+                Classification::BlankExplained(why) => {
+                    if why.is_empty() {
+                        silent.push(file.display().to_string());
+                    }
+                    1
                 }
-                1
+                Classification::Rejected(_) => 2,
+            };
+            all[k] += 1;
+            if !file.to_string_lossy().ends_with(".fake.sdf") {
+                distinct[k] += 1;
             }
-            Classification::Rejected(_) => 2,
-        };
-        all[k] += 1;
-        if !file.to_string_lossy().ends_with(".fake.sdf") {
-            distinct[k] += 1;
         }
+        assert!(
+            silent.is_empty(),
+            "{set}: blank without a reason: {silent:?}"
+        );
+        assert_eq!(
+            (distinct, all),
+            counts,
+            "{set}: [renders, blank, rejected] of the distinct files, then of all files"
+        );
     }
-    assert!(silent.is_empty(), "blank without a reason: {silent:?}");
-    assert_eq!(
-        (distinct, all),
-        ([73, 8, 2], [136, 13, 5]),
-        "[renders, blank, rejected] of the distinct files, then of all files"
-    );
 }

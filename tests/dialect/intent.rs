@@ -17,16 +17,22 @@ fn auto() -> LoadOptions {
     }
 }
 
+/// The files of both public sets, `corpus/wild` and `corpus/wild2`.
 fn corpus_files(test: &str) -> Option<Vec<PathBuf>> {
-    let dir = shared_dir(test)?.join("corpus/wild");
+    let shared = shared_dir(test)?;
     let mut files = Vec::new();
-    for entry in std::fs::read_dir(&dir).ok()?.flatten() {
-        for file in std::fs::read_dir(entry.path())
-            .into_iter()
-            .flatten()
+    for set in ["wild", "wild2"] {
+        for entry in std::fs::read_dir(shared.join("corpus").join(set))
+            .ok()?
             .flatten()
         {
-            files.push(file.path());
+            for file in std::fs::read_dir(entry.path())
+                .into_iter()
+                .flatten()
+                .flatten()
+            {
+                files.push(file.path());
+            }
         }
     }
     files.sort();

@@ -28,6 +28,7 @@ fn every_loadable_scene_renders_finite_pixels() {
     scene_files(&root.join("animations"), &mut files);
     if let Some(shared) = common::shared_dir("finite pixels (corpus part)") {
         scene_files(&shared.join("corpus/wild"), &mut files);
+        scene_files(&shared.join("corpus/wild2"), &mut files);
     }
     files.sort();
     let settings = RenderSettings {

@@ -155,15 +155,18 @@ fn every_scene_renders_the_pixels_of_the_golden_manifest() {
     scenes.extend(generated_frames(root, frames_root.path()));
     let shared = shared_dir("golden manifest (corpus part)");
     if let Some(shared) = &shared {
-        let corpus = shared.join("corpus/wild");
-        let mut files = Vec::new();
-        common::files_below(&corpus, &mut files);
-        for f in files
-            .into_iter()
-            .filter(|f| f.file_name().is_some_and(|n| n != "MANIFEST.tsv"))
-        {
-            let label = format!("corpus/{}", f.strip_prefix(&corpus).unwrap().display());
-            scenes.push((label, f));
+        // The first public set is labelled `corpus/`, the second `corpus-wild2/`.
+        for (set, prefix) in [("wild", "corpus"), ("wild2", "corpus-wild2")] {
+            let corpus = shared.join("corpus").join(set);
+            let mut files = Vec::new();
+            common::files_below(&corpus, &mut files);
+            for f in files
+                .into_iter()
+                .filter(|f| f.file_name().is_some_and(|n| n != "MANIFEST.tsv"))
+            {
+                let label = format!("{prefix}/{}", f.strip_prefix(&corpus).unwrap().display());
+                scenes.push((label, f));
+            }
         }
     }
     scenes.sort();
@@ -185,7 +188,7 @@ fn every_scene_renders_the_pixels_of_the_golden_manifest() {
         std::fs::read_to_string(MANIFEST).expect("tests/images/golden/manifest.tsv exists");
     let expected: Vec<&str> = expected
         .lines()
-        .filter(|l| shared.is_some() || !l.starts_with("corpus/"))
+        .filter(|l| shared.is_some() || !l.starts_with("corpus"))
         .collect();
     let actual: Vec<&str> = actual.lines().collect();
     let missing: Vec<&&str> = expected.iter().filter(|l| !actual.contains(l)).collect();
