@@ -6,7 +6,7 @@
 Each `.sdf` and `.txt` file (MANIFEST.tsv aside) is rendered with `anim render --width 96
 --height 72 --spp 1` into a temporary folder; its first image goes into a grid, labelled with
 the file's path below the folder given and how anim judged it: a red label for a file anim
-refused, orange for an image `anim check` calls blank, so a person sees at a glance which
+refused, orange for an image anim calls blank or nearly one colour, so a person sees at a glance which
 files look wrong. Needs Pillow (`pip install pillow`). The sheet is an output: keep it out of
 git.
 """
@@ -47,7 +47,8 @@ def render(anim, scene, out):
     ) if os.path.isdir(out) else []
     if run.returncode != 0 or not images:
         return None, "refused"
-    return images[0], "blank" if "would be blank" in run.stderr else "ok"
+    blank = "would be blank" in run.stderr or "is one colour over" in run.stderr
+    return images[0], "blank" if blank else "ok"
 
 
 def main():

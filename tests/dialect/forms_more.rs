@@ -235,3 +235,42 @@ fn a_camera_turned_as_the_course_framework_turns_it() {
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("would be blank"), "{err}");
 }
+
+/// `anim render` of `body` after the materials and light: its stderr.
+fn render_warnings(body: &str) -> String {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(dir.join("scene.sdf"), format!("{HEAD}{body}")).unwrap();
+    let (code, err) = run(dir, &["render", "scene.sdf"]);
+    assert_eq!(code, 0, "{err}");
+    err
+}
+
+#[test]
+fn an_image_of_nearly_one_colour_says_why() {
+    // The camera inside a sphere that only the ambient light shows (the light is outside):
+    // all one colour, but not black.
+    let err = render_warnings(&format!("define shape sphere big 0 0 0 5 red\n{CAMERA}"));
+    assert!(
+        err.contains(
+            "is one colour over 100.0 % of its pixels: the camera is inside an object `big`"
+        ),
+        "{err}"
+    );
+    // A speck far away.
+    let err = render_warnings(&format!(
+        "define shape sphere speck 0 0 -30 1 red\n{CAMERA}"
+    ));
+    assert!(err.contains("cover almost none of it"), "{err}");
+    // A field of view of one degree (radians were meant) on a surface of one colour.
+    let err = render_warnings(
+        "define material flat 1 0 0 0 0 0 0 0 0 1\n\
+         define shape sphere s 0 0 -5 1 flat\n\
+         define camera eye 1 0 0 0 0 0 -1 0 1 0\n\
+         render eye image.ppm 40 30\n",
+    );
+    assert!(err.contains("under 2° (radians? 1 rad is 57.3°)"), "{err}");
+    // A picture with something in it says nothing of the kind.
+    let err = render_warnings(&format!("define shape sphere s 0 0 -5 1 red\n{CAMERA}"));
+    assert!(!err.contains("one colour"), "{err}");
+}

@@ -12,12 +12,13 @@ use crate::diag::{Diagnostic, Loc, Severity};
 use crate::math::{reflect, Ray};
 use crate::render::camera::PinholeCamera;
 use crate::render::compile::{Occlusion, RayHint, RenderScene};
+use crate::render::film::{tone_map_u8, HdrImage};
 use crate::render::geometry::{PrimId, Scratch, SurfaceHit};
 use crate::render::shading::ShadeMaterial;
 use crate::render::Prepared;
 use crate::scene::{Camera, RenderJob, Scene};
 use crate::sdf::LoadOptions;
-use glam::Vec3A;
+use glam::{Vec3, Vec3A};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -252,18 +253,22 @@ impl<'p> Probe<'p> {
 
     /// The camera is inside an object: which one, as the middle ray meets it.
     fn inside_reason(&self) -> String {
+        let name = self.middle_object_name();
+        format!(
+            "the camera is inside an object{name}: every ray meets its inside, which no light reaches"
+        )
+    }
+
+    /// ` `name`` of the object the middle ray meets first, or nothing.
+    fn middle_object_name(&self) -> String {
         let middle = &self.rays[self.rays.len() / 2];
         let geometry = &self.compiled.geometry;
-        let name = self
-            .nearest(middle, f32::INFINITY)
+        self.nearest(middle, f32::INFINITY)
             .and_then(|h| geometry.source(h.prim))
             .and_then(|k| self.scene.instances.get(k as usize))
             .map_or(String::new(), |inst| {
                 format!(" `{}`", self.scene.instance_name(inst))
-            });
-        format!(
-            "the camera is inside an object{name}: every ray meets its inside, which no light reaches"
-        )
+            })
     }
 
     /// Something shows, but nothing lit: mirrors of nothing, no light, or all in shadow.
@@ -419,6 +424,93 @@ pub fn blank_warning(job: &RenderJob, blank: &Blank, path: &Path) -> Diagnostic 
     Diagnostic::new(Severity::Warning, loc, message)
 }
 
+/// Share of an image's pixels that one colour may cover before a person sees nothing in it.
+pub const ONE_COLOUR_SHARE: f64 = 0.99;
+
+/// The share of `image`'s pixels (as the 8-bit file holds them) that its most common colour
+/// covers, when that is at least [`ONE_COLOUR_SHARE`]. Such a colour is one of nine pixels
+/// spread over the image (corners, edge middles, centre): no more than 1 % of the pixels can
+/// hide it from all nine, so one pass comparing with those nine finds it.
+pub fn one_colour_share(image: &HdrImage) -> Option<f64> {
+    let (w, h) = (image.width as usize, image.height as usize);
+    let rgb = |p: Vec3| [tone_map_u8(p.x), tone_map_u8(p.y), tone_map_u8(p.z)];
+    let mut candidates: Vec<[u8; 3]> = Vec::with_capacity(9);
+    for y in [0, h / 2, h.saturating_sub(1)] {
+        for x in [0, w / 2, w.saturating_sub(1)] {
+            let c = rgb(*image.pixels.get(y * w + x)?);
+            if !candidates.contains(&c) {
+                candidates.push(c);
+            }
+        }
+    }
+    let mut counts = vec![0usize; candidates.len()];
+    for &p in &image.pixels {
+        let c = rgb(p);
+        if let Some(k) = candidates.iter().position(|&d| d == c) {
+            counts[k] += 1;
+        }
+    }
+    let share = *counts.iter().max()? as f64 / image.pixels.len() as f64;
+    (share >= ONE_COLOUR_SHARE).then_some(share)
+}
+
+/// Why the rendered `image` of a prepared job is one colour over nearly all of it, when it
+/// is and the probe did not find it blank already (its warning says why then).
+pub fn one_colour(prepared: &Prepared, image: &HdrImage) -> Option<(f64, String)> {
+    let share = one_colour_share(image)?;
+    let camera = &prepared.job().camera;
+    if camera.fov_x_deg < NARROW_FOV_DEG {
+        let reason = format!(
+            "camera `{}` has a field of view of {}°, under {NARROW_FOV_DEG}° (radians? {} rad is {:.1}°)",
+            camera.name,
+            camera.fov_x_deg,
+            camera.fov_x_deg,
+            camera.fov_x_deg.to_degrees()
+        );
+        return Some((share, reason));
+    }
+    let probe = Probe::new(prepared)?;
+    let hits: Vec<Option<Hit>> = probe
+        .rays
+        .iter()
+        .map(|r| probe.nearest(r, f32::INFINITY))
+        .collect();
+    let covered = hits.iter().filter(|h| h.is_some()).count() as f64 / hits.len().max(1) as f64;
+    let reason = if !hits.is_empty() && hits.iter().all(|h| h.as_ref().is_some_and(|h| h.inside)) {
+        let name = probe.middle_object_name();
+        format!("the camera is inside an object{name}, whose inside fills the view")
+    } else if covered < 0.02 {
+        format!(
+            "the shapes in the view of camera `{}` cover almost none of it: they are small or far away",
+            camera.name
+        )
+    } else if covered > 0.98 {
+        format!("one surface fills the view of camera `{}`", camera.name)
+    } else {
+        "the shapes in view are drawn in the background's colour (unlit, or mirrors that show nothing)"
+            .to_string()
+    };
+    Some((share, reason))
+}
+
+/// A field of view under this many degrees shows almost nothing of a scene.
+const NARROW_FOV_DEG: f64 = 2.0;
+
+/// The warning that `job`'s rendered image is one colour over `share` of its pixels.
+pub fn one_colour_warning(job: &RenderJob, share: f64, reason: &str, path: &Path) -> Diagnostic {
+    let loc = job.loc.clone().unwrap_or_else(|| Loc {
+        file: Arc::from(path),
+        line: 1,
+        col: 1,
+    });
+    let message = format!(
+        "the image `{}` is one colour over {:.1} % of its pixels: {reason}",
+        job.output.display(),
+        share * 100.0
+    );
+    Diagnostic::new(Severity::Warning, loc, message)
+}
+
 /// How a file fares, for `anim check --summary`.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Classification {
@@ -450,6 +542,25 @@ pub fn classify(path: &Path, opts: &LoadOptions) -> Classification {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_share_of_the_most_common_colour_is_counted_exactly() {
+        // 100 × 10 pixels of background with `n` lit ones in the middle row.
+        let image = |n: usize| {
+            let mut pixels = vec![Vec3::ZERO; 1000];
+            for p in &mut pixels[500..500 + n] {
+                *p = Vec3::ONE;
+            }
+            HdrImage {
+                width: 100,
+                height: 10,
+                pixels,
+            }
+        };
+        assert_eq!(one_colour_share(&image(0)), Some(1.0));
+        assert_eq!(one_colour_share(&image(10)), Some(0.99));
+        assert_eq!(one_colour_share(&image(11)), None);
+    }
     use crate::load::load_str;
 
     fn probe(text: &str) -> Option<String> {

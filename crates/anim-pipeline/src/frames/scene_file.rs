@@ -369,8 +369,9 @@ fn render_jobs(
                 .unwrap_or_default(),
         );
         let prepared = Prepared::new(job);
-        if let Some(blank) = probe::blank_image_of(&prepared) {
-            blanks.push(probe::blank_warning(job, &blank, path));
+        let blank = probe::blank_image_of(&prepared);
+        if let Some(blank) = &blank {
+            blanks.push(probe::blank_warning(job, blank, path));
         }
         let Rendered {
             image,
@@ -396,6 +397,12 @@ fn render_jobs(
                 return Err(());
             }
         };
+        if blank.is_none() {
+            // Something shows, yet a person may see nothing: say why.
+            if let Some((share, reason)) = probe::one_colour(&prepared, &image) {
+                blanks.push(probe::one_colour_warning(job, share, &reason, path));
+            }
+        }
         for d in dropped {
             let message = format!(
                 "shape '{}' is degenerate once transformed (too thin or too small to intersect) and is not drawn",
