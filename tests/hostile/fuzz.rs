@@ -1,7 +1,8 @@
 //! A stable-Rust fuzz harness for the readers of user text: the SDF reader (parse and build,
 //! no rendering; frame files with `motion` lines among its seeds), the RON keyframe spec
-//! reader (parse, then validate against a small base scene) and the OBJ mesh reader (scan,
-//! `tobj`, the mesh and its hierarchy). See FUZZING.md; `scripts/fuzz.sh` runs it.
+//! reader (parse, then validate against a small base scene), the OBJ mesh reader (scan,
+//! `tobj`, the mesh and its hierarchy) and `include` (a scene cut in two files, the second
+//! including the first, sometimes round a loop). See FUZZING.md; `scripts/fuzz.sh` runs it.
 //!
 //! Deterministic: the inputs are mutations of seed files (the shared corpus, `scenes/`,
 //! `animations/`) drawn from the seeded `SplitMix64` of `anim_core::util`, so a run is reproduced by its seed
@@ -138,6 +139,8 @@ enum Target {
     Sdf,
     Spec,
     Obj,
+    /// A scene cut in two files, the second including the first.
+    Include,
 }
 
 /// Seeds written here, so that every run has them whatever the corpus holds: frames with the
@@ -415,6 +418,7 @@ fn execute(target: Target, input: &[u8], variant: u64, base: &BaseScene) {
                 );
             }
         }
+        Target::Include => included(input, variant),
         Target::Spec => {
             let src = Source::new(Path::new("fuzz.ron"), text.into_owned());
             if let Ok(file) = spec::parse(&src) {
@@ -440,6 +444,43 @@ fn execute(target: Target, input: &[u8], variant: u64, base: &BaseScene) {
                 }
             }
         }
+    }
+}
+
+/// An input cut in two files of a folder of their own: `main.sdf` includes `part.sdfi` (the
+/// input's head), then holds its tail; the part sometimes ends by including main (a loop),
+/// itself, its folder or a file outside it.
+fn included(input: &[u8], variant: u64) {
+    static INPUTS: AtomicU64 = AtomicU64::new(0);
+    let n = INPUTS.fetch_add(1, Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("anim-fuzz-include-{}-{n}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary folder");
+    let cut = (variant as usize / 4) % (input.len() + 1);
+    let (head, tail) = input.split_at(cut);
+    let mut part = head.to_vec();
+    let ending: &[u8] = match (variant / 4 / 65536) % 5 {
+        0 => b"\ninclude main.sdf\n",
+        1 => b"\ninclude part.sdfi\n",
+        2 => b"\ninclude .\n",
+        3 => b"\ninclude ../outside.sdf\n",
+        _ => b"",
+    };
+    part.extend_from_slice(ending);
+    std::fs::write(dir.join("part.sdfi"), &part).expect("a temporary file");
+    let main = [b"include part.sdfi\n".as_slice(), tail].concat();
+    std::fs::write(dir.join("main.sdf"), main).expect("a temporary file");
+    let result = anim_core::load::load_file(&dir.join("main.sdf"), &LoadOptions::default());
+    let _ = std::fs::remove_dir_all(&dir);
+    let diagnostics = match &result {
+        Ok(loaded) => &loaded.diagnostics,
+        Err(d) => d,
+    };
+    for d in diagnostics {
+        let shown = d.to_string();
+        assert!(
+            !shown.contains('\u{1b}') && !shown.contains('\0'),
+            "a raw control byte reaches the terminal: {shown:?}"
+        );
     }
 }
 
@@ -585,10 +626,11 @@ fn record_panics() -> Arc<Mutex<String>> {
 
 /// The next input: a seed of the target chosen, mutated a few times with another seed.
 fn next_input(rng: &mut SplitMix64, seeds: &AllSeeds) -> (Target, Vec<u8>) {
-    // Three in five inputs are scenes: the SDF reader has far more paths than the others.
-    let (target, seeds) = match rng.below(5) {
+    // Half the inputs are scenes: the SDF reader has far more paths than the others.
+    let (target, seeds) = match rng.below(6) {
         0 => (Target::Spec, &seeds.spec),
         1 => (Target::Obj, &seeds.obj),
+        2 => (Target::Include, &seeds.sdf),
         _ => (Target::Sdf, &seeds.sdf),
     };
     let mut input = rng.pick(&seeds.files).clone();
@@ -681,6 +723,7 @@ fn save(settings: &Settings, kind: &str, exec: u64, target: Target, input: &[u8]
         Target::Sdf => "sdf",
         Target::Spec => "ron",
         Target::Obj => "obj",
+        Target::Include => "include.sdf",
     };
     let _ = std::fs::create_dir_all(&settings.out);
     let path = settings
