@@ -175,6 +175,18 @@ fn a_template_placeholder_is_an_error_that_names_it() {
         err.contains("scene.sdf:6:20: error: `{{ANGLE_0}}` is a template placeholder"),
         "{err}"
     );
+    // Written with spaces inside, it is named whole.
+    std::fs::write(
+        dir.join("spaced.sdf"),
+        format!("{HEAD}define shape sphere s 0 0 {{{{ Z }}}} 1 red\n{CAMERA}"),
+    )
+    .unwrap();
+    let (code, err) = run(dir, &["check", "spaced.sdf"]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("spaced.sdf:5:27: error: `{{ Z }}` is a template placeholder"),
+        "{err}"
+    );
 }
 
 #[test]

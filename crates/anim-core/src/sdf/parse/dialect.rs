@@ -11,17 +11,32 @@ impl Parser<'_> {
     /// cannot be read at all.
     pub(super) fn normalise<'t>(&mut self, line: &Line<'t>) -> Option<Line<'t>> {
         if let Some(i) = line.tokens.iter().position(|t| t.text.contains("{{")) {
-            let text = line.tokens[i].text;
-            let start = text.find("{{").unwrap_or(0);
-            let end = text[start..]
-                .find("}}")
-                .map_or(text.len(), |e| start + e + 2);
+            // The placeholder may be written with spaces inside, `{{ NAME }}`: it runs to the
+            // token that closes it (or to the end of its own token when none does).
+            let close = (i..line.tokens.len())
+                .find(|&j| {
+                    let t = line.tokens[j].text;
+                    let from = if j == i {
+                        t.find("{{").map_or(0, |s| s + 2)
+                    } else {
+                        0
+                    };
+                    t[from..].contains("}}")
+                })
+                .unwrap_or(i);
+            let words: Vec<&str> = line.tokens[i..=close].iter().map(|t| t.text).collect();
+            let joined = words.join(" ");
+            let start = joined.find("{{").unwrap_or(0);
+            let end = joined
+                .rfind("}}")
+                .filter(|&e| e >= start + 2)
+                .map_or(joined.len(), |e| e + 2);
             self.error(
                 line,
-                At::Tok(i),
+                At::Span(i, close),
                 format!(
                     "`{}` is a template placeholder: this file is a template that another program fills in before anything renders it",
-                    &text[start..end]
+                    &joined[start..end]
                 ),
                 Some("render the files that program writes, not the template".into()),
             );
