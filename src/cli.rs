@@ -48,7 +48,8 @@ pub struct SceneArgs {
     pub material_fields: Vec<Option<MaterialField>>,
     /// How a transform statement composes with earlier ones: `world` (M ← T·M), `local`
     /// (M ← M·T), or `auto`: world, unless the file's images would be blank that way and not
-    /// the other way (one warning says so).
+    /// with cameras turned the course framework's way (opposite to shapes) or in the other
+    /// order (one warning says which).
     #[arg(long, value_enum, default_value = "auto")]
     pub transform_order: TransformOrderArg,
     /// Largest scene file read, in bytes; larger files are refused unread.

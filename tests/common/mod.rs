@@ -54,6 +54,19 @@ pub fn anim() -> Command {
     Command::cargo_bin("anim").expect("the anim binary is built")
 }
 
+/// `anim ARGS...` run in `dir`: (exit code, stderr).
+pub fn run_in(dir: &Path, args: &[&str]) -> (i32, String) {
+    let out = anim()
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("anim runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
 /// Writes `sdf` to `dir/name` and renders it with `args`, images into `dir/out`.
 /// Returns the path of the output directory.
 pub fn render_in(dir: &Path, name: &str, sdf: &str, args: &[&str]) -> PathBuf {

@@ -3,8 +3,7 @@
 //! error under `--strict`, and an image that shows the scene. Template placeholders, which no
 //! reading can give a value, are a located error that names the placeholder.
 
-use crate::common::{anim, read_ppm};
-use std::path::Path;
+use crate::common::{read_ppm, run_in};
 
 const HEAD: &str = "\
 define material red 0.2 0 0 1 0 0 0.5 0.5 0.5 20
@@ -13,26 +12,13 @@ define light sun 0 10 10 1 1 1 1
 ambient 0.2 0.2 0.2
 ";
 
-/// `anim ARGS...` in `dir`: (exit code, stderr).
-fn run(dir: &Path, args: &[&str]) -> (i32, String) {
-    let out = anim()
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("anim runs");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 /// Loads `body` (after the materials and light) with a warning at `at` containing
 /// `reading`, refused under `--strict`; returns the 40×30 image it renders to `image.ppm`.
 fn read_with_warning(body: &str, at: &str, reading: &str) -> crate::common::Rgb8 {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     std::fs::write(dir.join("scene.sdf"), format!("{HEAD}{body}")).unwrap();
-    let (code, err) = run(dir, &["check", "scene.sdf"]);
+    let (code, err) = run_in(dir, &["check", "scene.sdf"]);
     assert_eq!(code, 0, "{err}");
     let wanted = format!("scene.sdf:{at}: warning: ");
     assert!(
@@ -40,9 +26,9 @@ fn read_with_warning(body: &str, at: &str, reading: &str) -> crate::common::Rgb8
             .any(|l| l.starts_with(&wanted) && l.contains(reading)),
         "no `{wanted}…{reading}` in\n{err}"
     );
-    let (code, err) = run(dir, &["check", "scene.sdf", "--strict"]);
+    let (code, err) = run_in(dir, &["check", "scene.sdf", "--strict"]);
     assert_ne!(code, 0, "--strict accepted it:\n{err}");
-    let (code, err) = run(dir, &["render", "scene.sdf", "--quiet"]);
+    let (code, err) = run_in(dir, &["render", "scene.sdf", "--quiet"]);
     assert_eq!(code, 0, "{err}");
     read_ppm(&dir.join("image.ppm"))
 }
@@ -88,7 +74,7 @@ fn amblight_is_the_ambient_light() {
         .to_string()
         + CAMERA;
     std::fs::write(dir.join("scene.sdf"), text).unwrap();
-    let (code, err) = run(dir, &["render", "scene.sdf"]);
+    let (code, err) = run_in(dir, &["render", "scene.sdf"]);
     assert_eq!(code, 0, "{err}");
     assert!(
         err.contains("scene.sdf:3:8: warning: `define amblight` read as `ambient`"),
@@ -169,7 +155,7 @@ fn a_template_placeholder_is_an_error_that_names_it() {
         ),
     )
     .unwrap();
-    let (code, err) = run(dir, &["check", "scene.sdf"]);
+    let (code, err) = run_in(dir, &["check", "scene.sdf"]);
     assert_ne!(code, 0);
     assert!(
         err.contains("scene.sdf:6:20: error: `{{ANGLE_0}}` is a template placeholder"),
@@ -181,7 +167,7 @@ fn a_template_placeholder_is_an_error_that_names_it() {
         format!("{HEAD}define shape sphere s 0 0 {{{{ Z }}}} 1 red\n{CAMERA}"),
     )
     .unwrap();
-    let (code, err) = run(dir, &["check", "spaced.sdf"]);
+    let (code, err) = run_in(dir, &["check", "spaced.sdf"]);
     assert_ne!(code, 0);
     assert!(
         err.contains("spaced.sdf:5:27: error: `{{ Z }}` is a template placeholder"),
@@ -230,7 +216,7 @@ fn a_camera_turned_as_the_course_framework_turns_it() {
         ),
     )
     .unwrap();
-    let (code, err) = run(dir, &["render", "scene.sdf"]);
+    let (code, err) = run_in(dir, &["render", "scene.sdf"]);
     assert_eq!(code, 0, "{err}");
     assert!(
         err.contains("scene.sdf:7:1: warning: camera `eye` turned the opposite way from a shape"),
@@ -243,7 +229,7 @@ fn a_camera_turned_as_the_course_framework_turns_it() {
         .count();
     assert!(lit > 40, "the sphere is not in view ({lit} red pixels)");
     // Asked for by name, the camera turns like a shape and sees nothing.
-    let (code, err) = run(dir, &["check", "scene.sdf", "--transform-order", "world"]);
+    let (code, err) = run_in(dir, &["check", "scene.sdf", "--transform-order", "world"]);
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("would be blank"), "{err}");
 }
@@ -253,7 +239,7 @@ fn render_warnings(body: &str) -> String {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     std::fs::write(dir.join("scene.sdf"), format!("{HEAD}{body}")).unwrap();
-    let (code, err) = run(dir, &["render", "scene.sdf"]);
+    let (code, err) = run_in(dir, &["render", "scene.sdf"]);
     assert_eq!(code, 0, "{err}");
     err
 }

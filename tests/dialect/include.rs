@@ -1,7 +1,7 @@
 //! `include <file>`: the statements of another file in place of the line, the same image as
 //! the file written out whole, and every way an include can go wrong refused at its line.
 
-use crate::common::anim;
+use crate::common::run_in;
 use std::path::Path;
 
 const MATERIALS: &str = "\
@@ -19,19 +19,6 @@ transform ball translate 0.5 0 0
 render cam image.ppm 48 32
 ";
 
-/// `anim ARGS...` in `dir`: (exit code, stderr).
-fn run(dir: &Path, args: &[&str]) -> (i32, String) {
-    let out = anim()
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("anim runs");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 fn write(dir: &Path, name: &str, text: &str) {
     let path = dir.join(name);
     std::fs::create_dir_all(path.parent().unwrap()).unwrap();
@@ -39,7 +26,7 @@ fn write(dir: &Path, name: &str, text: &str) {
 }
 
 fn render(dir: &Path, scene: &str, out: &str) -> Vec<u8> {
-    let (code, err) = run(dir, &["render", scene, "--out", out, "--quiet"]);
+    let (code, err) = run_in(dir, &["render", scene, "--out", out, "--quiet"]);
     assert_eq!(code, 0, "{err}");
     std::fs::read(dir.join(out).join("image.ppm")).unwrap()
 }
@@ -82,7 +69,7 @@ fn problems_in_an_included_file_are_located_in_it() {
         &format!("{MATERIALS}define shape sphere odd 0 0 -6 oops red\n"),
     );
     write(dir, "scene.sdf", &format!("include static.sdfi\n{FRAME}"));
-    let (code, err) = run(dir, &["check", "scene.sdf"]);
+    let (code, err) = run_in(dir, &["check", "scene.sdf"]);
     assert_ne!(code, 0, "{err}");
     assert!(err.contains("static.sdfi:3:"), "{err}");
     // The line is quoted from the included file.
@@ -127,7 +114,7 @@ fn every_bad_include_is_refused_at_its_line() {
     ];
     for (text, expected) in cases {
         write(dir, "case.sdf", &format!("{MATERIALS}\n{text}"));
-        let (code, err) = run(dir, &["check", "case.sdf"]);
+        let (code, err) = run_in(dir, &["check", "case.sdf"]);
         assert_ne!(code, 0, "{text}: {err}");
         let shifted = expected.replacen("1:", "4:", 1);
         let expected = if expected.starts_with("two.sdf") {
@@ -156,9 +143,9 @@ fn includes_nest_at_most_the_limit() {
         };
         write(dir, &format!("d{i}.sdf"), &text);
     }
-    let (code, err) = run(dir, &["check", "d1.sdf"]);
+    let (code, err) = run_in(dir, &["check", "d1.sdf"]);
     assert_eq!(code, 0, "{depth} files nest: {err}");
-    let (code, err) = run(dir, &["check", "d0.sdf"]);
+    let (code, err) = run_in(dir, &["check", "d0.sdf"]);
     assert_ne!(code, 0);
     let last = depth - 1;
     assert!(
@@ -179,9 +166,9 @@ fn max_input_counts_a_file_and_everything_it_includes() {
     write(dir, "scene.sdf", &scene);
     let both = (big.len() + scene.len()).to_string();
     let less = (big.len() + scene.len() - 1).to_string();
-    let (code, err) = run(dir, &["check", "scene.sdf", "--max-input", &both]);
+    let (code, err) = run_in(dir, &["check", "scene.sdf", "--max-input", &both]);
     assert_eq!(code, 0, "{err}");
-    let (code, err) = run(dir, &["check", "scene.sdf", "--max-input", &less]);
+    let (code, err) = run_in(dir, &["check", "scene.sdf", "--max-input", &less]);
     assert_ne!(code, 0);
     assert!(err.contains("scene.sdf:1:9: error:"), "{err}");
     assert!(err.contains("--max-input"), "{err}");
@@ -199,7 +186,7 @@ fn a_named_pipe_is_refused_without_waiting() {
         return;
     }
     write(dir, "scene.sdf", &format!("include pipe.sdfi\n{FRAME}"));
-    let (code, err) = run(dir, &["check", "scene.sdf"]);
+    let (code, err) = run_in(dir, &["check", "scene.sdf"]);
     assert_ne!(code, 0);
     assert!(
         err.contains("scene.sdf:1:9: error: `pipe.sdfi` is not a regular file"),
@@ -225,17 +212,17 @@ fn files_outside_the_scene_folder_are_read_from_inside_the_current_directory_or_
         ),
     );
     // From the project: both files are inside the current directory.
-    let (code, err) = run(project, &["check", "scenes/scene.sdf"]);
+    let (code, err) = run_in(project, &["check", "scenes/scene.sdf"]);
     assert_eq!(code, 0, "{err}");
     // From the scene's own folder: both are outside the scene's folder and the current one.
     let scenes = project.join("scenes");
-    let (code, err) = run(&scenes, &["check", "scene.sdf"]);
+    let (code, err) = run_in(&scenes, &["check", "scene.sdf"]);
     assert_ne!(code, 0);
     assert!(
         err.contains("scene.sdf:1:9: error: `../shared/materials.sdf` is outside"),
         "{err}"
     );
-    let (code, err) = run(&scenes, &["check", "scene.sdf", "--allow-any-input"]);
+    let (code, err) = run_in(&scenes, &["check", "scene.sdf", "--allow-any-input"]);
     assert_eq!(code, 0, "{err}");
     // The mesh alone.
     write(
@@ -243,7 +230,7 @@ fn files_outside_the_scene_folder_are_read_from_inside_the_current_directory_or_
         "scenes/mesh.sdf",
         &format!("{MATERIALS}{SHAPES}define shape obj mesh ../shared/tri.obj red\n{FRAME}"),
     );
-    let (code, err) = run(&scenes, &["check", "mesh.sdf"]);
+    let (code, err) = run_in(&scenes, &["check", "mesh.sdf"]);
     assert_ne!(code, 0);
     assert!(
         err.contains("mesh.sdf:6:1: error: mesh file `../shared/tri.obj` is outside"),

@@ -387,19 +387,7 @@ fn execute(target: Target, input: &[u8], variant: u64, base: &BaseScene) {
                     ..LoadOptions::default()
                 },
             };
-            let result = load_str(&text, Path::new("fuzz.sdf"), &opts);
-            // Every message must format (the windowing and escaping of long or hostile lines).
-            let diagnostics = match &result {
-                Ok(loaded) => &loaded.diagnostics,
-                Err(d) => d,
-            };
-            for d in diagnostics {
-                let shown = d.to_string();
-                assert!(
-                    !shown.contains('\u{1b}') && !shown.contains('\0'),
-                    "a raw control byte reaches the terminal: {shown:?}"
-                );
-            }
+            assert_printable(&load_str(&text, Path::new("fuzz.sdf"), &opts));
         }
         Target::Obj => {
             // The mesh reader reads a file: each input gets its own, gone afterwards.
@@ -471,7 +459,13 @@ fn included(input: &[u8], variant: u64) {
     std::fs::write(dir.join("main.sdf"), main).expect("a temporary file");
     let result = anim_core::load::load_file(&dir.join("main.sdf"), &LoadOptions::default());
     let _ = std::fs::remove_dir_all(&dir);
-    let diagnostics = match &result {
+    assert_printable(&result);
+}
+
+/// Every message of a load formats (the windowing and escaping of long or hostile lines)
+/// and holds no raw ESC or NUL.
+fn assert_printable(result: &Result<anim_core::load::Loaded, Vec<anim_core::diag::Diagnostic>>) {
+    let diagnostics = match result {
         Ok(loaded) => &loaded.diagnostics,
         Err(d) => d,
     };

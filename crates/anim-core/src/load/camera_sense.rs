@@ -6,9 +6,9 @@
 //! file is also read with every camera rotation reversed, and that reading is taken (with a
 //! warning) when it shows more.
 
-use super::first_blank_shown_otherwise;
+use super::another_reading;
 use crate::diag::{Diagnostic, Severity};
-use crate::scene::{build_jobs, RenderJob};
+use crate::scene::RenderJob;
 use crate::sdf::ast::{Statement, StatementKind, TransformOp};
 use crate::sdf::{self, LoadOptions};
 use std::collections::HashSet;
@@ -76,21 +76,8 @@ pub(super) fn read_with_cameras_turned_back(
 ) -> Option<(Vec<RenderJob>, Vec<Diagnostic>)> {
     let turn = first_turn(statements)?;
     let reversed = turned_back(statements);
-    let other_opts = LoadOptions {
-        infer_transform_order: false,
-        ..opts.clone()
-    };
-    let (other_jobs, mut built) = build_jobs(
-        &reversed,
-        Default::default(),
-        path,
-        &other_opts,
-        Some(omissions),
-    );
-    if other_jobs.len() != jobs.len() || built.iter().any(Diagnostic::is_error) {
-        return None;
-    }
-    let (job, reason) = first_blank_shown_otherwise(jobs, &other_jobs)?;
+    let (other_jobs, mut built, job, reason) =
+        another_reading(&reversed, omissions, jobs, path, opts)?;
     let StatementKind::Transform { target, .. } = &turn.kind else {
         return None;
     };

@@ -181,12 +181,30 @@ fn is_composed(statements: &[Statement]) -> bool {
     })
 }
 
-/// When `other` (the same file read another way) leaves fewer images blank than `jobs` and
-/// none blank that was not: the first image of `jobs` that is blank, with why.
-fn first_blank_shown_otherwise<'j>(
+/// The file's `statements` built again with `other_opts` (nothing inferred), when that
+/// reading leaves fewer images blank than `jobs` and none blank that was not: its jobs and
+/// diagnostics, and the first image of `jobs` that is blank, with why.
+fn another_reading<'j>(
+    statements: &[Statement],
+    omissions: &sdf::Omissions,
     jobs: &'j [RenderJob],
-    other: &[RenderJob],
-) -> Option<(&'j RenderJob, String)> {
+    path: &Path,
+    other_opts: &LoadOptions,
+) -> Option<(Vec<RenderJob>, Vec<Diagnostic>, &'j RenderJob, String)> {
+    let other_opts = LoadOptions {
+        infer_transform_order: false,
+        ..other_opts.clone()
+    };
+    let (other, built) = build_jobs(
+        statements,
+        Default::default(),
+        path,
+        &other_opts,
+        Some(omissions),
+    );
+    if other.len() != jobs.len() || built.iter().any(Diagnostic::is_error) {
+        return None;
+    }
     let blank: Vec<Option<probe::Blank>> = jobs.iter().map(probe::blank_image).collect();
     let other_blank: Vec<bool> = other
         .iter()
@@ -201,9 +219,11 @@ fn first_blank_shown_otherwise<'j>(
     if newly_blank || shown_after <= shown_before {
         return None;
     }
-    jobs.iter()
+    let (job, reason) = jobs
+        .iter()
         .zip(blank)
-        .find_map(|(job, b)| b.map(|b| (job, b.reason)))
+        .find_map(|(job, b)| b.map(|b| (job, b.reason)))?;
+    Some((other, built, job, reason))
 }
 
 /// The jobs and diagnostics of the file read in the other transform order, with a warning
@@ -222,20 +242,10 @@ fn read_in_other_order(
     };
     let other_opts = LoadOptions {
         transform_order: other,
-        infer_transform_order: false,
         ..opts.clone()
     };
-    let (other_jobs, mut built) = build_jobs(
-        statements,
-        Default::default(),
-        path,
-        &other_opts,
-        Some(omissions),
-    );
-    if other_jobs.len() != jobs.len() || built.iter().any(Diagnostic::is_error) {
-        return None;
-    }
-    let (job, reason) = first_blank_shown_otherwise(jobs, &other_jobs)?;
+    let (other_jobs, mut built, job, reason) =
+        another_reading(statements, omissions, jobs, path, &other_opts)?;
     let at = statements
         .iter()
         .find(|s| matches!(s.kind, StatementKind::Transform { .. }))

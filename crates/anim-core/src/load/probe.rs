@@ -411,16 +411,19 @@ pub fn blank_image_warnings(jobs: &[RenderJob], path: &Path) -> Vec<Diagnostic> 
 
 /// The warning that `job`'s image would be blank, for `blank`'s reason.
 pub fn blank_warning(job: &RenderJob, blank: &Blank, path: &Path) -> Diagnostic {
+    let what = format!("would be blank: {}", blank.reason);
+    image_warning(job, &what, path)
+}
+
+/// A warning about `job`'s image (`the image `NAME` WHAT`), at its render line, or the
+/// file's first line for the image of a file without one.
+fn image_warning(job: &RenderJob, what: &str, path: &Path) -> Diagnostic {
     let loc = job.loc.clone().unwrap_or_else(|| Loc {
         file: Arc::from(path),
         line: 1,
         col: 1,
     });
-    let message = format!(
-        "the image `{}` would be blank: {}",
-        job.output.display(),
-        blank.reason
-    );
+    let message = format!("the image `{}` {what}", job.output.display());
     Diagnostic::new(Severity::Warning, loc, message)
 }
 
@@ -498,17 +501,11 @@ const NARROW_FOV_DEG: f64 = 2.0;
 
 /// The warning that `job`'s rendered image is one colour over `share` of its pixels.
 pub fn one_colour_warning(job: &RenderJob, share: f64, reason: &str, path: &Path) -> Diagnostic {
-    let loc = job.loc.clone().unwrap_or_else(|| Loc {
-        file: Arc::from(path),
-        line: 1,
-        col: 1,
-    });
-    let message = format!(
-        "the image `{}` is one colour over {:.1} % of its pixels: {reason}",
-        job.output.display(),
+    let what = format!(
+        "is one colour over {:.1} % of its pixels: {reason}",
         share * 100.0
     );
-    Diagnostic::new(Severity::Warning, loc, message)
+    image_warning(job, &what, path)
 }
 
 /// How a file fares, for `anim check --summary`.

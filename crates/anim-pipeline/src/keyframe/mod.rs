@@ -172,7 +172,7 @@ fn write_frames(
     // as they are written, so memory holds one frame a thread, however long the animation;
     // generation is deterministic, so what is written is what was checked.
     let generator = Generator::new(base, anim, src);
-    let groups = (!standalone).then(|| split::base_groups(&base.statements));
+    let groups = (!standalone).then(|| split::by_subject(&base.statements));
     let checked: Vec<Result<HashSet<String>, Vec<Diagnostic>>> = (0..anim.frames)
         .into_par_iter()
         .map(|i| check_frame(&generator, anim, src, dir, i, groups.as_ref()))

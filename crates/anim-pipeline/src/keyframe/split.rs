@@ -48,8 +48,9 @@ fn subject(kind: &StatementKind) -> &str {
     names(kind)[0]
 }
 
-/// The statements about each subject, in order.
-fn by_subject(statements: &[Statement]) -> HashMap<&str, Vec<&StatementKind>> {
+/// The statements about each subject, in order (of the base scene, for
+/// [`changed_subjects`]).
+pub fn by_subject(statements: &[Statement]) -> HashMap<&str, Vec<&StatementKind>> {
     let mut groups: HashMap<&str, Vec<&StatementKind>> = HashMap::new();
     for s in statements {
         groups.entry(subject(&s.kind)).or_default().push(&s.kind);
@@ -58,7 +59,7 @@ fn by_subject(statements: &[Statement]) -> HashMap<&str, Vec<&StatementKind>> {
 }
 
 /// The subjects whose statements in `frame` are not exactly the base scene's (`base`, from
-/// [`base_groups`]).
+/// [`by_subject`]).
 pub fn changed_subjects(
     base: &HashMap<&str, Vec<&StatementKind>>,
     frame: &[Statement],
@@ -75,11 +76,6 @@ pub fn changed_subjects(
             .map(|name| name.to_string()),
     );
     changed
-}
-
-/// The base scene's statements grouped by subject, for [`changed_subjects`].
-pub fn base_groups(base: &[Statement]) -> HashMap<&str, Vec<&StatementKind>> {
-    by_subject(base)
 }
 
 /// The static part of an animation: the subjects no frame changes.

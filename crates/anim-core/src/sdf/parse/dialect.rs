@@ -63,18 +63,16 @@ impl Parser<'_> {
             let in_numbers = between_numbers(i.checked_sub(1)) || between_numbers(Some(i + 1));
             match split_glued(t) {
                 Some(parts) if in_numbers && !is_name_position(&out.tokens, i) => {
-                    glued.get_or_insert((i, t.text));
+                    if glued.is_none() {
+                        let texts: Vec<&str> = parts.iter().map(|p| p.text).collect();
+                        glued = Some((i, t.text, texts));
+                    }
                     tokens.extend(parts);
                 }
                 _ => tokens.push(*t),
             }
         }
-        if let Some((i, text)) = glued {
-            let parts: Vec<&str> = split_glued(&line.tokens[i])
-                .unwrap_or_default()
-                .iter()
-                .map(|p| p.text)
-                .collect();
+        if let Some((i, text, parts)) = glued {
             self.variant(
                 line,
                 At::Tok(i),
