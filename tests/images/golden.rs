@@ -3,11 +3,14 @@
 //! real binary, with a fingerprint of each image's decoded pixels. Refactoring must not change
 //! a single pixel: the manifest is compared line by line, and it is rewritten only on purpose,
 //! with `ANIM_UPDATE_GOLDEN=1 cargo test --test images golden` after a deliberate change of output.
+//! That run also renders each scene whose lines changed converged and prints each changed
+//! image's RMSE against it.
 
 use crate::common;
 
 use anim_core::util::Fnv64;
 use common::{anim, shared_dir};
+use image::RgbImage;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -36,8 +39,9 @@ fn image_files(dir: &Path) -> Vec<PathBuf> {
 }
 
 /// Renders one scene file in a sandbox of its own (deep enough that render lines with `../..`
-/// stay inside it) and returns its manifest lines.
-fn manifest_lines(label: &str, scene: &Path) -> String {
+/// stay inside it) with `args` added; the images it wrote, by file name, or `None` if it was
+/// rejected.
+fn render_images(label: &str, scene: &Path, args: &[&str]) -> Option<Vec<(String, RgbImage)>> {
     let sandbox = tempfile::tempdir().unwrap();
     let dir = sandbox.path().join("a/b/c/d");
     std::fs::create_dir_all(&dir).unwrap();
@@ -64,26 +68,39 @@ fn manifest_lines(label: &str, scene: &Path) -> String {
         .arg("--out")
         .arg(dir.join("out"))
         .args(SIZE)
+        .args(args)
         .arg("--quiet")
         .output()
         .unwrap();
-    let mut lines = String::new();
     if !output.status.success() {
-        writeln!(lines, "{label}\trejected").unwrap();
-        return lines;
+        return None;
     }
-    let images = image_files(sandbox.path());
-    if images.is_empty() {
-        writeln!(lines, "{label}\tno image").unwrap();
-    }
-    for image in images {
+    let images = image_files(sandbox.path()).into_iter().map(|image| {
         let decoded = image::open(&image)
             .unwrap_or_else(|e| panic!("{label}: {}: {e}", image.display()))
             .to_rgb8();
+        (
+            image.file_name().unwrap().to_string_lossy().into_owned(),
+            decoded,
+        )
+    });
+    Some(images.collect())
+}
+
+/// The manifest lines of one scene file.
+fn manifest_lines(label: &str, scene: &Path) -> String {
+    let mut lines = String::new();
+    let Some(images) = render_images(label, scene, &[]) else {
+        writeln!(lines, "{label}\trejected").unwrap();
+        return lines;
+    };
+    if images.is_empty() {
+        writeln!(lines, "{label}\tno image").unwrap();
+    }
+    for (name, decoded) in images {
         writeln!(
             lines,
-            "{label}\t{}\t{}x{}\t{:016x}",
-            image.file_name().unwrap().to_string_lossy(),
+            "{label}\t{name}\t{}x{}\t{:016x}",
             decoded.width(),
             decoded.height(),
             Fnv64::of(decoded.as_raw())
@@ -91,6 +108,43 @@ fn manifest_lines(label: &str, scene: &Path) -> String {
         .unwrap();
     }
     lines
+}
+
+/// Samples per pixel of the converged render a changed image is compared with.
+const CONVERGED_SPP: &str = "1024";
+
+/// Prints, for each scene whose manifest lines changed, the RMSE (8-bit levels) of each of
+/// its images against the same scene converged (`CONVERGED_SPP` uniform samples), for the
+/// commit that rewrites the manifest to list: at this size adaptive images sit 0.3 to 4
+/// levels from converged, so what a change of the sampler must show is that it moves them
+/// no farther.
+fn changed_against_converged(scenes: &[(String, PathBuf)], expected: &str, actual: &str) {
+    let old: Vec<&str> = expected.lines().collect();
+    for (label, path) in scenes {
+        let prefix = format!("{label}\t");
+        let changed = actual
+            .lines()
+            .any(|l| l.starts_with(&prefix) && !old.contains(&l));
+        if !changed {
+            continue;
+        }
+        let (Some(now), Some(converged)) = (
+            render_images(label, path, &[]),
+            render_images(label, path, &["--spp", CONVERGED_SPP]),
+        ) else {
+            continue;
+        };
+        for ((name, a), (_, b)) in now.iter().zip(&converged) {
+            let squares: f64 = a
+                .as_raw()
+                .iter()
+                .zip(b.as_raw())
+                .map(|(&x, &y)| (x as f64 - y as f64).powi(2))
+                .sum();
+            let rmse = (squares / a.as_raw().len().max(1) as f64).sqrt();
+            eprintln!("changed: {label} {name}: RMSE {rmse:.3} against {CONVERGED_SPP} spp");
+        }
+    }
 }
 
 /// Frames 0, a third and two thirds of the way through each spec's animation.
@@ -180,6 +234,8 @@ fn every_scene_renders_the_pixels_of_the_golden_manifest() {
             shared.is_some(),
             "the manifest is written only with the corpus present"
         );
+        let expected = std::fs::read_to_string(MANIFEST).unwrap_or_default();
+        changed_against_converged(&scenes, &expected, &actual);
         std::fs::write(MANIFEST, &actual).unwrap();
         eprintln!("wrote {MANIFEST}");
         return;

@@ -79,7 +79,7 @@ pub struct TraceState {
 }
 
 /// What adaptive sampling's first pass learned about a pixel, handed to the integrator for
-/// each sample it adds there: the lights every shadow ray of the centres around the pixel
+/// the first samples it adds there (`sampler::pattern::PRIOR_SAMPLES`): the lights every shadow ray of the centres around the pixel
 /// saw fully, taken as visible at the surface a camera ray hits without a shadow ray.
 #[derive(Clone, Debug, Default)]
 pub struct PixelPrior {

@@ -16,7 +16,8 @@
 //! and writes each pixel from its own position, so the image does not depend on the thread
 //! count, and each pixel's pattern depends on its position only, so it does not crawl from
 //! frame to frame of an animation. What pass 1 learned of the lights around a pixel goes to
-//! the integrator with each of its samples, as a [`PixelPrior`].
+//! the integrator with the samples of its first error check, as a [`PixelPrior`]
+//! (`pattern::PRIOR_SAMPLES`).
 //!
 //! In a frame with motion, the first pass takes the middle of the exposure and the samples of
 //! pass 2 carry instants (`PixelPattern::time`). A pixel is not flat when the rays of a centre
@@ -27,7 +28,7 @@
 //! (docs/scene-language.md §10).
 
 use super::first_pass::{around, FirstPass};
-use super::pattern::{self, tone3, Moments, PixelPattern, MOTION_MIN_SAMPLES};
+use super::pattern::{self, tone3, Moments, PixelPattern, MOTION_MIN_SAMPLES, PRIOR_SAMPLES};
 use super::{Frame, Sampled};
 use crate::render::integrator::{PixelPrior, TraceState};
 use crate::render::RayCounts;
@@ -63,7 +64,8 @@ impl Adaptive<'_> {
         }
     }
 
-    /// Sample `i` of pixel (x, y)'s own pattern: its radiance.
+    /// Sample `i` of pixel (x, y)'s own pattern: its radiance. The first `PRIOR_SAMPLES` take
+    /// what `prior` knows of the lights; the others trace every shadow ray.
     fn sample(
         &self,
         (x, y): (usize, usize),
@@ -78,6 +80,11 @@ impl Adaptive<'_> {
         let ray = match frame.shutter {
             None => frame.camera.ray(px, py),
             Some(s) => s.ray(frame.camera, px, py, pattern.time(i)),
+        };
+        let prior = if i < PRIOR_SAMPLES {
+            prior
+        } else {
+            &PixelPrior::NONE
         };
         frame.integrator.camera_sample(&ray, prior, st).radiance
     }

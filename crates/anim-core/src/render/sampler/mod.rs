@@ -5,7 +5,7 @@
 //! - `adaptive`: one sample in every pixel, then more where the first pass says a pixel
 //!   needs them (`first_pass`), at the points of each pixel's own scrambled Sobol pattern
 //!   ([`pattern`]). What the first pass learned travels to the integrator as a value, the
-//!   `PixelPrior` of each added sample.
+//!   `PixelPrior` of the first samples it adds (`pattern::PRIOR_SAMPLES`).
 //! - `packet`: camera rays of still frames, traced a block at a time.
 
 mod adaptive;

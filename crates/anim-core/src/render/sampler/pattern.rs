@@ -17,6 +17,15 @@ use glam::Vec3A;
 /// points) can be compared, one sample per quadrant.
 pub const MIN_SAMPLES: u32 = 4;
 
+/// Samples of a refined pixel that take the lights every shadow ray of the centres around it
+/// saw fully as visible at their camera hits, without shadow rays (`PixelPrior`): those of
+/// its first error check. A pixel that goes on has a feature its first samples disagree
+/// about, and a shadow smaller than the spacing of the centres, which all nine missed, would
+/// otherwise be taken as lit by every one of its samples: over a floor under many small
+/// spheres that left converged renders 0.8 levels too bright on average and up to 30 levels
+/// off (docs/benchmarks-history.md §4.8).
+pub const PRIOR_SAMPLES: u32 = MIN_SAMPLES;
+
 /// Fewest samples of a pixel that motion touches. Its instants are stratified, one in each
 /// 1/n of the exposure, so n samples all miss only what covers the pixel for less than about
 /// 1/n of it: at 4, a moving shadow's blurred end went unseen often enough to leave the
