@@ -187,7 +187,7 @@ pub struct PreviewArgs {
 
 #[derive(Args, Debug, Clone)]
 pub struct BenchArgs {
-    /// Write bench.csv, bench.md, calibration.tsv and one time-vs-error-SCENE.png per scene here
+    /// Write bench.csv, bench.md, calibration.tsv, one time-vs-error-SCENE.png per scene and one estimate-vs-error-SCENE.png per adaptively rendered scene here
     /// (stress.csv and stress.md with --stress).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,

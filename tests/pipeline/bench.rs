@@ -50,9 +50,11 @@ fn quick_bench_writes_csv_markdown_and_plots() {
         let one = rmse(&csv, scene, "1 spp");
         let many = rmse(&csv, scene, "64 spp");
         assert!(many < one, "{scene}: 64 spp RMSE {many} ≥ 1 spp RMSE {one}");
-        let png = out.join(format!("time-vs-error-{scene}.png"));
-        let img = image::open(&png).unwrap();
-        assert!(img.width() > 100 && img.height() > 100);
+        for plot in ["time-vs-error", "estimate-vs-error"] {
+            let png = out.join(format!("{plot}-{scene}.png"));
+            let img = image::open(&png).unwrap_or_else(|e| panic!("{}: {e}", png.display()));
+            assert!(img.width() > 100 && img.height() > 100);
+        }
     }
     let md = std::fs::read_to_string(out.join("bench.md")).unwrap();
     assert!(md.contains("## assignment") && md.contains("## showcase"));

@@ -2,6 +2,7 @@
 //! DejaVu Sans (assets/fonts, Bitstream Vera licence), so no system font library is needed,
 //! and encoded with the `image` crate the renderer already uses.
 
+use super::metrics::CalibrationBin;
 use super::{Renderer, Row};
 use plotters::prelude::*;
 use std::path::Path;
@@ -53,12 +54,8 @@ pub fn time_vs_error(path: &Path, scene: &str, rows: &[&Row]) -> Result<(), Stri
     }
     // Half a decade of room on each side keeps end points off the frame.
     let (x0, x1, y0, y1) = (x0 / 1.6, x1 * 1.6, y0 / 1.6, y1 * 1.6);
-    let mut buf = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
-    {
-        let err = |e: DrawingAreaErrorKind<_>| format!("plot {}: {e:?}", path.display());
-        let root = BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(err)?;
-        let mut chart = ChartBuilder::on(&root)
+    draw_png(path, |root, err| {
+        let mut chart = ChartBuilder::on(root)
             .caption(
                 format!("{scene}: time against error"),
                 ("sans-serif", 22).into_font(),
@@ -97,6 +94,115 @@ pub fn time_vs_error(path: &Path, scene: &str, rows: &[&Row]) -> Result<(), Stri
             .position(SeriesLabelPosition::UpperRight)
             .draw()
             .map_err(err)?;
+        Ok(())
+    })
+}
+
+/// Plots, per adaptive setting, the sampler's per-pixel error estimate where each pixel
+/// stopped against the error measured there, pixels binned by estimate (the bins of
+/// `metrics::calibration`; the pixels that kept their centre sample have no estimate and are
+/// left out), log-log, with the line on which the estimate would be exact.
+pub fn estimate_vs_error(
+    path: &Path,
+    scene: &str,
+    settings: &[(&str, &[CalibrationBin])],
+) -> Result<(), String> {
+    register_font()?;
+    const FLOOR: f64 = 1e-2;
+    let binned = |bins: &[CalibrationBin]| -> Vec<(f64, f64)> {
+        bins.iter()
+            .filter(|b| b.estimate.is_some() && b.mean_estimate.is_finite())
+            .map(|b| (b.mean_estimate.max(FLOOR), b.measured_rms.max(FLOOR)))
+            .collect()
+    };
+    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+    for (_, bins) in settings {
+        for (x, y) in binned(bins) {
+            lo = lo.min(x.min(y));
+            hi = hi.max(x.max(y));
+        }
+    }
+    if lo > hi {
+        (lo, hi) = (FLOOR, 10.0);
+    }
+    let (lo, hi) = (lo / 1.6, hi * 1.6);
+    draw_png(path, |root, err| {
+        let mut chart = ChartBuilder::on(root)
+            .caption(
+                format!("{scene}: estimated against measured error per pixel"),
+                ("sans-serif", 22).into_font(),
+            )
+            .margin(14)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
+            .build_cartesian_2d((lo..hi).log_scale(), (lo..hi).log_scale())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("mean estimate of the bin (8-bit levels)")
+            .y_desc("measured RMS error (8-bit levels)")
+            .x_label_formatter(&|v| short(*v))
+            .y_label_formatter(&|v| short(*v))
+            .light_line_style(RGBColor(236, 236, 236))
+            .draw()
+            .map_err(err)?;
+        let grey = RGBColor(0x7f, 0x7f, 0x7f);
+        chart
+            .draw_series(LineSeries::new([(lo, lo), (hi, hi)], grey.stroke_width(1)))
+            .map_err(err)?
+            .label("estimate exact")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
+        for (i, (setting, bins)) in settings.iter().enumerate() {
+            let c = SETTING_COLOURS[i % SETTING_COLOURS.len()];
+            let points = binned(bins);
+            chart
+                .draw_series(LineSeries::new(points.clone(), c.stroke_width(2)))
+                .map_err(err)?
+                .label(setting.to_string())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
+            chart
+                .draw_series(points.into_iter().map(|p| Circle::new(p, 4, c.filled())))
+                .map_err(err)?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()
+            .map_err(err)?;
+        Ok(())
+    })
+}
+
+/// One colour per adaptive setting of a calibration plot, dark enough to read on white.
+const SETTING_COLOURS: [RGBColor; 6] = [
+    RGBColor(0xd6, 0x27, 0x28),
+    RGBColor(0x2c, 0xa0, 0x2c),
+    RGBColor(0x1f, 0x77, 0xb4),
+    RGBColor(0x94, 0x67, 0xbd),
+    RGBColor(0x8c, 0x56, 0x4b),
+    RGBColor(0xff, 0x7f, 0x0e),
+];
+
+/// The error type of drawing into the bitmap, as the plots see it.
+type DrawError = DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>;
+
+/// Draws one chart (`draw` gets the white drawing area and the error's converter) into a
+/// bitmap of `SIZE` and writes it to `path` as a PNG.
+fn draw_png(
+    path: &Path,
+    draw: impl FnOnce(
+        &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
+        &dyn Fn(DrawError) -> String,
+    ) -> Result<(), String>,
+) -> Result<(), String> {
+    let mut buf = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    {
+        let err = |e: DrawError| format!("plot {}: {e:?}", path.display());
+        let root = BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(err)?;
+        draw(&root, &err)?;
         root.present().map_err(err)?;
     }
     let rgb = image::RgbImage::from_raw(SIZE.0, SIZE.1, buf)

@@ -1,6 +1,7 @@
 //! The bench's outputs: `bench.csv` (one row per scene × renderer × setting), `bench.md` (the
 //! tables) and one time-against-error plot per scene.
 
+use super::metrics::CalibrationBin;
 use super::{plot, BenchReport, Row};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -131,8 +132,9 @@ fn calibration_tsv(report: &BenchReport) -> String {
     out
 }
 
-/// Writes `bench.csv`, `bench.md`, `calibration.tsv` and `time-vs-error-<scene>.png` into
-/// `dir`; returns the files written.
+/// Writes `bench.csv`, `bench.md`, `calibration.tsv`, `time-vs-error-<scene>.png` and, for
+/// the scenes rendered adaptively, `estimate-vs-error-<scene>.png` into `dir`; returns the
+/// files written.
 pub fn write_outputs(report: &BenchReport, dir: &Path) -> Result<Vec<PathBuf>, String> {
     let mut written = Vec::new();
     let outputs = [
@@ -154,6 +156,17 @@ pub fn write_outputs(report: &BenchReport, dir: &Path) -> Result<Vec<PathBuf>, S
         let path = dir.join(format!("time-vs-error-{}.png", scene.name));
         plot::time_vs_error(&path, &scene.name, &rows)?;
         written.push(path);
+        let settings: Vec<(&str, &[CalibrationBin])> = report
+            .calibration
+            .iter()
+            .filter(|(s, _, _)| *s == scene.name)
+            .map(|(_, setting, bins)| (setting.as_str(), bins.as_slice()))
+            .collect();
+        if !settings.is_empty() {
+            let path = dir.join(format!("estimate-vs-error-{}.png", scene.name));
+            plot::estimate_vs_error(&path, &scene.name, &settings)?;
+            written.push(path);
+        }
     }
     Ok(written)
 }
