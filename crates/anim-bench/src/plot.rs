@@ -2,7 +2,6 @@
 //! DejaVu Sans (assets/fonts, Bitstream Vera licence), so no system font library is needed,
 //! and encoded with the `image` crate the renderer already uses.
 
-use super::metrics::CalibrationBin;
 use super::{Renderer, Row};
 use plotters::prelude::*;
 use std::path::Path;
@@ -99,25 +98,25 @@ pub fn time_vs_error(path: &Path, scene: &str, rows: &[&Row]) -> Result<(), Stri
 }
 
 /// Plots, per adaptive setting, the sampler's per-pixel error estimate where each pixel
-/// stopped against the error measured there, pixels binned by estimate (the bins of
-/// `metrics::calibration`; the pixels that kept their centre sample have no estimate and are
-/// left out), log-log, with the line on which the estimate would be exact.
+/// stopped against the error measured there: one point per bin of pixels (mean estimate,
+/// measured RMS error; `metrics::calibration`), log-log, with the line on which the estimate
+/// would be exact.
 pub fn estimate_vs_error(
     path: &Path,
     scene: &str,
-    settings: &[(&str, &[CalibrationBin])],
+    settings: &[(&str, Vec<(f64, f64)>)],
 ) -> Result<(), String> {
     register_font()?;
     const FLOOR: f64 = 1e-2;
-    let binned = |bins: &[CalibrationBin]| -> Vec<(f64, f64)> {
-        bins.iter()
-            .filter(|b| b.estimate.is_some() && b.mean_estimate.is_finite())
-            .map(|b| (b.mean_estimate.max(FLOOR), b.measured_rms.max(FLOOR)))
+    let floored = |points: &[(f64, f64)]| -> Vec<(f64, f64)> {
+        points
+            .iter()
+            .map(|&(x, y)| (x.max(FLOOR), y.max(FLOOR)))
             .collect()
     };
     let (mut lo, mut hi) = (f64::MAX, f64::MIN);
-    for (_, bins) in settings {
-        for (x, y) in binned(bins) {
+    for (_, points) in settings {
+        for (x, y) in floored(points) {
             lo = lo.min(x.min(y));
             hi = hi.max(x.max(y));
         }
@@ -152,9 +151,9 @@ pub fn estimate_vs_error(
             .map_err(err)?
             .label("estimate exact")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
-        for (i, (setting, bins)) in settings.iter().enumerate() {
+        for (i, (setting, points)) in settings.iter().enumerate() {
             let c = SETTING_COLOURS[i % SETTING_COLOURS.len()];
-            let points = binned(bins);
+            let points = floored(points);
             chart
                 .draw_series(LineSeries::new(points.clone(), c.stroke_width(2)))
                 .map_err(err)?

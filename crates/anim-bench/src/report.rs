@@ -1,7 +1,6 @@
 //! The bench's outputs: `bench.csv` (one row per scene × renderer × setting), `bench.md` (the
 //! tables) and one time-against-error plot per scene.
 
-use super::metrics::CalibrationBin;
 use super::{plot, BenchReport, Row};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -156,11 +155,18 @@ pub fn write_outputs(report: &BenchReport, dir: &Path) -> Result<Vec<PathBuf>, S
         let path = dir.join(format!("time-vs-error-{}.png", scene.name));
         plot::time_vs_error(&path, &scene.name, &rows)?;
         written.push(path);
-        let settings: Vec<(&str, &[CalibrationBin])> = report
+        // The bins with an estimate (not the pixels that kept their centre sample).
+        let settings: Vec<(&str, Vec<(f64, f64)>)> = report
             .calibration
             .iter()
             .filter(|(s, _, _)| *s == scene.name)
-            .map(|(_, setting, bins)| (setting.as_str(), bins.as_slice()))
+            .map(|(_, setting, bins)| {
+                let points = bins
+                    .iter()
+                    .filter(|b| b.estimate.is_some() && b.mean_estimate.is_finite())
+                    .map(|b| (b.mean_estimate, b.measured_rms));
+                (setting.as_str(), points.collect())
+            })
             .collect();
         if !settings.is_empty() {
             let path = dir.join(format!("estimate-vs-error-{}.png", scene.name));
