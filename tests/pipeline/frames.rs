@@ -101,6 +101,32 @@ fn second_render_skips_everything_and_a_changed_frame_renders_alone() {
     );
 }
 
+/// A triangle 1 wide (`x`: its right corner), as an OBJ file.
+fn triangle_obj(x: f64) -> String {
+    format!("v -1 -1 -5\nv {x} -1 -5\nv 0 1 -5\nf 1 2 3\n")
+}
+
+#[test]
+fn an_edited_mesh_renders_the_frames_that_name_it_again() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mesh = dir.path().join("tri.obj");
+    std::fs::write(&mesh, triangle_obj(1.0)).expect("write");
+    for (name, shape) in [
+        ("frame_0000", "define shape obj tri tri.obj red"),
+        ("frame_0001", "define shape sphere ball 0 0 -5 1 red"),
+    ] {
+        let text = frame_text(0.0, name).replace("define shape sphere ball 0 0 -5 1 red", shape);
+        std::fs::write(dir.path().join(format!("{name}.sdf")), text).expect("write");
+    }
+    assert_eq!(render(dir.path(), &[]).rendered.len(), 2);
+    assert!(render(dir.path(), &[]).rendered.is_empty());
+    // The mesh changes (its size, and its time): the frame naming it renders again, alone.
+    std::fs::write(&mesh, triangle_obj(1.5)).expect("write");
+    let again = render(dir.path(), &[]);
+    assert_eq!(again.rendered, ["frame_0000.sdf"]);
+    assert_eq!(again.skipped, ["frame_0001.sdf"]);
+}
+
 #[test]
 fn an_interrupted_run_resumes_with_only_the_missing_frames() {
     let dir = frames(5);

@@ -11,7 +11,7 @@ mod parse;
 pub mod repair;
 
 pub use lexer::{image_names, raw_lines, scene_key, ImageName};
-pub use parse::{default_output, included_files, IncludeCache, Omissions, Parsed};
+pub use parse::{default_output, included_files, mesh_files, IncludeCache, Omissions, Parsed};
 
 use crate::diag::{Diagnostic, Severity};
 use crate::shape::MeshCache;

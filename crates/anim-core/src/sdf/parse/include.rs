@@ -406,6 +406,26 @@ pub fn included_files(text: &str, path: &Path) -> Vec<PathBuf> {
     files
 }
 
+/// The OBJ files that the mesh statements of `text` (read from `path`) name, as the loader
+/// finds them (relative to `path`'s folder): `define shape obj <name> <file> <material>`,
+/// the one form it reads. A frame's record notes them (`anim-pipeline`'s `frames::cache`), so
+/// that an edited mesh renders the frame again.
+pub fn mesh_files(text: &str, path: &Path) -> Vec<PathBuf> {
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let mut tokens = Vec::new();
+    let mut files = Vec::new();
+    for raw in super::lines_containing(text, "obj") {
+        crate::sdf::lexer::tokenize_into(raw, &mut tokens);
+        let words: Vec<&str> = tokens.iter().map(|t| t.text).collect();
+        if let Some(k) = words.windows(2).position(|w| w == ["shape", "obj"]) {
+            if words.len() == k + 5 {
+                files.push(folder.join(words[k + 3]));
+            }
+        }
+    }
+    files
+}
+
 /// `path` as a message shows it: relative to `folder` when it is inside it.
 fn shown(path: &Path, folder: &Path) -> String {
     path.strip_prefix(folder)
@@ -422,6 +442,17 @@ mod tests {
 
     fn write(dir: &Path, name: &str, text: &str) {
         std::fs::write(dir.join(name), text).unwrap();
+    }
+
+    #[test]
+    fn mesh_files_are_those_of_the_mesh_statement_beside_the_file_that_names_them() {
+        let text = "define shape obj tri meshes/tri.obj red\n\
+                    # define shape obj old old.obj red\n\
+                    define shape obj short.obj\n\
+                    define shape obj big big.obj red extra\n\
+                    define shape sphere obj 0 0 0 1 red\n";
+        let files = super::mesh_files(text, Path::new("scenes/part.sdfi"));
+        assert_eq!(files, [Path::new("scenes/meshes/tri.obj")]);
     }
 
     const PART: &str = "define material m 0.1 0.1 0.1 0.5 0.5 0.5 0 0 0 1\n\

@@ -20,7 +20,7 @@ mod shape;
 mod transform;
 
 pub(super) use include::Chain;
-pub use include::{included_files, IncludeCache};
+pub use include::{included_files, mesh_files, IncludeCache};
 pub use resolve::default_output;
 
 use super::ast::{FlatShapes, NameRef, Span, Statement, StatementKind, StatementSpans};
