@@ -225,6 +225,8 @@ const ROWS: &[Row] = &[
         Diag(W, at(2, 17), "a field of view of 1° is very narrow")),
     row("camera with zero direction", concat!(head!(), "define camera c 60 0 0 0 0 0 0 0 1 0\nrender c out.png 8 8\n"),
         Diag(W, at(2, 26), "viewing direction is zero: read as its field of view alone")),
+    row("camera with fov last and zero direction", concat!(head!(), "define camera c 0 2 3 0 0 0 45\nrender c out.png 8 8\n"),
+        Diag(W, at(2, 23), "viewing direction is zero: read as its field of view alone")),
     row("broken camera beside a good one", concat!(head!(), "define camera c 60 0 0 0 0 1 0 0 1 0\nrender c a.png 8 8\n", tail!()),
         Diag(W, at(2, 32), "camera `c` is skipped with the render line that uses it (line 3)")),
     row("camera with fov last", concat!(head!(), "define camera c 0 0 0 0 0 -1 0 1 0 90\n", tail!()),

@@ -119,8 +119,13 @@ impl Parser<'_> {
                 "camera written as [eye] [dir] <fov-x>, the field of view last: +y is up",
                 Some(format!("canonical form: `{FORM_CAMERA}`")),
             );
-            nums.rotate_right(1);
-            nums.extend([0.0, 1.0, 0.0]);
+            if is_zero(DVec3::new(nums[3], nums[4], nums[5])) {
+                self.warn_zero_direction(line, name, first + 3, first + 6);
+                nums = vec![nums[6]];
+            } else {
+                nums.rotate_right(1);
+                nums.extend([0.0, 1.0, 0.0]);
+            }
         } else if nums.len() == 7 && is_zero(DVec3::new(nums[4], nums[5], nums[6])) {
             self.read_default_view_angles(line, first, name, &mut nums);
         } else if nums.len() == 7 {
@@ -327,6 +332,21 @@ impl Parser<'_> {
 
     /// The eye, direction and up vector of a camera line's ten numbers `nums` (from token
     /// `first`) into `def`, with an up vector that gives no roll replaced by +y.
+    /// Warns that a camera's viewing direction (the three tokens from `dir_at`) is zero, and
+    /// that it is read as its field of view (token `fov_at`) alone: the renderers that wrote
+    /// such lines looked along -z from the origin, and so does this reading.
+    fn warn_zero_direction(&mut self, line: &Line, name: &str, dir_at: usize, fov_at: usize) {
+        let fov = line.tokens[fov_at].text;
+        self.warn(
+            line,
+            At::Span(dir_at, dir_at + 2),
+            "the camera's viewing direction is zero: read as its field of view alone, at the origin looking along -z with +y up",
+            Some(format!(
+                "that is `define camera {name} {fov}`; to place the camera, give a direction: `{FORM_CAMERA}`"
+            )),
+        );
+    }
+
     fn camera_pose(
         &mut self,
         line: &Line,
@@ -341,17 +361,7 @@ impl Parser<'_> {
         def.dir = v(4);
         def.up = v(7);
         if is_zero(def.dir) {
-            // No direction to look along: the renderers that wrote such lines read the field
-            // of view alone and looked along -z from the origin, and so does this reading.
-            let fov = toks[first].text;
-            self.warn(
-                line,
-                At::Span(first + 4, first + 6),
-                "the camera's viewing direction is zero: read as its field of view alone, at the origin looking along -z with +y up",
-                Some(format!(
-                    "that is `define camera {name} {fov}`; to place the camera, give a direction: `{FORM_CAMERA}`"
-                )),
-            );
+            self.warn_zero_direction(line, name, first + 4, first);
             def.eye = DVec3::ZERO;
             def.dir = DVec3::NEG_Z;
             def.up = DVec3::Y;
