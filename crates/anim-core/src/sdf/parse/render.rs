@@ -295,9 +295,6 @@ impl Parser<'_> {
         Ok(Some(s))
     }
 
-    /// The output file name from the tokens `pieces`; a name broken by spaces around its
-    /// dot (`image . ppm`, `image .ppm`) is joined with a warning. `None` if the pieces do not
-    /// form one name.
     /// Whether a render line's first two names are a job's name and a camera: the first is no
     /// camera defined so far, the second is.
     fn is_render_name(&self, first: &str, second: &str) -> bool {
@@ -305,6 +302,9 @@ impl Parser<'_> {
         !known(first) && known(second)
     }
 
+    /// The output file name from the tokens `pieces`; a name broken by spaces around its
+    /// dot (`image . ppm`, `image .ppm`) is joined with a warning. `None` if the pieces do not
+    /// form one name.
     fn file_name(&mut self, line: &Line, pieces: std::ops::Range<usize>) -> Option<String> {
         let toks = &line.tokens;
         let parts: Vec<&str> = toks[pieces.clone()].iter().map(|t| t.text).collect();
