@@ -39,10 +39,8 @@ read -r W H <<<"${SIZE:-640 360}"
 IFS=';' read -r -a LADDER <<<"${LADDER---error 2.5;--error 3;--error 4;--error 64;--spp 1}"
 mkdir -p "$OUT"
 
-# The held-out stand-in for the mirror-and-glass room (see its script).
-moved=$OUT/mirror-glass-moved.sdf
-"$root/scripts/bench/mirror-glass-moved.sh" "$moved"
-read -r -a SCENES <<<"${SCENES:-scenes/bench/mirror-glass.sdf $moved scenes/showcase.sdf}"
+# The mirror-and-glass room, its held-out stand-in (see the file's header) and the showcase.
+read -r -a SCENES <<<"${SCENES:-scenes/bench/mirror-glass.sdf scenes/bench/mirror-glass-moved.sdf scenes/showcase.sdf}"
 
 # cpu_of LOG: user + sys seconds from a /usr/bin/time -f '%U %S' line (the last line).
 cpu_of() { tail -n 1 "$1" | awk '{printf "%.2f", $1 + $2}'; }

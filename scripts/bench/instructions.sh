@@ -55,8 +55,6 @@ lines.append("define shape composite root " + " ".join(uses))
 open(sys.argv[1], "w").write("\n".join(lines) + "\n")
 PY
 
-scripts=$root/scripts/bench
-"$scripts/mirror-glass-moved.sh" "$out/scenes/mirror-glass-moved.sdf"
 mg=$root/scenes/bench/mirror-glass.sdf
 
 # name | scene | options
@@ -72,8 +70,8 @@ pov) cases=(
 adaptive) cases=(
   "mirror-glass|$mg|--width 640 --height 360"
   "mirror-glass-1|$mg|--spp 1 --width 640 --height 360"
-  "moved|$out/scenes/mirror-glass-moved.sdf|--width 640 --height 360"
-  "moved-1|$out/scenes/mirror-glass-moved.sdf|--spp 1 --width 640 --height 360"
+  "moved|$root/scenes/bench/mirror-glass-moved.sdf|--width 640 --height 360"
+  "moved-1|$root/scenes/bench/mirror-glass-moved.sdf|--spp 1 --width 640 --height 360"
   "showcase|$root/scenes/showcase.sdf|--width 640 --height 360"
   "showcase-1|$root/scenes/showcase.sdf|--spp 1 --width 640 --height 360"
 ) ;;

@@ -3,7 +3,8 @@
 # against error"; docs/benchmarks-history.md §4.9). ANIM must be a build with dump.patch
 # applied, which makes every refined pixel also take 128 samples of its own pattern and print,
 # at each power of two, its mean, its error estimate and the rays spent (the image itself is
-# the normal one). For the bench scenes and the held-out room, at 640×360 on one thread:
+# the normal one). For the bench scenes (the held-out room among them), at 640×360 on one
+# thread:
 #   OUT/NAME.dump  the refined pixels' lines      OUT/NAME.ppm  the default render
 #   OUT/NAME.log   its render summary (rays)      OUT/NAME.ref.ppm  a converged render
 #
@@ -20,8 +21,7 @@ root=$(cd "$(dirname "$0")/../../.." && pwd)
 out=${1:?usage: dump.sh OUT}
 mkdir -p "$out"
 read -r W H <<<"${SIZE:-640 360}"
-"$root/scripts/bench/mirror-glass-moved.sh" "$out/mirror-glass-moved.sdf"
-for scene in "$root"/scenes/bench/*.sdf "$out/mirror-glass-moved.sdf"; do
+for scene in "$root"/scenes/bench/*.sdf; do
   name=$(basename "$scene" .sdf)
   work=$(mktemp -d)
   # A copy whose render line writes image.ppm, which score.py reads without an image library.
