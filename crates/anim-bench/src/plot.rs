@@ -1,4 +1,5 @@
-//! Log-log time-against-error plots, drawn by `plotters` into a pixel buffer with the bundled
+//! Log-log plots (time against error; the sampler's error estimate against the measured
+//! error), drawn by `plotters` into a pixel buffer with the bundled
 //! DejaVu Sans (assets/fonts, Bitstream Vera licence), so no system font library is needed,
 //! and encoded with the `image` crate the renderer already uses.
 
@@ -36,65 +37,33 @@ fn colour(renderer: Renderer, mode: &str) -> RGBColor {
 /// small positive floors because a log axis cannot show 0 (an exact image, or a render
 /// shorter than the clock's tick).
 pub fn time_vs_error(path: &Path, scene: &str, rows: &[&Row]) -> Result<(), String> {
-    register_font()?;
     const MIN_S: f64 = 1e-4;
     const MIN_RMSE: f64 = 1e-3;
-    let pts = |r: &Row| (r.cpu_s.max(MIN_S), r.error.rmse.max(MIN_RMSE));
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &r in rows {
-        let (x, y) = pts(r);
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
-    if rows.is_empty() {
-        (x0, x1, y0, y1) = (MIN_S, 1.0, MIN_RMSE, 1.0);
-    }
-    // Half a decade of room on each side keeps end points off the frame.
-    let (x0, x1, y0, y1) = (x0 / 1.6, x1 * 1.6, y0 / 1.6, y1 * 1.6);
-    draw_png(path, |root, err| {
-        let mut chart = ChartBuilder::on(root)
-            .caption(
-                format!("{scene}: time against error"),
-                ("sans-serif", 22).into_font(),
-            )
-            .margin(14)
-            .x_label_area_size(44)
-            .y_label_area_size(64)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("CPU seconds")
-            .y_desc("RMSE (8-bit levels)")
-            .x_label_formatter(&|v| short(*v))
-            .y_label_formatter(&|v| short(*v))
-            .light_line_style(RGBColor(236, 236, 236))
-            .draw()
-            .map_err(err)?;
-        for ((renderer, mode), mut line) in series(rows) {
+    let lines: Vec<PlotLine> = series(rows)
+        .into_iter()
+        .map(|((renderer, mode), mut line)| {
             line.sort_by(|a, b| a.cpu_s.total_cmp(&b.cpu_s));
-            let c = colour(renderer, &mode);
-            let points: Vec<(f64, f64)> = line.iter().map(|r| pts(r)).collect();
-            chart
-                .draw_series(LineSeries::new(points.clone(), c.stroke_width(2)))
-                .map_err(err)?
-                .label(format!("{} {mode}", renderer.name()))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
-            chart
-                .draw_series(points.into_iter().map(|p| Circle::new(p, 4, c.filled())))
-                .map_err(err)?;
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(err)?;
-        Ok(())
-    })
+            PlotLine {
+                label: format!("{} {mode}", renderer.name()),
+                colour: colour(renderer, &mode),
+                points: line
+                    .iter()
+                    .map(|r| (r.cpu_s.max(MIN_S), r.error.rmse.max(MIN_RMSE)))
+                    .collect(),
+                dots: true,
+            }
+        })
+        .collect();
+    let all = lines.iter().flat_map(|l| l.points.iter().copied());
+    let (x, y) = padded_bounds(all).unwrap_or(((MIN_S, 1.0), (MIN_RMSE, 1.0)));
+    let chart = LogLog {
+        caption: format!("{scene}: time against error"),
+        axes: ("CPU seconds", "RMSE (8-bit levels)"),
+        x,
+        y,
+        legend: SeriesLabelPosition::UpperRight,
+    };
+    chart.draw(path, &lines)
 }
 
 /// Plots, per adaptive setting, the sampler's per-pixel error estimate where each pixel
@@ -106,72 +75,127 @@ pub fn estimate_vs_error(
     scene: &str,
     settings: &[(&str, Vec<(f64, f64)>)],
 ) -> Result<(), String> {
-    register_font()?;
     const FLOOR: f64 = 1e-2;
-    let floored = |points: &[(f64, f64)]| -> Vec<(f64, f64)> {
-        points
-            .iter()
-            .map(|&(x, y)| (x.max(FLOOR), y.max(FLOOR)))
-            .collect()
+    let mut lines: Vec<PlotLine> = settings
+        .iter()
+        .enumerate()
+        .map(|(i, (setting, points))| PlotLine {
+            label: setting.to_string(),
+            colour: SETTING_COLOURS[i % SETTING_COLOURS.len()],
+            points: points
+                .iter()
+                .map(|&(x, y)| (x.max(FLOOR), y.max(FLOOR)))
+                .collect(),
+            dots: true,
+        })
+        .collect();
+    // Both axes span the same range, so that the exact line is the diagonal.
+    let all = lines.iter().flat_map(|l| l.points.iter().copied());
+    let ((x0, x1), (y0, y1)) = padded_bounds(all).unwrap_or(((FLOOR, 10.0), (FLOOR, 10.0)));
+    let (lo, hi) = (x0.min(y0), x1.max(y1));
+    lines.insert(
+        0,
+        PlotLine {
+            label: "estimate exact".into(),
+            colour: RGBColor(0x7f, 0x7f, 0x7f),
+            points: vec![(lo, lo), (hi, hi)],
+            dots: false,
+        },
+    );
+    let chart = LogLog {
+        caption: format!("{scene}: estimated against measured error per pixel"),
+        axes: (
+            "mean estimate of the bin (8-bit levels)",
+            "measured RMS error (8-bit levels)",
+        ),
+        x: (lo, hi),
+        y: (lo, hi),
+        legend: SeriesLabelPosition::UpperLeft,
     };
-    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
-    for (_, points) in settings {
-        for (x, y) in floored(points) {
-            lo = lo.min(x.min(y));
-            hi = hi.max(x.max(y));
-        }
-    }
-    if lo > hi {
-        (lo, hi) = (FLOOR, 10.0);
-    }
-    let (lo, hi) = (lo / 1.6, hi * 1.6);
-    draw_png(path, |root, err| {
-        let mut chart = ChartBuilder::on(root)
-            .caption(
-                format!("{scene}: estimated against measured error per pixel"),
-                ("sans-serif", 22).into_font(),
-            )
-            .margin(14)
-            .x_label_area_size(44)
-            .y_label_area_size(64)
-            .build_cartesian_2d((lo..hi).log_scale(), (lo..hi).log_scale())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("mean estimate of the bin (8-bit levels)")
-            .y_desc("measured RMS error (8-bit levels)")
-            .x_label_formatter(&|v| short(*v))
-            .y_label_formatter(&|v| short(*v))
-            .light_line_style(RGBColor(236, 236, 236))
-            .draw()
-            .map_err(err)?;
-        let grey = RGBColor(0x7f, 0x7f, 0x7f);
-        chart
-            .draw_series(LineSeries::new([(lo, lo), (hi, hi)], grey.stroke_width(1)))
-            .map_err(err)?
-            .label("estimate exact")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
-        for (i, (setting, points)) in settings.iter().enumerate() {
-            let c = SETTING_COLOURS[i % SETTING_COLOURS.len()];
-            let points = floored(points);
-            chart
-                .draw_series(LineSeries::new(points.clone(), c.stroke_width(2)))
-                .map_err(err)?
-                .label(setting.to_string())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
-            chart
-                .draw_series(points.into_iter().map(|p| Circle::new(p, 4, c.filled())))
+    chart.draw(path, &lines)
+}
+
+/// One line of a plot: its legend label, colour and points; `dots` marks each point (and
+/// draws the line wider).
+struct PlotLine {
+    label: String,
+    colour: RGBColor,
+    points: Vec<(f64, f64)>,
+    dots: bool,
+}
+
+/// A log-log chart: its caption, the names of its axes, their ranges and where the legend
+/// goes.
+struct LogLog {
+    caption: String,
+    axes: (&'static str, &'static str),
+    x: (f64, f64),
+    y: (f64, f64),
+    legend: SeriesLabelPosition,
+}
+
+impl LogLog {
+    /// Draws `lines` on this chart and writes it to `path` as a PNG.
+    fn draw(self, path: &Path, lines: &[PlotLine]) -> Result<(), String> {
+        register_font()?;
+        let LogLog {
+            caption,
+            axes,
+            x,
+            y,
+            legend,
+        } = self;
+        let (x, y) = (x.0..x.1, y.0..y.1);
+        draw_png(path, |root, err| {
+            let mut chart = ChartBuilder::on(root)
+                .caption(caption, ("sans-serif", 22).into_font())
+                .margin(14)
+                .x_label_area_size(44)
+                .y_label_area_size(64)
+                .build_cartesian_2d(x.log_scale(), y.log_scale())
                 .map_err(err)?;
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperLeft)
-            .draw()
-            .map_err(err)?;
-        Ok(())
-    })
+            chart
+                .configure_mesh()
+                .x_desc(axes.0)
+                .y_desc(axes.1)
+                .x_label_formatter(&|v| short(*v))
+                .y_label_formatter(&|v| short(*v))
+                .light_line_style(RGBColor(236, 236, 236))
+                .draw()
+                .map_err(err)?;
+            for line in lines {
+                let c = line.colour;
+                let width = if line.dots { 2 } else { 1 };
+                chart
+                    .draw_series(LineSeries::new(line.points.clone(), c.stroke_width(width)))
+                    .map_err(err)?
+                    .label(line.label.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c));
+                if line.dots {
+                    let dots = line.points.iter().map(|&p| Circle::new(p, 4, c.filled()));
+                    chart.draw_series(dots).map_err(err)?;
+                }
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .position(legend)
+                .draw()
+                .map_err(err)?;
+            Ok(())
+        })
+    }
+}
+
+/// The ranges of `points` in x and in y, each widened by half a decade on both sides so that
+/// end points stay off the frame; `None` without points.
+fn padded_bounds(points: impl Iterator<Item = (f64, f64)>) -> Option<((f64, f64), (f64, f64))> {
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for (x, y) in points {
+        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+    }
+    (x0 <= x1).then_some(((x0 / 1.6, x1 * 1.6), (y0 / 1.6, y1 * 1.6)))
 }
 
 /// One colour per adaptive setting of a calibration plot, dark enough to read on white.
