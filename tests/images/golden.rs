@@ -8,6 +8,7 @@
 
 use crate::common;
 
+use anim_bench::metrics::compare_rgb8;
 use anim_core::util::Fnv64;
 use common::{anim, shared_dir};
 use image::RgbImage;
@@ -41,7 +42,7 @@ fn image_files(dir: &Path) -> Vec<PathBuf> {
 /// Renders one scene file in a sandbox of its own (deep enough that render lines with `../..`
 /// stay inside it) with `args` added; the images it wrote, by file name, or `None` if it was
 /// rejected.
-fn render_images(label: &str, scene: &Path, args: &[&str]) -> Option<Vec<(String, RgbImage)>> {
+fn render_images(label: &str, scene: &Path, args: &[&str]) -> Rendered {
     let sandbox = tempfile::tempdir().unwrap();
     let dir = sandbox.path().join("a/b/c/d");
     std::fs::create_dir_all(&dir).unwrap();
@@ -87,10 +88,13 @@ fn render_images(label: &str, scene: &Path, args: &[&str]) -> Option<Vec<(String
     Some(images.collect())
 }
 
-/// The manifest lines of one scene file.
-fn manifest_lines(label: &str, scene: &Path) -> String {
+/// The images one scene file rendered as the manifest renders it (`None`: it was rejected).
+type Rendered = Option<Vec<(String, RgbImage)>>;
+
+/// The manifest lines of one scene file, from what it rendered.
+fn manifest_lines(label: &str, rendered: &Rendered) -> String {
     let mut lines = String::new();
-    let Some(images) = render_images(label, scene, &[]) else {
+    let Some(images) = rendered else {
         writeln!(lines, "{label}\trejected").unwrap();
         return lines;
     };
@@ -114,34 +118,24 @@ fn manifest_lines(label: &str, scene: &Path) -> String {
 const CONVERGED_SPP: &str = "1024";
 
 /// Prints, for each scene whose manifest lines changed, the RMSE (8-bit levels) of each of
-/// its images against the same scene converged (`CONVERGED_SPP` uniform samples), for the
-/// commit that rewrites the manifest to list: at this size adaptive images sit 0.3 to 4
-/// levels from converged, so what a change of the sampler must show is that it moves them
-/// no farther.
-fn changed_against_converged(scenes: &[(String, PathBuf)], expected: &str, actual: &str) {
+/// its images (`rendered`, in the order of `scenes`) against the same scene converged
+/// (`CONVERGED_SPP` uniform samples), for the commit that rewrites the manifest to list: at
+/// this size adaptive images sit 0.3 to 4 levels from converged, so what a change of the
+/// sampler must show is that it moves them no farther.
+fn changed_against_converged(scenes: &[(String, PathBuf)], rendered: &[Rendered], expected: &str) {
     let old: Vec<&str> = expected.lines().collect();
-    for (label, path) in scenes {
-        let prefix = format!("{label}\t");
-        let changed = actual
-            .lines()
-            .any(|l| l.starts_with(&prefix) && !old.contains(&l));
-        if !changed {
+    for ((label, path), now) in scenes.iter().zip(rendered) {
+        let lines = manifest_lines(label, now);
+        if lines.lines().all(|l| old.contains(&l)) {
             continue;
         }
-        let (Some(now), Some(converged)) = (
-            render_images(label, path, &[]),
-            render_images(label, path, &["--spp", CONVERGED_SPP]),
-        ) else {
+        let (Some(now), Some(converged)) =
+            (now, render_images(label, path, &["--spp", CONVERGED_SPP]))
+        else {
             continue;
         };
         for ((name, a), (_, b)) in now.iter().zip(&converged) {
-            let squares: f64 = a
-                .as_raw()
-                .iter()
-                .zip(b.as_raw())
-                .map(|(&x, &y)| (x as f64 - y as f64).powi(2))
-                .sum();
-            let rmse = (squares / a.as_raw().len().max(1) as f64).sqrt();
+            let rmse = compare_rgb8(a.as_raw(), b.as_raw()).rmse;
             eprintln!("changed: {label} {name}: RMSE {rmse:.3} against {CONVERGED_SPP} spp");
         }
     }
@@ -224,9 +218,14 @@ fn every_scene_renders_the_pixels_of_the_golden_manifest() {
         }
     }
     scenes.sort();
+    let rendered: Vec<Rendered> = scenes
+        .iter()
+        .map(|(label, path)| render_images(label, path, &[]))
+        .collect();
     let actual: String = scenes
         .iter()
-        .map(|(label, path)| manifest_lines(label, path))
+        .zip(&rendered)
+        .map(|((label, _), images)| manifest_lines(label, images))
         .collect();
 
     if std::env::var_os("ANIM_UPDATE_GOLDEN").is_some() {
@@ -235,7 +234,7 @@ fn every_scene_renders_the_pixels_of_the_golden_manifest() {
             "the manifest is written only with the corpus present"
         );
         let expected = std::fs::read_to_string(MANIFEST).unwrap_or_default();
-        changed_against_converged(&scenes, &expected, &actual);
+        changed_against_converged(&scenes, &rendered, &expected);
         std::fs::write(MANIFEST, &actual).unwrap();
         eprintln!("wrote {MANIFEST}");
         return;

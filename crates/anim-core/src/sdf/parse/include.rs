@@ -392,18 +392,10 @@ fn breaks_flat(kind: &StatementKind) -> bool {
 /// The files a scene's `include` lines name, resolved against the folder of the scene at
 /// `path`, in order: what a record of the scene's images vouches for besides its own bytes.
 pub fn included_files(text: &str, path: &Path) -> Vec<PathBuf> {
-    let folder = path.parent().unwrap_or(Path::new(""));
-    let mut tokens = Vec::new();
-    let mut files = Vec::new();
-    for raw in super::lines_containing(text, "include") {
-        crate::sdf::lexer::tokenize_into(raw, &mut tokens);
-        if let [first, file] = tokens.as_slice() {
-            if first.text == "include" {
-                files.push(folder.join(file.text.trim_matches('"')));
-            }
-        }
-    }
-    files
+    named_files(text, path, "include", |words| match words {
+        ["include", file] => Some(file.trim_matches('"')),
+        _ => None,
+    })
 }
 
 /// The OBJ files that the mesh statements of `text` (read from `path`) name, as the loader
@@ -411,16 +403,28 @@ pub fn included_files(text: &str, path: &Path) -> Vec<PathBuf> {
 /// the one form it reads. A frame's record notes them (`anim-pipeline`'s `frames::cache`), so
 /// that an edited mesh renders the frame again.
 pub fn mesh_files(text: &str, path: &Path) -> Vec<PathBuf> {
+    named_files(text, path, "obj", |words| {
+        let k = words.windows(2).position(|w| w == ["shape", "obj"])?;
+        (words.len() == k + 5).then(|| words[k + 3])
+    })
+}
+
+/// The files that the lines of `text` (read from `path`) holding `word` name, by `file_of`
+/// each line's words, relative to `path`'s folder, in order.
+fn named_files(
+    text: &str,
+    path: &Path,
+    word: &str,
+    file_of: impl for<'w> Fn(&[&'w str]) -> Option<&'w str>,
+) -> Vec<PathBuf> {
     let folder = path.parent().unwrap_or(Path::new(""));
     let mut tokens = Vec::new();
     let mut files = Vec::new();
-    for raw in super::lines_containing(text, "obj") {
+    for raw in super::lines_containing(text, word) {
         crate::sdf::lexer::tokenize_into(raw, &mut tokens);
         let words: Vec<&str> = tokens.iter().map(|t| t.text).collect();
-        if let Some(k) = words.windows(2).position(|w| w == ["shape", "obj"]) {
-            if words.len() == k + 5 {
-                files.push(folder.join(words[k + 3]));
-            }
+        if let Some(file) = file_of(&words) {
+            files.push(folder.join(file));
         }
     }
     files
