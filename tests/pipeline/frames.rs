@@ -101,9 +101,10 @@ fn second_render_skips_everything_and_a_changed_frame_renders_alone() {
     );
 }
 
-/// A triangle 1 wide (`x`: its right corner), as an OBJ file.
-fn triangle_obj(x: f64) -> String {
-    format!("v -1 -1 -5\nv {x} -1 -5\nv 0 1 -5\nf 1 2 3\n")
+/// A triangle `size` from its centre (on the view axis, 5 in front of the eye) to each side,
+/// as an OBJ file.
+fn triangle_obj(size: f64) -> String {
+    format!("v -{size} -{size} -5\nv {size} -{size} -5\nv 0 {size} -5\nf 1 2 3\n")
 }
 
 #[test]
@@ -120,7 +121,8 @@ fn an_edited_mesh_renders_the_frames_that_name_it_again() {
     }
     assert_eq!(render(dir.path(), &[]).rendered.len(), 2);
     assert!(render(dir.path(), &[]).rendered.is_empty());
-    // The mesh changes (its size, and its time): the frame naming it renders again, alone.
+    // The mesh changes (its bytes' length, and its time): the frame naming it renders again,
+    // alone.
     std::fs::write(&mesh, triangle_obj(1.5)).expect("write");
     let again = render(dir.path(), &[]);
     assert_eq!(again.rendered, ["frame_0000.sdf"]);
@@ -393,11 +395,7 @@ fn generate_is_deterministic_atomic_and_trims_old_frames() {
 fn mesh_project(root: &Path) {
     let scenes = root.join("scenes/meshes");
     std::fs::create_dir_all(&scenes).expect("mkdir");
-    std::fs::write(
-        scenes.join("tri.obj"),
-        "v -2 -2 -5\nv 2 -2 -5\nv 0 2 -5\nf 1 2 3\n",
-    )
-    .expect("obj");
+    std::fs::write(scenes.join("tri.obj"), triangle_obj(2.0)).expect("obj");
     std::fs::write(
         root.join("scenes/base.sdf"),
         "define material white 0.2 0.2 0.2 0.8 0.8 0.8 0 0 0 1\n\

@@ -79,8 +79,9 @@ pub struct TraceState {
 }
 
 /// What adaptive sampling's first pass learned about a pixel, handed to the integrator for
-/// the first samples it adds there (`sampler::pattern::PRIOR_SAMPLES`): the lights every shadow ray of the centres around the pixel
-/// saw fully, taken as visible at the surface a camera ray hits without a shadow ray.
+/// the first samples it adds there (`sampler::pattern::PRIOR_SAMPLES`): the lights every
+/// shadow ray of the centres around the pixel saw fully, taken as visible at the surface a
+/// camera ray hits without a shadow ray.
 #[derive(Clone, Debug, Default)]
 pub struct PixelPrior {
     /// Bit k: light k is known to be fully visible.

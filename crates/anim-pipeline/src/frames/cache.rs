@@ -42,15 +42,14 @@ pub fn settings_fingerprint(settings: &RenderSettings, load: &LoadOptions) -> St
 /// The hash a frame's record holds: of the settings, the frame's bytes (`sdf`, read from
 /// `path`), the bytes of every file it includes (`include`), so that a change to the static
 /// part of an animation renders its frames again, and the size and modification time of
-/// every mesh they name (`meshes_noted`).
+/// every mesh they name (`hash_referenced`).
 pub(super) fn frame_hash(sdf: &[u8], path: &Path, fingerprint: &str, max_input: u64) -> u64 {
     let mut h = Fnv64::default();
     h.write(fingerprint.as_bytes());
     // A separator that cannot occur in the fingerprint keeps the two parts apart.
     h.write(&[0]);
     h.write(sdf);
-    meshes_noted(&mut h, sdf, path);
-    hash_included(
+    hash_referenced(
         &mut h,
         sdf,
         path,
@@ -60,39 +59,34 @@ pub(super) fn frame_hash(sdf: &[u8], path: &Path, fingerprint: &str, max_input: 
     h.finish()
 }
 
-/// Adds the files `sdf` includes to `h`, each with its name and length, and what they include,
-/// `depth` files deep at most (deeper, the loader refuses the frame anyway). A file that
-/// cannot be read adds its name alone: the frame then fails to load and is never vouched for.
-fn hash_included(h: &mut Fnv64, sdf: &[u8], path: &Path, max_input: u64, depth: usize) {
+/// Adds to `h` what `sdf` (read from `path`) refers to: the OBJ files its mesh statements
+/// name, each with its name, size and modification time (a mesh may be hundreds of megabytes,
+/// which reading for every frame of a run would cost more than rendering some frames, and
+/// editing it changes its time), then the files it includes, each with its name and bytes and
+/// what it refers to, `depth` files deep at most (deeper, the loader refuses the frame anyway).
+/// A file that cannot be read adds its name alone: the frame then fails to load and is never
+/// vouched for.
+fn hash_referenced(h: &mut Fnv64, sdf: &[u8], path: &Path, max_input: u64, depth: usize) {
+    let text = String::from_utf8_lossy(sdf);
+    for mesh in anim_core::sdf::mesh_files(&text, path) {
+        h.write_part(mesh.as_os_str().as_encoded_bytes());
+        if let Ok(meta) = std::fs::metadata(&mesh) {
+            h.write_part(&meta.len().to_le_bytes());
+            let since_epoch = meta
+                .modified()
+                .ok()
+                .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+            h.write_part(&since_epoch.map_or(0, |d| d.as_nanos()).to_le_bytes());
+        }
+    }
     let Some(depth) = depth.checked_sub(1) else {
         return;
     };
-    for file in anim_core::sdf::included_files(&String::from_utf8_lossy(sdf), path) {
+    for file in anim_core::sdf::included_files(&text, path) {
         h.write_part(file.as_os_str().as_encoded_bytes());
         if let Ok(bytes) = anim_core::load::read_input(&file, max_input, "file") {
             h.write_part(&bytes);
-            meshes_noted(h, &bytes, &file);
-            hash_included(h, &bytes, &file, max_input, depth);
-        }
-    }
-}
-
-/// Adds the OBJ files the mesh statements of `sdf` (read from `path`) name to `h`, each with
-/// its name, size and modification time: a mesh may be hundreds of megabytes, which reading
-/// for every frame of a run would cost more than rendering some frames, and editing it
-/// changes its time. A file whose metadata cannot be read adds its name alone (the frame then
-/// fails to load and is never vouched for).
-fn meshes_noted(h: &mut Fnv64, sdf: &[u8], path: &Path) {
-    for file in anim_core::sdf::mesh_files(&String::from_utf8_lossy(sdf), path) {
-        h.write_part(file.as_os_str().as_encoded_bytes());
-        if let Ok(meta) = std::fs::metadata(&file) {
-            h.write_part(&meta.len().to_le_bytes());
-            let modified = meta.modified().ok().and_then(|t| {
-                t.duration_since(std::time::UNIX_EPOCH)
-                    .ok()
-                    .map(|d| d.as_nanos())
-            });
-            h.write_part(&modified.unwrap_or(0).to_le_bytes());
+            hash_referenced(h, &bytes, &file, max_input, depth);
         }
     }
 }
