@@ -3,9 +3,9 @@
 
 use super::camera::PinholeCamera;
 use super::compile::{Occlusion, RayHint, RenderScene};
+use super::counts::RayCounts;
 use super::geometry::{PrimId, Scratch, SurfaceHit};
 use super::shading::ShadeMaterial;
-use super::RayCounts;
 use crate::math::{reflect, Ray};
 use glam::Vec3A;
 

@@ -17,6 +17,7 @@
 
 pub mod camera;
 pub mod compile;
+mod counts;
 pub mod film;
 pub mod geometry;
 pub mod integrator;
@@ -27,6 +28,7 @@ mod settings;
 pub mod shading;
 pub mod view;
 
+pub use counts::RayCounts;
 pub use film::HdrImage;
 pub use settings::{RenderSettings, Sampling};
 
@@ -40,41 +42,6 @@ use integrator::Integrator;
 use motion::Shutter;
 use std::sync::Arc;
 use view::Viewpoint;
-
-/// How many rays of each kind a render traced.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct RayCounts {
-    /// Rays from the camera.
-    pub primary: u64,
-    /// Rays towards lights.
-    pub shadow: u64,
-    /// Mirror rays.
-    pub reflected: u64,
-    /// Rays through transparent surfaces.
-    pub refracted: u64,
-}
-
-impl RayCounts {
-    /// Rays of every kind.
-    pub fn total(&self) -> u64 {
-        self.primary + self.shadow + self.reflected + self.refracted
-    }
-
-    /// `a + b`, for reductions over workers.
-    pub fn sum(mut a: RayCounts, b: RayCounts) -> RayCounts {
-        a += b;
-        a
-    }
-}
-
-impl std::ops::AddAssign for RayCounts {
-    fn add_assign(&mut self, o: RayCounts) {
-        self.primary += o.primary;
-        self.shadow += o.shadow;
-        self.reflected += o.reflected;
-        self.refracted += o.refracted;
-    }
-}
 
 /// One rendered image and what it took.
 #[derive(Clone, Debug)]

@@ -30,8 +30,8 @@
 use super::first_pass::{around, FirstPass};
 use super::pattern::{self, tone3, Moments, PixelPattern, MOTION_MIN_SAMPLES, PRIOR_SAMPLES};
 use super::{Frame, Sampled};
+use crate::render::counts::RayCounts;
 use crate::render::integrator::{PixelPrior, TraceState};
-use crate::render::RayCounts;
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 

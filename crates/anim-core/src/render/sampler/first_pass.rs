@@ -6,9 +6,9 @@
 use super::packet;
 use super::pattern::{tone3, FLAT_CONTRAST};
 use super::Frame;
+use crate::render::counts::RayCounts;
 use crate::render::integrator::{KnownNear, PixelPrior, TraceState};
 use crate::render::motion::Shutter;
-use crate::render::RayCounts;
 use glam::Vec3A;
 use rayon::prelude::*;
 

@@ -17,9 +17,10 @@ mod uniform;
 pub use uniform::sample_offsets;
 
 use super::camera::PinholeCamera;
+use super::counts::RayCounts;
 use super::integrator::Integrator;
 use super::motion::Shutter;
-use super::{RayCounts, Sampling};
+use super::settings::Sampling;
 use glam::Vec3;
 
 /// One frame as a sampler sees it.

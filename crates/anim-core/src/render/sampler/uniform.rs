@@ -5,8 +5,8 @@
 use super::packet::{self, BLOCK, BLOCK_H, BLOCK_W};
 use super::pattern::uniform_time;
 use super::Frame;
+use crate::render::counts::RayCounts;
 use crate::render::integrator::{PixelPrior, TraceState};
-use crate::render::RayCounts;
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 
