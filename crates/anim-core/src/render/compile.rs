@@ -4,10 +4,10 @@
 //! ([`RayHint`], in the manner of Mitsuba's `coherent` flag) that lets the scene answer it
 //! from the structure that serves it best.
 //!
-//! A compiled scene has three parts: the [`Geometry`] (camera-free, immutable, shared by an
+//! A compiled scene has three parts: the [`Aggregate`] (camera-free, immutable, shared by an
 //! `Arc`), the [`View`] (built with the camera) and the [`Shading`] data.
 
-use super::geometry::{Dropped, Geometry, PrimId, Scratch, SurfaceHit};
+use super::geometry::{Aggregate, Dropped, PrimId, Scratch, SurfaceHit};
 use super::policy::{GeometryPlan, ViewPlan};
 use super::shading::Shading;
 use super::view::{View, Viewpoint};
@@ -46,7 +46,7 @@ pub enum Occlusion {
 #[derive(Clone, Debug)]
 pub struct RenderScene {
     /// What rays meet: the primitives and their hierarchy (camera-free, shared).
-    pub geometry: Arc<Geometry>,
+    pub geometry: Arc<Aggregate>,
     /// Where the rays whose start is known look their candidates up.
     pub view: View,
     /// How what rays meet is shaded.
@@ -58,17 +58,17 @@ impl RenderScene {
     /// of the geometry alone); the shapes that stay degenerate once transformed are left out
     /// and returned.
     pub fn compile(scene: &Scene, viewpoint: Option<&Viewpoint>) -> (RenderScene, Vec<Dropped>) {
-        let (geometry, dropped) = Geometry::build(scene);
+        let (geometry, dropped) = Aggregate::build(scene);
         (
             Self::with_geometry(Arc::new(geometry), scene, viewpoint),
             dropped,
         )
     }
 
-    /// The scene `scene` whose geometry was built already (`Geometry::build` of it), as
+    /// The scene `scene` whose geometry was built already (`Aggregate::build` of it), as
     /// seen from `viewpoint`.
     pub fn with_geometry(
-        geometry: Arc<Geometry>,
+        geometry: Arc<Aggregate>,
         scene: &Scene,
         viewpoint: Option<&Viewpoint>,
     ) -> RenderScene {

@@ -3,7 +3,7 @@
 //! The data flow of one frame (docs/architecture.md has the picture):
 //!
 //! ```text
-//! RenderJob ──compile──▶ RenderScene { Geometry (Arc, camera-free) · View · Shading }
+//! RenderJob ──compile──▶ RenderScene { Aggregate (Arc, camera-free) · View · Shading }
 //!           ──sampler──▶ camera ray (camera, motion) ──integrator──▶ radiance ──▶ film
 //! ```
 //!
@@ -36,7 +36,7 @@ use crate::math::Transform;
 use crate::scene::{Camera, RenderJob, Scene};
 use camera::{CameraError, PinholeCamera};
 use compile::RenderScene;
-use geometry::{Dropped, Geometry};
+use geometry::{Aggregate, Dropped};
 use glam::DVec3;
 use integrator::Integrator;
 use motion::Shutter;
@@ -74,7 +74,7 @@ pub struct Prepared<'j> {
     /// The scene and camera moved, or `None` when the eye is at the origin already.
     rebased: Option<(Scene, Camera)>,
     /// The camera-free geometry, shared by the probe and the render.
-    pub geometry: Arc<Geometry>,
+    pub geometry: Arc<Aggregate>,
     /// Shapes that became degenerate once transformed (in f32) and were left out.
     pub dropped: Vec<Dropped>,
 }
@@ -97,7 +97,7 @@ impl<'j> Prepared<'j> {
             (scene, camera)
         });
         let scene = rebased.as_ref().map_or(&job.scene, |(s, _)| s);
-        let (geometry, dropped) = Geometry::build(scene);
+        let (geometry, dropped) = Aggregate::build(scene);
         Prepared {
             job,
             rebased,

@@ -5,7 +5,7 @@
 //! once, when the scene is compiled; never patched afterwards. [`super::policy::view_plan`]
 //! decides which structure serves which point.
 
-use super::geometry::{Candidates, Geometry};
+use super::geometry::{Aggregate, Candidates};
 use super::policy::{self, Lookup, ViewFacts, ViewPlan};
 use super::shading::PointLight;
 use crate::accel::{DirectionCells, ImageTiles, ImageView};
@@ -45,7 +45,7 @@ pub struct View {
 impl View {
     /// The view of `geometry` from `viewpoint` (`None`: no camera), lit by `lights`.
     pub fn new(
-        geometry: &Geometry,
+        geometry: &Aggregate,
         lights: &[PointLight],
         lights_move: bool,
         viewpoint: Option<&Viewpoint>,

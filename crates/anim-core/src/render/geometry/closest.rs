@@ -5,7 +5,7 @@
 //! the same answer to the bit.
 
 use super::leaf::Best;
-use super::{placed_surface, sphere_surface, Geometry, Kind, PrimId, Scratch, SurfaceHit};
+use super::{placed_surface, sphere_surface, Aggregate, Kind, PrimId, Scratch, SurfaceHit};
 use crate::math::Ray;
 use crate::render::geometry::Primitive;
 use crate::shape::{BoxRay, SphereRay};
@@ -38,7 +38,7 @@ const FLAT: [u32; crate::render::policy::FLAT_MAX] = {
     all
 };
 
-impl Geometry {
+impl Aggregate {
     /// Nearest surface along the ray with `t < t_max` among `candidates`.
     #[inline]
     pub fn closest(
@@ -60,7 +60,7 @@ impl Geometry {
         }
     }
 
-    /// [`Geometry::closest`] among every primitive.
+    /// [`Aggregate::closest`] among every primitive.
     #[inline]
     fn closest_of_all(
         &self,

@@ -1,10 +1,10 @@
-//! Four primitives at a time: the tests every query of [`super::Geometry`] ends in, whether
+//! Four primitives at a time: the tests every query of [`super::Aggregate`] ends in, whether
 //! its candidates come from a leaf of the hierarchy, the flat leaf of a small scene or a
 //! list looked up by a view. Packed spheres go four to one SIMD test, world-space boxes are
 //! hit by the slab test of their bounds, and the other kinds are tested one by one where
 //! that slab test passes.
 
-use super::{Geometry, Kind, Scratch, BOUNDS_OF_BOX, BOUNDS_OF_OTHER, BOUNDS_OF_SPHERE};
+use super::{Aggregate, Kind, Scratch, BOUNDS_OF_BOX, BOUNDS_OF_OTHER, BOUNDS_OF_SPHERE};
 use crate::math::Ray;
 use crate::render::geometry::Primitive;
 use crate::shape::{BoxRay, ShapeHit, SphereRay};
@@ -33,7 +33,7 @@ impl Best {
     }
 }
 
-/// Four primitives sorted by [`Geometry::classify`], as lane masks.
+/// Four primitives sorted by [`Aggregate::classify`], as lane masks.
 pub(super) struct Lanes {
     pub spheres: u32,
     pub boxes_hit: u32,
@@ -80,7 +80,7 @@ pub(super) fn offer(
     false
 }
 
-impl Geometry {
+impl Aggregate {
     /// The four primitives from `start` on (those before `end`), sorted by the slab test of
     /// their bounds: the packed spheres; the boxes hit before `t_max`, and where; the other
     /// kinds whose bounds the ray meets before `t_max`.
@@ -112,7 +112,7 @@ impl Geometry {
     }
 
     /// The closest hit among a leaf of packed spheres only: the same tests and the same
-    /// winner as [`Geometry::closest_in_leaf`], without asking each primitive its kind. Only
+    /// winner as [`Aggregate::closest_in_leaf`], without asking each primitive its kind. Only
     /// the lanes hit are looked at, in lane order, which is the order `closest_in_leaf`
     /// judges them in. Returns the new `t_max`.
     #[inline(always)]

@@ -4,11 +4,11 @@
 //! of the same query over every primitive.
 
 use super::leaf::{fours, gather, offer};
-use super::{Geometry, PrimId, Scratch, SurfaceHit};
+use super::{Aggregate, PrimId, Scratch, SurfaceHit};
 use crate::math::Ray;
 use crate::shape::{BoxRay, SphereRay};
 
-impl Geometry {
+impl Aggregate {
     /// The closest hit (without limit) among the bounded primitives of `listed` (padded to a
     /// multiple of four) and the unbounded ones: which of those listed wins is judged as
     /// every closest-hit query judges it, by distance and number. `NEAREST_FIRST`: `near`

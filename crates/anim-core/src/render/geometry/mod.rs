@@ -1,7 +1,9 @@
-//! The camera-free part of a compiled scene: every primitive placed in the world, the
-//! hierarchy over them, the instanced composites and the shapes that move. Built once from a
-//! scene description ([`Geometry::build`]), immutable afterwards and shared (`Arc`) by
-//! whatever renders that scene.
+//! The camera-free part of a compiled scene, the [`Aggregate`] (pbrt's and Mitsuba's name for
+//! the structure that answers rays over every primitive): every primitive placed in the
+//! world, the hierarchy over them, the instanced composites and the shapes that move. Built
+//! once from a scene description ([`Aggregate::build`]), immutable afterwards and shared
+//! (`Arc`) by whatever renders that scene. Only the facade (`super::compile`) asks it rays;
+//! the integrator and the samplers never name it.
 //!
 //! It answers two questions about a ray, each in its own file: the closest hit
 //! (`closest.rs`) and whether, and what, the ray meets before a distance (`occlusion.rs`);
@@ -36,7 +38,7 @@ use leaf::{four, LANES};
 use motion::Moving;
 
 /// A primitive's number in a compiled scene: its place in the hierarchy's leaf order, then
-/// the unbounded ones, then (from [`Geometry::len`] on) the shapes of instanced composites.
+/// the unbounded ones, then (from [`Aggregate::len`] on) the shapes of instanced composites.
 /// Equal numbers are the same surface, which adaptive sampling compares between pixels.
 pub type PrimId = u32;
 
@@ -83,18 +85,18 @@ impl KindTag {
     }
 }
 
-/// `w` of [`Geometry`]'s bounds: how a primitive's slab test is read. A world-space box's
+/// `w` of [`Aggregate`]'s bounds: how a primitive's slab test is read. A world-space box's
 /// bounds are the box itself, and their slab test gives its hit; any other kind's bounds are
 /// tested before its own test; a packed sphere is tested by `SphereRay::hit4` instead.
 const BOUNDS_OF_BOX: f32 = 1.0;
 const BOUNDS_OF_OTHER: f32 = 0.0;
 const BOUNDS_OF_SPHERE: f32 = -1.0;
 
-/// Primitives are numbered in the hierarchy's leaf order (so a leaf reads consecutive
-/// entries), then the unbounded ones. World-space spheres, the common case, are packed into
+/// The compiled primitive table and its hierarchy. Primitives are numbered in the hierarchy's
+/// leaf order (so a leaf reads consecutive entries), then the unbounded ones. World-space spheres, the common case, are packed into
 /// 16 bytes and tested four at a time with no dispatch; everything else is a [`Primitive`].
 #[derive(Clone, Debug)]
-pub struct Geometry {
+pub struct Aggregate {
     /// Per primitive: its material.
     material: Vec<u32>,
     /// Per primitive: its [`Kind`].
@@ -216,10 +218,10 @@ impl Table {
     }
 }
 
-impl Geometry {
+impl Aggregate {
     /// Places every shape of `scene` (the ones that stay degenerate once transformed are
     /// left out and returned) and builds the hierarchy over them.
-    pub fn build(scene: &Scene) -> (Geometry, Vec<Dropped>) {
+    pub fn build(scene: &Scene) -> (Aggregate, Vec<Dropped>) {
         let mut moving = Moving::new(scene).map(Box::new);
         let (mut table, dropped) = Table::of_instances(scene, &mut moving);
         if let Some(m) = &mut moving {
@@ -249,7 +251,7 @@ impl Geometry {
         let kind = order.iter().map(|&i| table.kind[i as usize]).collect();
         let mut spheres: Vec<Vec4> = order.iter().map(|&i| table.spheres[i as usize]).collect();
         spheres.resize(order.len() + LANES - 1, Vec4::NAN);
-        let geometry = Geometry {
+        let geometry = Aggregate {
             material,
             kind,
             spheres,
@@ -466,7 +468,7 @@ impl Geometry {
         moving.placed_with(k, ray.time, scratch, |p| placed_surface(p, ray, hit.t, hit))
     }
 
-    /// Whether [`Geometry::moving_blocks`] answers.
+    /// Whether [`Aggregate::moving_blocks`] answers.
     pub fn answers_moving_blocks(&self) -> bool {
         self.moving.as_ref().is_none_or(|m| m.answers_blocks())
     }

@@ -2,11 +2,11 @@
 //! cheapest (shadow rays, and the tests that hold every strategy to brute force).
 
 use super::leaf::{offer, LANES};
-use super::{Candidates, Geometry, Kind, PrimId, Scratch};
+use super::{Aggregate, Candidates, Kind, PrimId, Scratch};
 use crate::math::Ray;
 use crate::shape::{BoxRay, SphereRay};
 
-impl Geometry {
+impl Aggregate {
     /// Offers each primitive among `candidates` hit before `t_max` (in an instanced
     /// composite, the first shape hit of each use) to `stop`, until it returns true. Which
     /// of several comes first is the strategy's: near first through the hierarchy, by
@@ -33,7 +33,7 @@ impl Geometry {
     }
 
     /// Something that lies on the ray before `t_max` (a primitive id, for
-    /// [`Geometry::hit`]), if anything does; which one, of several, is left to the hierarchy.
+    /// [`Aggregate::hit`]), if anything does; which one, of several, is left to the hierarchy.
     pub fn occluder(&self, ray: &Ray, t_max: f32, scratch: &Scratch) -> Option<PrimId> {
         let mut found = None;
         self.any_hit(ray, t_max, scratch, |i| {
@@ -43,7 +43,7 @@ impl Geometry {
         found
     }
 
-    /// [`Geometry::any`] among every primitive, in the hierarchy's near-first order. Not
+    /// [`Aggregate::any`] among every primitive, in the hierarchy's near-first order. Not
     /// inlined, as the queries over lists are not: the dispatch that picks one of them stays
     /// small enough to be inlined where rays are traced.
     #[inline(never)]
@@ -51,7 +51,7 @@ impl Geometry {
         self.any_hit(ray, t_max, scratch, stop)
     }
 
-    /// [`Geometry::any`] among every primitive, in the hierarchy's near-first order.
+    /// [`Aggregate::any`] among every primitive, in the hierarchy's near-first order.
     #[inline(always)]
     fn any_hit(&self, ray: &Ray, t_max: f32, scratch: &Scratch, mut stop: impl FnMut(u32) -> bool) {
         for i in self.unbounded..self.len() as u32 {

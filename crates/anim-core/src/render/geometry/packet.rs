@@ -1,19 +1,19 @@
 //! Closest hits of packets of coherent rays: one walk of the hierarchy for all of them, each
 //! leaf tested ray by ray with the single-ray leaf tests, so every ray's answer is
-//! [`Geometry::closest`]'s to the bit (the same winner of ties too).
+//! [`Aggregate::closest`]'s to the bit (the same winner of ties too).
 //!
 //! Packets, one home per layer: `crate::accel::wide::packet` (the shared walk of the
 //! hierarchy), `crate::render::geometry::packet` (closest hits of a packet) and
 //! `crate::render::sampler::packet` (camera rays of a block of pixels, traced together).
 
 use super::leaf::{fours, gather, Best, LANES};
-use super::{Candidates, Geometry, PrimId, Primitive, Scratch, SurfaceHit};
+use super::{Aggregate, Candidates, PrimId, Primitive, Scratch, SurfaceHit};
 use crate::accel::Packet;
 use crate::math::Ray;
 use crate::shape::{BoxRay, SphereRay};
 
-impl Geometry {
-    /// [`Geometry::closest`] of each ray among every primitive, all up to `t_max`. Rays
+impl Aggregate {
+    /// [`Aggregate::closest`] of each ray among every primitive, all up to `t_max`. Rays
     /// whose directions do not share an octant are traced one by one.
     pub fn closest_packet<const N: usize>(
         &self,
