@@ -30,12 +30,12 @@ fn rays_through_direction_cells_meet_what_brute_force_meets() {
             .collect();
         let (scene, prims) = lit_scene(instances, transforms, &lights);
         // Camera rays from an eye with cells around it (and rays from elsewhere): the same
-        // hit as `closest` and brute force find, to the bit.
+        // hit as `intersect` and brute force find, to the bit.
         let eye = rng.vec(60.0) - DVec3::splat(5.0);
         let eye = Vec3A::from(eye.as_vec3());
         let (render, dropped) = Compiled::new(&scene, Some(&viewpoint_at(eye, false)));
         assert!(dropped.is_empty());
-        assert!(render.scene.view.kept().1, "the eye keeps cells");
+        assert!(render.scene.view().kept().1, "the eye keeps cells");
         for i in 0..3000 {
             let ray = if i % 5 == 4 {
                 random_ray(&mut rng, i)
@@ -93,11 +93,11 @@ fn lit_scene(
     (scene, prims)
 }
 
-/// `closest_seen` of a camera ray against `closest` (to the bit) and brute force (the
+/// `intersect_camera` of a camera ray against `intersect` (to the bit) and brute force (the
 /// distance); whether it hit.
 fn check_seen(render: &Compiled, prims: &[Primitive], ray: &Ray, i: usize) -> bool {
-    let seen = render.closest_seen(ray);
-    let found = render.closest(ray, f32::INFINITY);
+    let seen = render.intersect_camera(ray);
+    let found = render.intersect(ray, f32::INFINITY);
     let brute = brute_closest(prims, ray, f32::INFINITY);
     assert_eq!(
         seen.map(|(_, h)| h.t.to_bits()),
@@ -122,14 +122,17 @@ fn shadow_ray(rng: &mut SplitMix64, light: Vec3A, i: usize) -> (Ray, f32) {
     (Ray::new(origin, dir), (light - origin).dot(dir))
 }
 
-/// `shadow` of a ray towards light `k` against brute force (opaque shapes only); whether it
-/// is blocked.
+/// `occlusion` of a ray towards light `k` against brute force (opaque shapes only); whether
+/// it is blocked.
 fn check_shadow(render: &Compiled, prims: &[Primitive], ray: &Ray, t_limit: f32, k: usize) -> bool {
     let brute = brute_closest(prims, ray, t_limit).is_some();
-    let found = render.shadow(ray, t_limit, k);
+    let found = render.occlusion(ray, t_limit, RayHint::Shadow(k));
     match found {
         Occlusion::Clear => {}
-        Occlusion::Blocked(id) => assert!(render.hit(id, ray, t_limit).is_some(), "{ray:?}"),
+        Occlusion::Blocked(id) => {
+            let hit = render.intersect_primitive(id, ray, t_limit);
+            assert!(hit.is_some(), "{ray:?}");
+        }
         other => panic!("opaque shapes only, yet {other:?}"),
     }
     assert_eq!(found != Occlusion::Clear, brute, "light {k}: {ray:?}");
@@ -169,10 +172,10 @@ fn tally_shadows(
     (blocked, clear)
 }
 
-/// Image tiles (`RenderScene::watch_image`): in scenes larger than a flat one (mixed kinds
+/// Image tiles (`View`'s, which `RayHint::Camera` and `RayHint::Shadow` rays look up): in scenes larger than a flat one (mixed kinds
 /// with a plane, world boxes with rooms around the eye, world spheres alone), camera rays
 /// through random points of the image (and a few beyond its edges, or from elsewhere) get
-/// `closest`'s hit to the bit, and brute force's distance; shadow rays towards lights far
+/// `intersect`'s hit to the bit, and brute force's distance; shadow rays towards lights far
 /// off, among the shapes and inside the rooms, lifted off their start as `spawn_ray` does,
 /// are blocked exactly when brute force finds a hit before the light.
 #[test]
@@ -231,17 +234,17 @@ fn rays_through_image_tiles_meet_what_brute_force_meets() {
             let bits = |h: &Option<(u32, SurfaceHit)>| {
                 h.map(|(id, h)| (id, h.t.to_bits(), h.normal.to_array()))
             };
-            for (ray, hit) in block.iter().zip(render.closest_seen_packet(&block)) {
+            for (ray, hit) in block.iter().zip(render.intersect_camera_packet(&block)) {
                 assert_eq!(
                     bits(&hit),
-                    bits(&render.closest_seen(ray)),
+                    bits(&render.intersect_camera(ray)),
                     "block {i}: {ray:?}"
                 );
             }
-            for (ray, hit) in run.iter().zip(render.closest_seen_packet(&run)) {
+            for (ray, hit) in run.iter().zip(render.intersect_camera_packet(&run)) {
                 assert_eq!(
                     bits(&hit),
-                    bits(&render.closest_seen(ray)),
+                    bits(&render.intersect_camera(ray)),
                     "run {i}: {ray:?}"
                 );
             }
@@ -302,9 +305,9 @@ fn direction_cells_in_a_frame_with_motion_answer_as_the_hierarchy() {
         let scene = loaded_scene(&format!("{shapes}{motion}render eye m.png 64 48\n"));
         let view = viewpoint_at(Vec3A::ZERO, true);
         let (render, dropped) = Compiled::new(&scene, Some(&view));
-        assert!(dropped.is_empty() && render.scene.geometry.has_motion());
+        assert!(dropped.is_empty() && render.scene.aggregate().has_motion());
         let lights = if light_moves { 0 } else { 2 };
-        assert_eq!(render.scene.view.kept(), (lights, true));
+        assert_eq!(render.scene.view().kept(), (lights, true));
         for i in 0..4000 {
             let time = rng.unit_f64() as f32;
             // Mostly across the image, some anywhere.
@@ -312,24 +315,25 @@ fn direction_cells_in_a_frame_with_motion_answer_as_the_hierarchy() {
             let towards = rng.vec(spread) - DVec3::new(spread / 2.0, spread / 2.0, 1.0);
             let towards = Vec3A::from(towards.as_vec3());
             let ray = Ray::new(Vec3A::ZERO, towards.normalize()).at_time(time);
-            let seen = render.closest_seen(&ray);
-            let found = render.closest(&ray, f32::INFINITY);
+            let seen = render.intersect_camera(&ray);
+            let found = render.intersect(&ray, f32::INFINITY);
             let bits = |h: Option<(u32, SurfaceHit)>| {
                 h.map(|(id, h)| (id, h.point.to_array(), h.normal.to_array()))
             };
             assert_eq!(bits(seen), bits(found), "camera ray {i}: {ray:?}");
-            let geometry = &render.scene.geometry;
+            let geometry = render.scene.aggregate();
             moving_hits += seen.is_some_and(|(id, _)| geometry.moving_entry(id).is_some()) as usize;
             for (k, light) in render.lights().iter().enumerate() {
                 let Some((_, hit)) = found else { break };
-                let to = render.scene.shading.light_position(k, light, time) - hit.point;
+                let to = render.scene.shading().light_position(k, light, time) - hit.point;
                 let ray = hit.spawn_ray(to.normalize()).at_time(time);
                 let t_limit = (hit.point + to - ray.origin).dot(ray.dir);
-                let hierarchy = render.closest(&ray, t_limit).is_some();
-                match render.shadow(&ray, t_limit, k) {
+                let hierarchy = render.intersect(&ray, t_limit).is_some();
+                match render.occlusion(&ray, t_limit, RayHint::Shadow(k)) {
                     Occlusion::Clear => assert!(!hierarchy, "light {k}, ray {i}: {ray:?}"),
                     Occlusion::Blocked(id) => {
-                        assert!(hierarchy && render.hit(id, &ray, t_limit).is_some());
+                        let hit = render.intersect_primitive(id, &ray, t_limit);
+                        assert!(hierarchy && hit.is_some());
                     }
                     other => panic!("opaque shapes only, yet {other:?}"),
                 }

@@ -9,99 +9,111 @@
 //!   flattened trees, packets against single rays.
 //! - `lookups`: camera and shadow rays through the eye's and the lights' direction cells and
 //!   image tiles, in still and moving frames.
+//! - `shadows`: how much of a light passes the glass before it (`RenderScene::transmittance`),
+//!   with and without lookups, and through instanced composites.
 
 mod hierarchy;
 mod lookups;
 mod render_scene;
+mod shadows;
+
+#[path = "../common/composites.rs"]
+mod composites;
 
 use anim_core::math::{Ray, Transform};
 use anim_core::render::camera::PinholeCamera;
-use anim_core::render::compile::{Occlusion, RayHint, RenderScene};
-use anim_core::render::geometry::{Dropped, Primitive, Scratch, SurfaceHit};
+use anim_core::render::compile::{Occlusion, RayHint, RenderScene, Scratch, ShadowRay, SurfaceHit};
+use anim_core::render::geometry::{Dropped, MovingScratch, Primitive};
 use anim_core::render::shading::PointLight;
 use anim_core::render::view::Viewpoint;
 use anim_core::scene::{Camera, Instance, Material, Scene};
 use anim_core::shape::Geometry;
 use anim_core::util::SplitMix64;
 use glam::{DVec3, Vec3, Vec3A};
+use std::cell::RefCell;
 
-/// A compiled scene with a scratch of its own, asked what the renderer asks it.
+/// A compiled scene with a scratch of its own, asked what the renderer asks it: each helper
+/// is named after the question of the facade (`RenderScene`) or of its aggregate it asks.
 struct Compiled {
     scene: RenderScene,
-    scratch: Scratch,
+    scratch: RefCell<Scratch>,
+    /// For the aggregate's own queries.
+    moving: RefCell<MovingScratch>,
 }
 
 impl Compiled {
     fn new(scene: &Scene, viewpoint: Option<&Viewpoint>) -> (Compiled, Vec<Dropped>) {
         let (scene, dropped) = RenderScene::compile(scene, viewpoint);
-        let scratch = Scratch::default();
-        (Compiled { scene, scratch }, dropped)
+        let compiled = Compiled {
+            scene,
+            scratch: RefCell::default(),
+            moving: RefCell::default(),
+        };
+        (compiled, dropped)
     }
 
     fn len(&self) -> usize {
-        self.scene.geometry.len()
+        self.scene.aggregate().len()
     }
 
     fn material_of(&self, id: u32) -> u32 {
-        self.scene.geometry.material_of(id)
+        self.scene.aggregate().material_of(id)
     }
 
-    /// The closest hit as a reflected ray asks it: through the hierarchy.
-    fn closest(&self, ray: &Ray, t_max: f32) -> Option<(u32, SurfaceHit)> {
+    /// `RenderScene::intersect` as a reflected ray asks it: through the hierarchy.
+    fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(u32, SurfaceHit)> {
+        let scratch = &mut self.scratch.borrow_mut();
         self.scene
-            .intersect(ray, t_max, RayHint::Secondary, &self.scratch)
+            .intersect(ray, t_max, RayHint::Secondary, scratch)
     }
 
-    /// The closest hit as a camera ray asks it: through the eye's lookup where it answers.
-    fn closest_seen(&self, ray: &Ray) -> Option<(u32, SurfaceHit)> {
+    /// `RenderScene::intersect` as a camera ray asks it: through the eye's lookup where it
+    /// answers.
+    fn intersect_camera(&self, ray: &Ray) -> Option<(u32, SurfaceHit)> {
+        let scratch = &mut self.scratch.borrow_mut();
         self.scene
-            .intersect(ray, f32::INFINITY, RayHint::Camera, &self.scratch)
+            .intersect(ray, f32::INFINITY, RayHint::Camera, scratch)
     }
 
-    fn closest_seen_packet<const N: usize>(
+    /// `RenderScene::intersect_camera_packet`.
+    fn intersect_camera_packet<const N: usize>(
         &self,
         rays: &[Ray; N],
     ) -> [Option<(u32, SurfaceHit)>; N] {
-        self.scene.intersect_camera_packet(rays, &self.scratch)
+        let scratch = &mut self.scratch.borrow_mut();
+        self.scene.intersect_camera_packet(rays, scratch)
     }
 
+    /// `Aggregate::closest_packet`: the packet walk over every primitive, up to `t_max`.
     fn closest_packet<const N: usize>(
         &self,
         rays: &[Ray; N],
         t_max: f32,
     ) -> [Option<(u32, SurfaceHit)>; N] {
+        let moving = &mut self.moving.borrow_mut();
+        self.scene.aggregate().closest_packet(rays, t_max, moving)
+    }
+
+    /// `RenderScene::occlusion` of a ray of kind `hint`.
+    fn occlusion(&self, ray: &Ray, t_max: f32, hint: RayHint) -> Occlusion {
+        let scratch = &mut self.scratch.borrow_mut();
+        self.scene.occlusion(ray, t_max, hint, scratch)
+    }
+
+    /// `RenderScene::transmittance`.
+    fn transmittance(&self, shadow: &ShadowRay) -> f32 {
         self.scene
-            .geometry
-            .closest_packet(rays, t_max, &self.scratch)
+            .transmittance(shadow, &mut self.scratch.borrow_mut())
     }
 
-    fn shadow(&self, ray: &Ray, t_max: f32, light: usize) -> Occlusion {
-        self.scene
-            .occlusion(ray, t_max, RayHint::Shadow(light), &self.scratch)
-    }
-
-    fn occluder(&self, ray: &Ray, t_max: f32) -> Option<u32> {
-        self.scene.geometry.occluder(ray, t_max, &self.scratch)
-    }
-
-    fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.occluder(ray, t_max).is_some()
-    }
-
-    fn hit(&self, id: u32, ray: &Ray, t_max: f32) -> Option<f32> {
-        self.scene.geometry.hit(id, ray, t_max, &self.scratch)
-    }
-
-    fn intersect(&self, id: u32, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
-        self.scene.geometry.intersect(id, ray, t_max, &self.scratch)
-    }
-
-    fn any_candidate(&self, ray: &Ray, t_max: f32, stop: impl FnMut(u32) -> bool) -> bool {
-        self.scene.geometry.any_candidate(ray, t_max, stop)
+    /// `RenderScene::intersect_primitive`.
+    fn intersect_primitive(&self, id: u32, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
+        let scratch = &mut self.scratch.borrow_mut();
+        self.scene.intersect_primitive(id, ray, t_max, scratch)
     }
 
     fn lights(&self) -> &[PointLight] {
-        &self.scene.shading.lights
+        &self.scene.shading().lights
     }
 }
 

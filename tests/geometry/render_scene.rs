@@ -6,7 +6,7 @@ use anim_core::accel::Packet;
 
 /// Also on scenes of world-space spheres only (with a duplicate: a tie), which the render
 /// scene tests without looking at kinds, and of world-space boxes only (with a duplicate, and
-/// rooms around every ray origin); `occluder` names a primitive that is really hit.
+/// rooms around every ray origin); `occlusion` names a primitive that is really hit.
 #[test]
 fn render_scene_equals_brute_force_on_mixed_scenes() {
     let mut rng = SplitMix64::new(0x2545F4914F6CDD1D);
@@ -31,7 +31,8 @@ fn render_scene_equals_brute_force_on_mixed_scenes() {
     }
 }
 
-/// `closest`, `intersect`, `occluded` and `occluder` of the render scene against brute force.
+/// `intersect`, `intersect_primitive` and `occlusion` of the render scene against brute
+/// force.
 fn check_render_scene(
     rng: &mut SplitMix64,
     n: usize,
@@ -61,7 +62,7 @@ fn check_render_scene(
         let ray = random_ray(rng, i);
         let t_limit = t_limit_of(i);
         let brute = brute_closest(&prims, &ray, t_limit);
-        let found = render.closest(&ray, t_limit);
+        let found = render.intersect(&ray, t_limit);
         assert_eq!(
             brute.map(|(_, t)| t.to_bits()),
             found.map(|(_, h)| h.t.to_bits()),
@@ -77,20 +78,17 @@ fn check_render_scene(
                 (h.point.to_array(), h.normal.to_array()),
                 "n={n} ray {i}: surface of primitive {b}"
             );
-            let again = render.intersect(slot, &ray, t_limit).unwrap();
+            let again = render.intersect_primitive(slot, &ray, t_limit).unwrap();
             assert_eq!(again.t.to_bits(), h.t.to_bits());
             hits += 1;
         }
-        assert_eq!(
-            render.occluded(&ray, t_limit),
+        check_opaque_occlusion(
+            &render,
+            &ray,
+            t_limit,
             brute.is_some(),
-            "n={n} ray {i}"
+            &format!("n={n} ray {i}"),
         );
-        let occluder = render.occluder(&ray, t_limit);
-        assert_eq!(occluder.is_some(), brute.is_some(), "n={n} ray {i}");
-        if let Some(id) = occluder {
-            assert!(render.hit(id, &ray, t_limit).is_some(), "n={n} ray {i}");
-        }
     }
     assert!(n < 2000 || hits > 1000, "{hits} hits");
     let hits = check_packets(rng, &render, DVec3::splat(-15.0), DVec3::splat(80.0));
@@ -99,7 +97,7 @@ fn check_render_scene(
 
 /// Packets of eight rays from one origin towards nearby points (a fan narrow enough to share
 /// an octant, as the camera rays of a pixel block do; some axis-parallel, some with limits,
-/// some mixing octants, which go ray by ray): every ray's closest hit is `closest`'s to the
+/// some mixing octants, which go ray by ray): every ray's closest hit is `intersect`'s to the
 /// bit, the same primitive included. Origins lie in `lo + [0, size)³`. Returns how many
 /// rays hit.
 fn check_packets(rng: &mut SplitMix64, scene: &Compiled, lo: DVec3, size: DVec3) -> usize {
@@ -136,7 +134,7 @@ fn check_packets(rng: &mut SplitMix64, scene: &Compiled, lo: DVec3, size: DVec3)
                     )
                 })
             };
-            let alone = scene.closest(ray, t_limit);
+            let alone = scene.intersect(ray, t_limit);
             hits += usize::from(alone.is_some());
             assert_eq!(bits(together[k]), bits(alone), "packet {i} ray {k}");
         }
@@ -145,9 +143,6 @@ fn check_packets(rng: &mut SplitMix64, scene: &Compiled, lo: DVec3, size: DVec3)
     assert!(packets > 1000, "{packets} packets");
     hits
 }
-
-#[path = "../common/composites.rs"]
-mod composites;
 
 /// The nearest hit over primitives in the flattened tree's order, as the render scene
 /// resolves ties: unbounded primitives first, then the first in the tree.
@@ -181,20 +176,19 @@ fn assert_same_shapes(instanced: &Scene, flat: &Scene) {
     }
 }
 
-/// The any-hit answers of both scenes for a ray that brute force finds `blocked` or not: the
-/// same answer, and an occluder that the ray does hit.
-fn check_any_hit(scenes: [&Compiled; 2], ray: &Ray, t_limit: f32, blocked: bool, what: &str) {
-    for s in scenes {
-        assert_eq!(s.occluded(ray, t_limit), blocked, "{what}");
-        let occluder = s.occluder(ray, t_limit);
-        assert_eq!(occluder.is_some(), blocked, "{what}");
-        if let Some(id) = occluder {
-            assert!(s.hit(id, ray, t_limit).is_some(), "{what}");
+/// `occlusion` of a ray (not a shadow ray: every primitive is asked) in a scene of opaque
+/// shapes that brute force finds `blocked` or not: the same answer, and a blocker that the
+/// ray does hit.
+fn check_opaque_occlusion(scene: &Compiled, ray: &Ray, t_limit: f32, blocked: bool, what: &str) {
+    match scene.occlusion(ray, t_limit, RayHint::Secondary) {
+        Occlusion::Clear => assert!(!blocked, "{what}"),
+        Occlusion::Blocked(id) => {
+            assert!(blocked, "{what}");
+            let hit = scene.intersect_primitive(id, ray, t_limit);
+            assert!(hit.is_some(), "{what}");
         }
+        other => panic!("opaque shapes only, yet {other:?}: {what}"),
     }
-    let a = scenes[0];
-    let any = a.any_candidate(ray, t_limit, |id| a.hit(id, ray, t_limit).is_some());
-    assert_eq!(any, blocked, "{what}");
 }
 
 /// Instancing differential: a scene with shared and nested-shared composites, transforms and
@@ -217,7 +211,7 @@ fn instanced_render_scene_equals_flattened_and_brute_force() {
         let (a, dropped_a) = Compiled::new(&instanced, None);
         let (b, dropped_b) = Compiled::new(&flat, None);
         assert!(dropped_a.is_empty() && dropped_b.is_empty());
-        assert!(a.scene.geometry.instance_uses() > 0);
+        assert!(a.scene.aggregate().instance_uses() > 0);
         let mut rng = SplitMix64::new(seed.wrapping_mul(0x9E3779B97F4A7C15));
         let (mut hits, mut ties) = (0, 0);
         let mut same_id = std::collections::HashMap::new();
@@ -233,7 +227,7 @@ fn instanced_render_scene_equals_flattened_and_brute_force() {
             let ray = Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(dir.as_vec3()));
             let t_limit = t_limit_of(i);
             let brute = brute_in_tree_order(&prims, &ray, t_limit);
-            let (ha, hb) = (a.closest(&ray, t_limit), b.closest(&ray, t_limit));
+            let (ha, hb) = (a.intersect(&ray, t_limit), b.intersect(&ray, t_limit));
             let bits = |h: &Option<(u32, SurfaceHit)>, s: &Compiled| {
                 h.map(|(id, h)| {
                     (
@@ -268,11 +262,13 @@ fn instanced_render_scene_equals_flattened_and_brute_force() {
                     ida,
                     "seed {seed} ray {i}"
                 );
-                let again = a.intersect(ida, &ray, t_limit).unwrap();
+                let again = a.intersect_primitive(ida, &ray, t_limit).unwrap();
                 assert_eq!(again.t.to_bits(), t.to_bits());
             }
             let what = format!("seed {seed} ray {i}");
-            check_any_hit([&a, &b], &ray, t_limit, brute.is_some(), &what);
+            for s in [&a, &b] {
+                check_opaque_occlusion(s, &ray, t_limit, brute.is_some(), &what);
+            }
         }
         let (lo, size) = (DVec3::new(-50.0, -30.0, -20.0), DVec3::splat(100.0));
         for s in [&a, &b] {

@@ -20,14 +20,14 @@
 
 use anim_core::math::{reflect, Ray};
 use anim_core::render::camera::PinholeCamera;
-use anim_core::render::compile::{RayHint, RenderScene};
-use anim_core::render::geometry::{Scratch, SurfaceHit};
+use anim_core::render::compile::{RayHint, RenderScene, Scratch, SurfaceHit};
 use anim_core::render::integrator::fresnel;
 use anim_core::scene::RenderJob;
 use anim_core::shape::Shape;
 use anim_core::util::SplitMix64;
 use glam::Vec3A;
 use rayon::prelude::*;
+use std::cell::RefCell;
 
 /// The kind of a primitive's shape (`None`: a packed world-space sphere), as an index of
 /// `Shape::KINDS`; `None` for a kind that is not judged: one neither convex nor one flat
@@ -77,22 +77,25 @@ fn hemisphere(rng: &mut SplitMix64, axis: Vec3A) -> Vec3A {
 struct Walk<'a> {
     scene: &'a RenderScene,
     max_depth: u32,
-    scratch: Scratch,
+    scratch: RefCell<Scratch>,
 }
 
 impl Walk<'_> {
     /// Spawns one ray from `hit` of primitive `prim` towards `dir`, as the renderer does
     /// (`SurfaceHit::spawn_ray`), and judges it.
     fn spawn(&self, prim: u32, hit: &SurfaceHit, dir: Vec3A, out: &mut RehitCount) {
-        let geometry = &self.scene.geometry;
-        let shape = geometry.object_shape(prim);
+        let shape = self.scene.aggregate().object_shape(prim);
         let Some(kind) = kind_index(shape) else {
             return;
         };
         let normal = hit.normal;
         let ray = hit.spawn_ray(dir);
         out.by_kind[kind].0 += 1;
-        let Some(again) = geometry.intersect(prim, &ray, f32::INFINITY, &self.scratch) else {
+        let mut scratch = self.scratch.borrow_mut();
+        let again = self
+            .scene
+            .intersect_primitive(prim, &ray, f32::INFINITY, &mut scratch);
+        let Some(again) = again else {
             return;
         };
         let outward = normal.dot(dir) >= 0.0;
@@ -104,9 +107,9 @@ impl Walk<'_> {
 
     fn trace(&self, ray: &Ray, depth: u32, rng: &mut SplitMix64, out: &mut RehitCount) {
         let hint = RayHint::Secondary;
-        let Some((prim, hit)) = self
-            .scene
-            .intersect(ray, f32::INFINITY, hint, &self.scratch)
+        let Some((prim, hit)) =
+            self.scene
+                .intersect(ray, f32::INFINITY, hint, &mut self.scratch.borrow_mut())
         else {
             return;
         };
@@ -114,10 +117,10 @@ impl Walk<'_> {
             return;
         }
         let scene = self.scene;
-        let mat = &scene.shading.materials[scene.geometry.material_of(prim) as usize];
+        let mat = scene.material(prim);
         let entering = hit.normal.dot(ray.dir) < 0.0;
         let n = if entering { hit.normal } else { -hit.normal };
-        for light in &scene.shading.lights {
+        for light in &scene.shading().lights {
             let l = (light.position - hit.point).normalize_or_zero();
             if n.dot(l) > 0.0 {
                 self.spawn(prim, &hit, l, out);
@@ -165,7 +168,7 @@ pub fn count(
             let walk = Walk {
                 scene: &scene,
                 max_depth,
-                scratch: Scratch::default(),
+                scratch: RefCell::default(),
             };
             let mut out = RehitCount::default();
             for x in 0..width {
@@ -223,7 +226,7 @@ mod tests {
         let walk = Walk {
             scene: &scene,
             max_depth: 0,
-            scratch: Scratch::default(),
+            scratch: RefCell::default(),
         };
         let mut out = RehitCount::default();
         // A "surface point" 1 % inside, claimed to leave outwards.

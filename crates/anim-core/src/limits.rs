@@ -193,6 +193,25 @@ pub const MOTION_MAX_STEPS: usize = 256;
 /// smeared without visible steps.
 pub const MOTION_TIME_STEPS: u32 = 256;
 
+/// The part of the exposure (one of [`MOTION_TIME_STEPS`]) that instant `time` falls in.
+#[inline]
+pub fn motion_step(time: f32) -> u32 {
+    ((time * MOTION_TIME_STEPS as f32) as u32).min(MOTION_TIME_STEPS - 1)
+}
+
+/// The middle of part `step` of the exposure: the instant its camera samples are taken at,
+/// and its moving shapes placed at.
+#[inline]
+pub fn motion_step_middle(step: u32) -> f32 {
+    (step as f32 + 0.5) / MOTION_TIME_STEPS as f32
+}
+
+/// The instant a camera sample at `time` is taken at: the middle of its part of the exposure.
+#[inline]
+pub fn quantized_time(time: f32) -> f32 {
+    motion_step_middle(motion_step(time))
+}
+
 /// Most placed moving shapes (shapes × instants) a render keeps; beyond, each worker places
 /// a shape once per camera sample instead.
 pub const MOTION_MAX_PLACED: usize = 1 << 18;
@@ -219,5 +238,15 @@ mod tests {
         }
         assert!(is_image_extension("PNG"));
         assert!(!is_image_extension("sdf"));
+    }
+
+    #[test]
+    fn quantized_times_are_the_middles_of_their_parts() {
+        let n = MOTION_TIME_STEPS as f32;
+        assert_eq!(quantized_time(0.0), 0.5 / n);
+        assert_eq!(quantized_time(1.0), (n - 0.5) / n);
+        assert_eq!(quantized_time(0.5), (n / 2.0 + 0.5) / n);
+        assert_eq!(quantized_time(quantized_time(0.3)), quantized_time(0.3));
+        assert_eq!(motion_step(quantized_time(0.3)), motion_step(0.3));
     }
 }

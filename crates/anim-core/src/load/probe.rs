@@ -11,14 +11,14 @@ use super::load_file;
 use crate::diag::{Diagnostic, Loc, Severity};
 use crate::math::{reflect, Ray};
 use crate::render::camera::PinholeCamera;
-use crate::render::compile::{Occlusion, RayHint, RenderScene};
+use crate::render::compile::{Occlusion, PrimId, RayHint, RenderScene, Scratch, SurfaceHit};
 use crate::render::film::{tone_map_u8, HdrImage};
-use crate::render::geometry::{PrimId, Scratch, SurfaceHit};
 use crate::render::shading::ShadeMaterial;
 use crate::render::Prepared;
 use crate::scene::{Camera, RenderJob, Scene};
 use crate::sdf::LoadOptions;
 use glam::{Vec3, Vec3A};
+use std::cell::RefCell;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -89,7 +89,8 @@ struct Probe<'p> {
     scene: &'p Scene,
     compiled: RenderScene,
     rays: Vec<Ray>,
-    scratch: Scratch,
+    /// The probe's own scratch for its queries (its methods read, and only this changes).
+    scratch: RefCell<Scratch>,
 }
 
 impl<'p> Probe<'p> {
@@ -103,18 +104,17 @@ impl<'p> Probe<'p> {
             scene: prepared.scene(),
             compiled: prepared.compile(None),
             rays,
-            scratch: Scratch::default(),
+            scratch: RefCell::default(),
         })
     }
 
     fn material(&self, prim: PrimId) -> &ShadeMaterial {
-        let shading = &self.compiled.shading;
-        &shading.materials[self.compiled.geometry.material_of(prim) as usize]
+        self.compiled.material(prim)
     }
 
     /// Every primitive's material.
     fn materials(&self) -> impl Iterator<Item = &ShadeMaterial> + '_ {
-        (0..self.compiled.geometry.len() as PrimId).map(|i| self.material(i))
+        (0..self.compiled.aggregate().len() as PrimId).map(|i| self.material(i))
     }
 
     /// The nearest hit along `ray` with a surface that draws something: invisible ones are
@@ -123,9 +123,12 @@ impl<'p> Probe<'p> {
         let mut ray = *ray;
         let mut left = t_max;
         for _ in 0..INVISIBLE_MAX {
-            let (prim, surface) =
-                self.compiled
-                    .intersect(&ray, left, RayHint::Secondary, &self.scratch)?;
+            let (prim, surface) = self.compiled.intersect(
+                &ray,
+                left,
+                RayHint::Secondary,
+                &mut self.scratch.borrow_mut(),
+            )?;
             if !invisible(self.material(prim)) {
                 let inside = surface.normal.dot(ray.dir) > 0.0;
                 let normal = if inside {
@@ -133,7 +136,7 @@ impl<'p> Probe<'p> {
                 } else {
                     surface.normal
                 };
-                let closed = self.compiled.geometry.is_closed(prim);
+                let closed = self.compiled.aggregate().is_closed(prim);
                 return Some(Hit {
                     prim,
                     surface,
@@ -150,7 +153,7 @@ impl<'p> Probe<'p> {
     /// Ambient and direct light at a hit (shadows from opaque shapes included).
     fn direct(&self, hit: &Hit, view: Vec3A) -> Vec3A {
         let m = self.material(hit.prim);
-        let shading = &self.compiled.shading;
+        let shading = self.compiled.shading();
         let mut c = shading.ambient * m.ka;
         for (k, light) in shading.lights.iter().enumerate() {
             let to_light = light.position - hit.surface.point;
@@ -165,7 +168,9 @@ impl<'p> Probe<'p> {
             }
             let shadow = hit.surface.spawn_ray(l);
             let hint = RayHint::Shadow(k);
-            let blocked = self.compiled.occlusion(&shadow, dist, hint, &self.scratch);
+            let blocked =
+                self.compiled
+                    .occlusion(&shadow, dist, hint, &mut self.scratch.borrow_mut());
             if matches!(blocked, Occlusion::Blocked(_)) {
                 continue;
             }
@@ -211,7 +216,12 @@ impl<'p> Probe<'p> {
         let any_hit = self.rays.iter().any(|ray| {
             let scene = &self.compiled;
             scene
-                .intersect(ray, f32::INFINITY, RayHint::Secondary, &self.scratch)
+                .intersect(
+                    ray,
+                    f32::INFINITY,
+                    RayHint::Secondary,
+                    &mut self.scratch.borrow_mut(),
+                )
                 .is_some()
         });
         if !any_hit {
@@ -242,7 +252,7 @@ impl<'p> Probe<'p> {
 
     /// Whether every shape (all bounded) lies behind the eye, by its bounds' centre.
     fn all_behind(&self) -> bool {
-        let geometry = &self.compiled.geometry;
+        let geometry = self.compiled.aggregate();
         let dir = self.job.camera.dir.as_vec3();
         geometry.bounded() == geometry.len()
             && (0..geometry.len()).all(|i| {
@@ -262,7 +272,7 @@ impl<'p> Probe<'p> {
     /// ` `name`` of the object the middle ray meets first, or nothing.
     fn middle_object_name(&self) -> String {
         let middle = &self.rays[self.rays.len() / 2];
-        let geometry = &self.compiled.geometry;
+        let geometry = self.compiled.aggregate();
         self.nearest(middle, f32::INFINITY)
             .and_then(|h| geometry.source(h.prim))
             .and_then(|k| self.scene.instances.get(k as usize))
@@ -273,7 +283,7 @@ impl<'p> Probe<'p> {
 
     /// Something shows, but nothing lit: mirrors of nothing, no light, or all in shadow.
     fn unlit_reason(&self) -> String {
-        let shading = &self.compiled.shading;
+        let shading = self.compiled.shading();
         if self
             .materials()
             .filter(|m| !invisible(m))

@@ -1,10 +1,13 @@
 //! Whitted-style shading: the local Phong model of docs/shading.md §2 with hard shadows, mirror
-//! reflection and Fresnel refraction.
+//! reflection and Fresnel refraction. Every question about a ray goes to the compiled scene's
+//! facade (`super::compile::RenderScene`): closest hits, and for a shadow ray how much of
+//! its light passes ([`RenderScene::transmittance`]) or what the moving shapes alone do to it
+//! ([`RenderScene::moving_shadow`]).
 
 use super::camera::PinholeCamera;
-use super::compile::{Occlusion, RayHint, RenderScene};
-use super::counts::RayCounts;
-use super::geometry::{PrimId, Scratch, SurfaceHit};
+use super::compile::{
+    MovingShadow, PrimId, RayHint, RenderScene, Scratch, ShadowRay, SurfaceHit, NO_HIT,
+};
 use super::shading::ShadeMaterial;
 use crate::math::{reflect, Ray};
 use glam::Vec3A;
@@ -13,59 +16,13 @@ use glam::Vec3A;
 /// result: `c/(c+1)` has slope at most 1, so an HDR change `w·L_max` moves the output by at
 /// most that much.
 const NEGLIGIBLE: f32 = 0.5 / 255.0;
-/// Bound on surfaces a shadow ray may pass through (glass behind glass behind glass ...).
-const MAX_SHADOW_CROSSINGS: usize = 64;
 
-/// The primitive index reported for a camera ray that hit nothing.
-pub const NO_HIT: PrimId = PrimId::MAX;
-
-/// Lights whose last blocker a [`TraceState`] remembers (the others go without).
-const CACHED_LIGHTS: usize = 8;
-/// Shadow rays towards a light found clear in a row after which its last blocker is no
-/// longer tried first (see [`LastShadows`]).
-const CLEAR_RUN_SKIP: u8 = 8;
-
-/// What a worker's latest shadow rays towards one light found: the opaque primitive that
-/// last blocked one, tried first by the next (neighbouring points mostly lie in the same
-/// shadow), and how many in a row have since found the light clear. Out of shadow, trying
-/// a blocker that blocks nothing is a wasted test per ray; but where shadowed and lit points
-/// alternate (a packet of camera rays crossing gaps between spheres), the blocker of two
-/// rays ago is often the next one's too. So it is tried until a few clear rays in a row.
-/// Rays that cross only glass neither count nor break the run: making them break it cost
-/// the glass scenes more than it saved (docs/benchmarks-history.md §9.7).
-#[derive(Clone, Copy, Debug)]
-struct LastShadows {
-    blocker: u32,
-    clear_run: u8,
-}
-
-impl LastShadows {
-    const NONE: LastShadows = LastShadows {
-        blocker: NO_HIT,
-        clear_run: 0,
-    };
-
-    /// The primitive to try first, if any.
-    fn guess(&self) -> Option<u32> {
-        (self.blocker != NO_HIT && self.clear_run < CLEAR_RUN_SKIP).then_some(self.blocker)
-    }
-
-    fn blocked_by(&mut self, prim: u32) {
-        *self = LastShadows {
-            blocker: prim,
-            clear_run: 0,
-        };
-    }
-}
-
-/// What one worker keeps between the rays it traces: its ray counts, per light the opaque
-/// primitive that last blocked a shadow ray (see `Integrator::visibility`), and the
-/// scratch its scene queries keep. The caches only save work, never change a value, so
-/// images do not depend on which worker traced which pixel.
+/// What one worker keeps between the rays it traces: the scratch its scene queries keep
+/// (its ray counts among them), and how its camera samples are shaded. The caches only save
+/// work, never change a value, so images do not depend on which worker traced which pixel.
 pub struct TraceState {
-    /// Rays traced so far.
-    pub counts: RayCounts,
-    shadows: [LastShadows; CACHED_LIGHTS],
+    /// What the scene's queries keep between rays, and the rays traced so far.
+    pub scratch: Scratch,
     /// A light's term whose share of the pixel, lit, is below this is added as lit without
     /// its shadow ray: 0 (every shadow ray traced) except for adaptive sampling's refining
     /// samples ([`TraceState::refining`]).
@@ -73,9 +30,6 @@ pub struct TraceState {
     /// Bit k: a shadow ray towards light k of the current camera sample's tree found it not
     /// fully visible (blocked, or through glass); [`CameraSample::not_clear`].
     not_clear: u32,
-    /// What the scene's queries keep between rays (the moving shapes placed at the current
-    /// instant, and what a watched centre sample met).
-    pub scratch: Scratch,
 }
 
 /// What adaptive sampling's first pass learned about a pixel, handed to the integrator for
@@ -112,6 +66,10 @@ pub struct CameraSample {
     pub t: Option<f32>,
     /// Bit k: some shadow ray of the sample's tree towards light k did not see it fully.
     pub not_clear: u32,
+    /// The largest angle (radians, as the eye sees it) swept over the exposure by the moving
+    /// shapes the sample's rays may have met at some instant, where it was measured
+    /// ([`Integrator::camera_sample_swept`]); 0 otherwise.
+    pub swept: f32,
 }
 
 /// Where a camera hit of a frame with motion must lie for the lights the first pass's
@@ -149,11 +107,9 @@ impl KnownNear {
 impl Default for TraceState {
     fn default() -> Self {
         TraceState {
-            counts: RayCounts::default(),
-            shadows: [LastShadows::NONE; CACHED_LIGHTS],
+            scratch: Scratch::default(),
             shadow_cut: 0.0,
             not_clear: 0,
-            scratch: Scratch::default(),
         }
     }
 }
@@ -180,8 +136,8 @@ impl TraceState {
 struct KnownLit {
     lights: u32,
     /// In a frame with motion (the prior knows only of what holds still): the moving shapes
-    /// are still asked, from the moving entry the hit lies on if any.
-    ask_moving: Option<Option<u32>>,
+    /// are still asked, about shadow rays leaving this primitive (the camera hit's).
+    ask_moving: Option<PrimId>,
 }
 
 impl KnownLit {
@@ -189,6 +145,24 @@ impl KnownLit {
         lights: 0,
         ask_moving: None,
     };
+}
+
+/// Where a ray meets a surface, as shading reads it: the ray, the primitive and its hit.
+#[derive(Clone, Copy)]
+struct SurfacePoint<'a> {
+    ray: &'a Ray,
+    prim: PrimId,
+    hit: &'a SurfaceHit,
+}
+
+/// What shading carries down a ray's tree besides the point: the number of bounces so far,
+/// the ray's share of the pixel (for `NEGLIGIBLE` and `TraceState::shadow_cut`), and the
+/// lights taken as visible without a shadow ray (at camera hits only).
+#[derive(Clone, Copy)]
+struct ShadeContext {
+    depth: u32,
+    weight: f32,
+    known: KnownLit,
 }
 
 /// The Whitted integrator over a compiled scene (docs/shading.md).
@@ -220,10 +194,26 @@ impl Integrator<'_> {
     pub fn trace(&self, ray: &Ray, depth: u32, weight: f32, st: &mut TraceState) -> Vec3A {
         let hit = self
             .scene
-            .intersect(ray, f32::INFINITY, RayHint::Secondary, &st.scratch);
+            .intersect(ray, f32::INFINITY, RayHint::Secondary, &mut st.scratch);
         match hit {
-            Some((prim, hit)) => self.shade(ray, prim, &hit, depth, weight, KnownLit::NONE, st),
-            None => self.scene.shading.background,
+            Some((prim, hit)) => {
+                let at = SurfacePoint {
+                    ray,
+                    prim,
+                    hit: &hit,
+                };
+                let known = KnownLit::NONE;
+                self.shade(
+                    &at,
+                    ShadeContext {
+                        depth,
+                        weight,
+                        known,
+                    },
+                    st,
+                )
+            }
+            None => self.scene.shading().background,
         }
     }
 
@@ -237,8 +227,24 @@ impl Integrator<'_> {
     ) -> CameraSample {
         let hit = self
             .scene
-            .intersect(ray, f32::INFINITY, RayHint::Camera, &st.scratch);
+            .intersect(ray, f32::INFINITY, RayHint::Camera, &mut st.scratch);
         self.shade_camera_hit(ray, hit.as_ref(), prior, st)
+    }
+
+    /// [`Integrator::camera_sample`] that also measures [`CameraSample::swept`]: adaptive
+    /// sampling's first pass asks it of each pixel centre in a frame with motion.
+    pub fn camera_sample_swept(
+        &self,
+        ray: &Ray,
+        prior: &PixelPrior,
+        st: &mut TraceState,
+    ) -> CameraSample {
+        st.scratch.measure_sweep();
+        let sample = self.camera_sample(ray, prior, st);
+        CameraSample {
+            swept: st.scratch.take_sweep(),
+            ..sample
+        }
     }
 
     /// [`Integrator::camera_sample`] of a camera ray whose closest hit (`hit`) is known.
@@ -253,18 +259,30 @@ impl Integrator<'_> {
         st.not_clear = 0;
         let Some((prim, hit)) = hit else {
             return CameraSample {
-                radiance: self.scene.shading.background,
+                radiance: self.scene.shading().background,
                 prim: NO_HIT,
                 t: None,
                 not_clear: 0,
+                swept: 0.0,
             };
         };
         let known = self.known_at(prior, *prim, hit);
+        let at = SurfacePoint {
+            ray,
+            prim: *prim,
+            hit,
+        };
+        let context = ShadeContext {
+            depth: 0,
+            weight: 1.0,
+            known,
+        };
         CameraSample {
-            radiance: self.shade(ray, *prim, hit, 0, 1.0, known, st),
+            radiance: self.shade(&at, context, st),
             prim: *prim,
             t: Some(hit.t),
             not_clear: st.not_clear,
+            swept: 0.0,
         }
     }
 
@@ -279,33 +297,25 @@ impl Integrator<'_> {
             },
             Some(near) if near.holds(hit.point, hit.t) => KnownLit {
                 lights: prior.known_clear,
-                ask_moving: Some(self.scene.geometry.moving_entry(prim)),
+                ask_moving: Some(prim),
             },
             Some(_) => KnownLit::NONE,
         }
     }
 
-    /// Radiance leaving the surface point `hit` of primitive `prim` back along `ray`.
+    /// Radiance leaving the surface point `at` back along its ray.
     #[inline]
-    #[allow(clippy::too_many_arguments)]
-    fn shade(
-        &self,
-        ray: &Ray,
-        prim: PrimId,
-        hit: &SurfaceHit,
-        depth: u32,
-        weight: f32,
-        known: KnownLit,
-        st: &mut TraceState,
-    ) -> Vec3A {
-        let shading = &self.scene.shading;
-        let mat = &shading.materials[self.scene.geometry.material_of(prim) as usize];
+    fn shade(&self, at: &SurfacePoint, context: ShadeContext, st: &mut TraceState) -> Vec3A {
+        let (ray, hit) = (at.ray, at.hit);
+        let ShadeContext { depth, weight, .. } = context;
+        let shading = self.scene.shading();
+        let mat = self.scene.material(at.prim);
         let entering = hit.normal.dot(ray.dir) < 0.0;
         // Shading normal faces the incoming ray; the geometric one decides inside/outside.
         let n = if entering { hit.normal } else { -hit.normal };
         let (rho, alpha) = (mat.reflectivity, mat.opacity);
         if rho == 0.0 && alpha == 1.0 {
-            return self.local(mat, hit, n, -ray.dir, ray.time, (weight, known), st);
+            return self.local(mat, at, n, context, st);
         }
 
         // c = α·((1−ρ)·c_local + ρ·c_r) + (1−α)·(F·c_r + (1−F)·c_t)
@@ -328,43 +338,46 @@ impl Integrator<'_> {
         let mut c = if w_local == 0.0 {
             Vec3A::ZERO
         } else {
-            let v = -ray.dir;
-            self.local(mat, hit, n, v, ray.time, (weight * w_local, known), st) * w_local
+            let local = ShadeContext {
+                weight: weight * w_local,
+                ..context
+            };
+            self.local(mat, at, n, local, st) * w_local
         };
         let can_recurse = depth < self.max_depth;
         let worth =
             |w: f32| can_recurse && w > 0.0 && weight * w * shading.max_radiance >= NEGLIGIBLE;
         if worth(w_reflect) {
             let dir = reflect(ray.dir, n);
-            st.counts.reflected += 1;
+            st.scratch.counts.reflected += 1;
             let r = hit.spawn_ray(dir).at_time(ray.time);
             c += self.trace(&r, depth + 1, weight * w_reflect, st) * w_reflect;
         }
         if let Some(dir) = refracted.filter(|_| worth(w_refract)) {
-            st.counts.refracted += 1;
+            st.scratch.counts.refracted += 1;
             let r = hit.spawn_ray(dir).at_time(ray.time);
             c += self.trace(&r, depth + 1, weight * w_refract, st) * w_refract;
         }
         c
     }
 
-    /// `Ka·I_ambient + Σ vis·I·(Kd·max(N·L,0) + Ks·max(R·V,0)^m)`, specular only where N·L > 0.
-    /// Lights and shadowing geometry are taken at `time`, the instant of the exposure;
-    /// `weight` is the result's share of the pixel (for `TraceState::shadow_cut`), and
-    /// `known` the lights taken as visible here without a shadow ray (at camera hits only).
+    /// `Ka·I_ambient + Σ vis·I·(Kd·max(N·L,0) + Ks·max(R·V,0)^m)`, specular only where N·L > 0,
+    /// at `at` with shading normal `n`, seen back along its ray. Lights and shadowing geometry
+    /// are taken at the ray's instant of the exposure; `context.weight` is the result's share
+    /// of the pixel (for `TraceState::shadow_cut`), and `context.known` the lights taken as
+    /// visible here without a shadow ray.
     #[inline]
-    #[allow(clippy::too_many_arguments)]
     fn local(
         &self,
         mat: &ShadeMaterial,
-        hit: &SurfaceHit,
+        at: &SurfacePoint,
         n: Vec3A,
-        v: Vec3A,
-        time: f32,
-        (weight, known): (f32, KnownLit),
+        context: ShadeContext,
         st: &mut TraceState,
     ) -> Vec3A {
-        let shading = &self.scene.shading;
+        let (hit, v, time) = (at.hit, -at.ray.dir, at.ray.time);
+        let ShadeContext { weight, known, .. } = context;
+        let shading = self.scene.shading();
         let mut c = mat.ka * shading.ambient;
         // `ks·spec` is exactly zero without a specular colour (spec is at most 1 for m ≥ 0).
         let specular = mat.ks != Vec3A::ZERO || mat.m < 0.0 || mat.m.is_nan();
@@ -397,17 +410,23 @@ impl Integrator<'_> {
                 continue;
             }
             let lit = light.intensity * unshadowed;
+            let shadow = || ShadowRay::new(hit, l, dist, time, k);
+            // A light known clear of what holds still is lit unless a moving shape, asked at
+            // the sample's instant, may block it; then the shadow ray is traced in full.
             if lit.max_element() * weight < st.shadow_cut
                 || ((known.lights >> k.min(31)) & 1 != 0
-                    && !known.ask_moving.is_some_and(|from| {
-                        self.moving_blocks(hit, l, dist, time, from, &st.scratch)
+                    && !known.ask_moving.is_some_and(|leaving| {
+                        let moving = self
+                            .scene
+                            .moving_shadow(&shadow(), leaving, &mut st.scratch);
+                        moving != MovingShadow::Clear
                     }))
             {
                 c += lit;
                 continue;
             }
-            st.counts.shadow += 1;
-            let vis = self.visibility(hit, k, l, dist, time, st);
+            st.scratch.counts.shadow += 1;
+            let vis = self.scene.transmittance(&shadow(), &mut st.scratch);
             if vis < 1.0 {
                 st.not_clear |= 1 << k.min(31);
             }
@@ -417,136 +436,6 @@ impl Integrator<'_> {
             c += light.intensity * vis * unshadowed;
         }
         c
-    }
-
-    /// Whether a moving shape may block the light at distance `dist` along `l` from `hit` (on
-    /// moving entry `from`, if any), at `time`: then the shadow ray is traced in full, as also
-    /// when the moving shapes are too many to ask one by one.
-    fn moving_blocks(
-        &self,
-        hit: &SurfaceHit,
-        l: Vec3A,
-        dist: f32,
-        time: f32,
-        from: Option<u32>,
-        scratch: &Scratch,
-    ) -> bool {
-        let ray = hit.spawn_ray(l).at_time(time);
-        let remaining = (hit.point + l * dist - ray.origin).dot(l);
-        self.scene
-            .geometry
-            .moving_blocks(&ray, remaining, from, scratch)
-            != Some(false)
-    }
-
-    /// Fraction of a light's intensity reaching `p`: 0 behind an opaque object, attenuated by
-    /// (1 − α) for every transparent surface crossed (shadow rays are not refracted). Any-hit
-    /// either way: the first opaque blocker ends the query, and crossings of transparent
-    /// objects multiply in whatever order the hierarchy offers them.
-    ///
-    /// The opaque primitive that last blocked a shadow ray towards this light (the worker's
-    /// [`LastShadows`]) is tried first while it is likely to block again; an opaque hit means
-    /// no light whatever else the ray crosses, so the answer is the same as without the cache.
-    fn visibility(
-        &self,
-        hit: &SurfaceHit,
-        light_index: usize,
-        l: Vec3A,
-        dist: f32,
-        time: f32,
-        st: &mut TraceState,
-    ) -> f32 {
-        let scene = self.scene;
-        let geometry = &scene.geometry;
-        let ray = hit.spawn_ray(l).at_time(time);
-        let light = hit.point + l * dist;
-        let remaining = (light - ray.origin).dot(l);
-        let scratch = &st.scratch;
-        let mut last = st.shadows.get_mut(light_index);
-        if let Some(b) = last.as_deref().and_then(LastShadows::guess) {
-            if geometry.hit(b, &ray, remaining, scratch).is_some() {
-                return 0.0;
-            }
-        }
-        // Most shadow rays meet nothing at all, or one glass object: the any-hit query
-        // (packed primitives four at a time) says so, looking past glass for an opaque
-        // blocker, which means no light whatever else the ray crosses.
-        let hint = RayHint::Shadow(light_index);
-        match scene.occlusion(&ray, remaining, hint, scratch) {
-            Occlusion::Clear => {
-                if let Some(last) = last {
-                    last.clear_run = last.clear_run.saturating_add(1);
-                }
-                return 1.0;
-            }
-            Occlusion::Blocked(first) => {
-                if let Some(last) = last {
-                    last.blocked_by(first);
-                }
-                return 0.0;
-            }
-            // One object's crossings alone: the walk below would multiply the same factors
-            // in the same order, and nothing else.
-            Occlusion::Through(i) => {
-                return self.transmittance(&ray, i, l, light, remaining, 1.0, scratch);
-            }
-            Occlusion::Walk => {}
-        }
-        // Glass of several objects: the walk tells glass from opaque, and names the blocker
-        // for the next ray.
-        let mut transmit = 1.0f32;
-        let materials = &scene.shading.materials;
-        let blocked = geometry.any_candidate(&ray, remaining, |i| {
-            let opacity = materials[geometry.material_of(i) as usize].opacity;
-            if opacity >= 1.0 {
-                let hit = geometry.hit(i, &ray, remaining, scratch).is_some();
-                if let Some(last) = last.as_deref_mut().filter(|_| hit) {
-                    last.blocked_by(i);
-                }
-                return hit;
-            }
-            transmit = self.transmittance(&ray, i, l, light, remaining, transmit, scratch);
-            transmit == 0.0
-        });
-        if blocked {
-            0.0
-        } else {
-            transmit
-        }
-    }
-
-    /// `transmit` times `1 − α` for every crossing of transparent primitive `i` along `ray`
-    /// (unit direction `l`) before `remaining`, the distance to `light`, stepping past each.
-    #[allow(clippy::too_many_arguments)]
-    fn transmittance(
-        &self,
-        ray: &Ray,
-        i: PrimId,
-        l: Vec3A,
-        light: Vec3A,
-        remaining: f32,
-        mut transmit: f32,
-        scratch: &Scratch,
-    ) -> f32 {
-        let geometry = &self.scene.geometry;
-        let opacity = self.scene.shading.materials[geometry.material_of(i) as usize].opacity;
-        let mut segment = *ray;
-        let mut left = remaining;
-        for _ in 0..MAX_SHADOW_CROSSINGS {
-            let Some(hit) = geometry.intersect(i, &segment, left, scratch) else {
-                break;
-            };
-            transmit *= 1.0 - opacity;
-            if transmit == 0.0 {
-                break;
-            }
-            segment = hit.spawn_ray(l).at_time(ray.time);
-            left = (light - segment.origin).dot(l);
-            if left <= 0.0 {
-                break;
-            }
-        }
-        transmit
     }
 }
 
@@ -612,7 +501,7 @@ mod tests {
             .radiance
             .x;
         let assumed = integrator.camera_sample(&ray, &lit, &mut known).radiance.x;
-        (shadowed, refined, assumed, refining.counts.shadow)
+        (shadowed, refined, assumed, refining.scratch.counts.shadow)
     }
 
     #[test]

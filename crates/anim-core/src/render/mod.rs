@@ -74,7 +74,7 @@ pub struct Prepared<'j> {
     /// The scene and camera moved, or `None` when the eye is at the origin already.
     rebased: Option<(Scene, Camera)>,
     /// The camera-free geometry, shared by the probe and the render.
-    pub geometry: Arc<Aggregate>,
+    geometry: Arc<Aggregate>,
     /// Shapes that became degenerate once transformed (in f32) and were left out.
     pub dropped: Vec<Dropped>,
 }

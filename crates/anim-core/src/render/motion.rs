@@ -9,7 +9,7 @@
 use super::camera::PinholeCamera;
 use super::integrator::{Integrator, PixelPrior, TraceState};
 use super::sampler::pattern::{tone3, FLAT_CONTRAST};
-use crate::limits::MOTION_TIME_STEPS;
+use crate::limits::{motion_step, motion_step_middle, quantized_time, MOTION_TIME_STEPS};
 use crate::math::Ray;
 use crate::scene::motion::Motion;
 use crate::scene::Camera;
@@ -80,7 +80,7 @@ impl Shutter {
                 .collect();
             shutter.slide_stray = slide_stray(&shutter.sweep);
             shutter.at_step = (0..MOTION_TIME_STEPS)
-                .map(|i| shutter.camera_at((i as f32 + 0.5) / MOTION_TIME_STEPS as f32))
+                .map(|i| shutter.camera_at(motion_step_middle(i)))
                 .collect();
         }
         shutter
@@ -105,18 +105,16 @@ impl Shutter {
     /// middle of the exposure (used as it is when the camera does not move, or where its
     /// placement at `time` is degenerate).
     /// The time is rounded to the instants moving shapes are placed at
-    /// (`geometry::motion::quantize`), so every thing of the scene is seen at one instant.
+    /// (`limits::quantized_time`), so every thing of the scene is seen at one instant.
     #[inline]
     pub fn ray(&self, still: &PinholeCamera, x: f32, y: f32, time: f32) -> Ray {
-        let step = super::geometry::motion::step(time);
+        let step = motion_step(time);
         let camera = self
             .at_step
             .get(step as usize)
             .and_then(Option::as_ref)
             .unwrap_or(still);
-        camera
-            .ray(x, y)
-            .at_time(super::geometry::motion::quantize(time))
+        camera.ray(x, y).at_time(quantized_time(time))
     }
 
     /// Where (pixels, from the centre of (`x`, `y`)) the point its middle-instant centre ray
@@ -202,7 +200,7 @@ impl Shutter {
             let ray = self.ray(still, x as f32 + 0.5, y as f32 + 0.5, u);
             let sample = integrator.camera_sample(&ray, &PixelPrior::NONE, st);
             let (c, prim) = (sample.radiance, sample.prim);
-            st.counts.primary += 1;
+            st.scratch.counts.primary += 1;
             if prim != centre.1 || 255.0 * (tone3(c) - tone).abs().max_element() > FLAT_CONTRAST {
                 return true;
             }

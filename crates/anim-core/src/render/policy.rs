@@ -34,15 +34,19 @@ pub struct GeometryPlan {
     pub flat: bool,
     /// Every primitive is a packed sphere: leaves are tested without asking kinds.
     pub spheres_only: bool,
+    /// A shadow ray may ask the moving shapes alone whether they block it
+    /// (`RenderScene::moving_shadow`): they are few enough ([`MOVING_BLOCKS_MAX`]), or none.
+    pub ask_moving: bool,
 }
 
-/// The plan of a geometry of `bounded` primitives with finite bounds: flat when few, but
-/// not with moving shapes, whose bounds span the whole exposure where the hierarchy skips
-/// them and a flat leaf would test them.
-pub fn geometry_plan(bounded: usize, moving: bool, spheres_only: bool) -> GeometryPlan {
+/// The plan of a geometry of `bounded` primitives with finite bounds and `moving` moving
+/// shapes: flat when few, but not with moving shapes, whose bounds span the whole exposure
+/// where the hierarchy skips them and a flat leaf would test them.
+pub fn geometry_plan(bounded: usize, moving: usize, spheres_only: bool) -> GeometryPlan {
     GeometryPlan {
-        flat: bounded > 0 && bounded <= FLAT_MAX && !moving,
+        flat: bounded > 0 && bounded <= FLAT_MAX && moving == 0,
         spheres_only,
+        ask_moving: moving <= MOVING_BLOCKS_MAX,
     }
 }
 

@@ -315,7 +315,7 @@ fn a_world_space_sphere_costs_at_most_100_bytes() {
     };
     let (compiled, dropped) = RenderScene::compile(&scene, None);
     assert!(dropped.is_empty());
-    assert_eq!(compiled.geometry.len(), n);
+    assert_eq!(compiled.aggregate().len(), n);
     let per_sphere = compiled.memory_bytes() as f64 / n as f64;
     assert!(per_sphere <= 100.0, "{per_sphere:.1} bytes per sphere");
     // Not vacuous: the packed sphere alone is 16 bytes, its material 4.

@@ -44,7 +44,7 @@ pub struct View {
 
 impl View {
     /// The view of `geometry` from `viewpoint` (`None`: no camera), lit by `lights`.
-    pub fn new(
+    pub(crate) fn new(
         geometry: &Aggregate,
         lights: &[PointLight],
         lights_move: bool,
@@ -96,7 +96,7 @@ impl View {
     /// The candidates of a camera ray (from the eye; a ray from elsewhere, or one the eye's
     /// lookup does not answer, gets every primitive).
     #[inline(always)]
-    pub fn camera(&self, ray: &Ray) -> Candidates<'_> {
+    pub(crate) fn camera(&self, ray: &Ray) -> Candidates<'_> {
         let listed = match &self.eye {
             Some(Candidacy::Cells(cells)) => cells
                 .candidates(ray.origin, ray.dir, f32::INFINITY)
@@ -115,7 +115,7 @@ impl View {
     /// The image tiles of camera rays, when the eye keeps them (camera packets share a
     /// tile's list).
     #[inline]
-    pub fn eye_tiles(&self) -> Option<&ImageTiles> {
+    pub(crate) fn eye_tiles(&self) -> Option<&ImageTiles> {
         match &self.eye {
             Some(Candidacy::Tiles(tiles)) => Some(tiles),
             _ => None,
@@ -124,7 +124,7 @@ impl View {
 
     /// The candidates of a shadow ray towards light `light` that ends there after `t_max`.
     #[inline(always)]
-    pub fn shadow(&self, ray: &Ray, t_max: f32, light: usize) -> Candidates<'_> {
+    pub(crate) fn shadow(&self, ray: &Ray, t_max: f32, light: usize) -> Candidates<'_> {
         let listed = match self.lights.get(light) {
             Some(Some(Candidacy::Cells(cells))) => cells
                 .candidates(ray.origin, ray.dir, t_max)

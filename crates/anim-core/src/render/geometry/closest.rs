@@ -5,14 +5,14 @@
 //! the same answer to the bit.
 
 use super::leaf::Best;
-use super::{placed_surface, sphere_surface, Aggregate, Kind, PrimId, Scratch, SurfaceHit};
+use super::{placed_surface, sphere_surface, Aggregate, Kind, MovingScratch, PrimId, SurfaceHit};
 use crate::math::Ray;
 use crate::render::geometry::Primitive;
 use crate::shape::{BoxRay, SphereRay};
 
 /// Which primitives a query tests.
 #[derive(Clone, Copy, Debug)]
-pub enum Candidates<'a> {
+pub(crate) enum Candidates<'a> {
     /// Every primitive: the hierarchy's walk, or the flat leaf of a small scene.
     All,
     /// The bounded primitives of `ids` (padded to a multiple of four) and the unbounded ones:
@@ -41,12 +41,12 @@ const FLAT: [u32; crate::render::policy::FLAT_MAX] = {
 impl Aggregate {
     /// Nearest surface along the ray with `t < t_max` among `candidates`.
     #[inline]
-    pub fn closest(
+    pub(crate) fn closest(
         &self,
         ray: &Ray,
         t_max: f32,
         candidates: Candidates,
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
     ) -> Option<(PrimId, SurfaceHit)> {
         match candidates {
             Candidates::All => self.closest_of_all(ray, t_max, scratch),
@@ -66,7 +66,7 @@ impl Aggregate {
         &self,
         ray: &Ray,
         t_max: f32,
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
     ) -> Option<(PrimId, SurfaceHit)> {
         // Filled in place, not returned: a `Primitive` is 240 bytes, and moving even a `None`
         // of it in and out of calls costs more than the tests of a small scene.
@@ -112,7 +112,7 @@ impl Aggregate {
         &self,
         ray: &Ray,
         t_max: f32,
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
     ) -> (Option<Best>, f32) {
         let mut best: Option<Best> = None;
         let mut t_best = t_max;
@@ -138,7 +138,7 @@ impl Aggregate {
         ray: &Ray,
         best: Best,
         won: Option<P>,
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
     ) -> Option<(PrimId, SurfaceHit)> {
         let Best { id: i, t, hit, .. } = best;
         let kind = self.kind.get(i as usize).map(|k| k.kind());

@@ -4,7 +4,7 @@
 //! hit by the slab test of their bounds, and the other kinds are tested one by one where
 //! that slab test passes.
 
-use super::{Aggregate, Kind, Scratch, BOUNDS_OF_BOX, BOUNDS_OF_OTHER, BOUNDS_OF_SPHERE};
+use super::{Aggregate, Kind, MovingScratch, BOUNDS_OF_BOX, BOUNDS_OF_OTHER, BOUNDS_OF_SPHERE};
 use crate::math::Ray;
 use crate::render::geometry::Primitive;
 use crate::shape::{BoxRay, ShapeHit, SphereRay};
@@ -147,7 +147,7 @@ impl Aggregate {
         mut t_max: f32,
         best: &mut Option<Best>,
         won: &mut Option<Primitive>,
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
     ) -> f32 {
         let first = leaf[0] as usize;
         let end = first + leaf.len();
@@ -180,7 +180,7 @@ impl Aggregate {
         limit: f32,
         mut t_max: f32,
         (best, won): (&mut Option<Best>, &mut Option<Primitive>),
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
     ) -> f32 {
         let (sphere_hit, sphere_t) = if c.spheres != 0 {
             lanes.hit4(four_spheres(), limit)
@@ -238,7 +238,7 @@ impl Aggregate {
         ray: &Ray,
         t_max: &mut f32,
         best: &mut Option<Best>,
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
     ) {
         let h = self
             .moving_with(m, ray, scratch, |p| p.hit(ray, t_max.next_up()))
@@ -303,7 +303,7 @@ impl Aggregate {
             Lanes,
             impl FnOnce() -> [Vec4; LANES],
         ),
-        (stop, scratch): (&mut impl FnMut(u32) -> bool, &Scratch),
+        (stop, scratch): (&mut impl FnMut(u32) -> bool, &mut MovingScratch),
     ) -> bool {
         if offer(&id, c.boxes_hit, stop) {
             return true;
@@ -329,7 +329,13 @@ impl Aggregate {
     /// it if the ray meets it before `t_max`: itself, or in an instanced composite the shape
     /// hit.
     #[inline(always)]
-    fn other_hit(&self, i: usize, ray: &Ray, t_max: f32, scratch: &Scratch) -> Option<u32> {
+    fn other_hit(
+        &self,
+        i: usize,
+        ray: &Ray,
+        t_max: f32,
+        scratch: &mut MovingScratch,
+    ) -> Option<u32> {
         match self.kind_of(i) {
             Kind::Moving(k) => self
                 .moving_with(k, ray, scratch, |p| p.hit(ray, t_max).is_some())

@@ -4,7 +4,7 @@
 //! of the same query over every primitive.
 
 use super::leaf::{fours, gather, offer};
-use super::{Aggregate, PrimId, Scratch, SurfaceHit};
+use super::{Aggregate, MovingScratch, PrimId, SurfaceHit};
 use crate::math::Ray;
 use crate::shape::{BoxRay, SphereRay};
 
@@ -21,7 +21,7 @@ impl Aggregate {
         ray: &Ray,
         listed: &[u32],
         near: &[f32],
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
     ) -> Option<(PrimId, SurfaceHit)> {
         let (mut best, mut t_max) = self.closest_unbounded(ray, f32::INFINITY, scratch);
         let mut won = None;
@@ -58,7 +58,7 @@ impl Aggregate {
         ray: &Ray,
         t_max: f32,
         (listed, near): (&[u32], &[f32]),
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
         mut stop: impl FnMut(u32) -> bool,
     ) {
         for i in self.unbounded..self.len() as u32 {

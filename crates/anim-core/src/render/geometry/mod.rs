@@ -10,21 +10,21 @@
 //! both for every primitive (walking the hierarchy, or one flat leaf in a small scene) or for
 //! a list of candidates a [`super::view::View`] looked up ([`Candidates`]). `packet.rs` asks
 //! the closest hit for several coherent rays at once. A leaf's primitives are tested four at
-//! a time (`leaf.rs`). Instanced composites ([`instancing`]) and moving shapes ([`motion`])
+//! a time (`leaf.rs`). Instanced composites (`instancing.rs`) and moving shapes (`motion.rs`)
 //! are primitives of the table like the others: a [`Kind`] says which, and each answers the
 //! same two questions.
 
 mod closest;
-pub mod instancing;
+mod instancing;
 mod leaf;
 mod listed;
-pub mod motion;
+mod motion;
 mod occlusion;
 mod packet;
 pub mod primitive;
 
-pub use closest::Candidates;
-pub use motion::Scratch;
+pub(crate) use closest::Candidates;
+pub use motion::{MovingScratch, MovingShadow};
 pub use primitive::{Primitive, SurfaceHit};
 
 use super::policy::{self, GeometryPlan};
@@ -44,7 +44,7 @@ pub type PrimId = u32;
 
 /// What a primitive of the table is, and where the rest of it is kept.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kind {
+pub(crate) enum Kind {
     /// A sphere in world space, packed in 16 bytes and tested four at a time.
     Sphere,
     /// Any other shape: object `k` of the table.
@@ -221,12 +221,9 @@ impl Table {
 impl Aggregate {
     /// Places every shape of `scene` (the ones that stay degenerate once transformed are
     /// left out and returned) and builds the hierarchy over them.
-    pub fn build(scene: &Scene) -> (Aggregate, Vec<Dropped>) {
+    pub(crate) fn build(scene: &Scene) -> (Aggregate, Vec<Dropped>) {
         let mut moving = Moving::new(scene).map(Box::new);
         let (mut table, dropped) = Table::of_instances(scene, &mut moving);
-        if let Some(m) = &mut moving {
-            m.finish();
-        }
         let instances = scene.has_prototypes().then(|| {
             let first_id = (table.material.len() + scene.instanced.uses.len()) as u32;
             Box::new(Instances::new(scene, first_id))
@@ -244,7 +241,11 @@ impl Aggregate {
         let first_unbounded = order.len() as u32;
         order.extend(unbounded);
         let all_spheres = table.tags.iter().all(|&t| t == BOUNDS_OF_SPHERE);
-        let plan = policy::geometry_plan(first_unbounded as usize, moving.is_some(), all_spheres);
+        let moving_entries = moving.as_ref().map_or(0, |m| m.len());
+        let plan = policy::geometry_plan(first_unbounded as usize, moving_entries, all_spheres);
+        if let Some(m) = &mut moving {
+            m.finish(plan.ask_moving);
+        }
         let (bounds_min, bounds_max) = packed_bounds(&table, &order, plan.spheres_only);
         let permute = |v: &[u32]| order.iter().map(|&i| v[i as usize]).collect::<Vec<u32>>();
         let (material, key) = (permute(&table.material), permute(&table.key));
@@ -279,17 +280,17 @@ impl Aggregate {
     }
 
     /// Primitives with finite bounds (they come first).
-    pub fn bounded(&self) -> usize {
+    pub(crate) fn bounded(&self) -> usize {
         self.unbounded as usize
     }
 
     /// The strategies chosen for this geometry.
-    pub fn plan(&self) -> GeometryPlan {
+    pub(crate) fn plan(&self) -> GeometryPlan {
         self.plan
     }
 
     /// Nodes of the hierarchy.
-    pub fn hierarchy_nodes(&self) -> usize {
+    pub(crate) fn hierarchy_nodes(&self) -> usize {
         self.bvh.node_count()
     }
 
@@ -308,7 +309,7 @@ impl Aggregate {
     }
 
     /// The world bounds of bounded primitive `i`.
-    pub fn bound(&self, i: usize) -> Aabb {
+    pub(crate) fn bound(&self, i: usize) -> Aabb {
         if self.plan.spheres_only {
             let s = self.spheres[i];
             let (c, r) = (Vec3A::from(s.truncate()), Vec3A::splat(s.w));
@@ -323,7 +324,7 @@ impl Aggregate {
 
     /// Whether primitive `i` encloses a solid (`Shape::is_closed`), which a camera can be
     /// inside.
-    pub fn is_closed(&self, i: PrimId) -> bool {
+    pub(crate) fn is_closed(&self, i: PrimId) -> bool {
         match self.kind.get(i as usize).map(|k| k.kind()) {
             Some(Kind::Sphere) => true,
             Some(Kind::Shape(k)) => self.objects[k as usize].shape.is_closed(),
@@ -334,7 +335,7 @@ impl Aggregate {
 
     /// The depth-first number of primitive `i` in the flattened composite tree: the index
     /// of its instance in the scene description when the scene has no instanced composites.
-    pub fn source(&self, i: PrimId) -> Option<u32> {
+    pub(crate) fn source(&self, i: PrimId) -> Option<u32> {
         self.key.get(i as usize).copied()
     }
 
@@ -364,7 +365,13 @@ impl Aggregate {
 
     /// Distance to primitive `i` along the ray, if it is hit with `0 < t < t_max`.
     #[inline(always)]
-    pub fn hit(&self, i: PrimId, ray: &Ray, t_max: f32, scratch: &Scratch) -> Option<f32> {
+    pub(crate) fn hit(
+        &self,
+        i: PrimId,
+        ray: &Ray,
+        t_max: f32,
+        scratch: &mut MovingScratch,
+    ) -> Option<f32> {
         let Some(tag) = self.kind.get(i as usize) else {
             return self.instanced(i)?.hit(ray, t_max).map(|h| h.t);
         };
@@ -380,12 +387,12 @@ impl Aggregate {
 
     /// Primitive `i`'s hit with `0 < t < t_max`, in world space.
     #[inline]
-    pub fn intersect(
+    pub(crate) fn intersect(
         &self,
         i: PrimId,
         ray: &Ray,
         t_max: f32,
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
     ) -> Option<SurfaceHit> {
         let Some(tag) = self.kind.get(i as usize) else {
             let p = self.instanced(i)?;
@@ -409,7 +416,13 @@ impl Aggregate {
     /// The hit of primitive `i` (not a use of a composite) before `t_max`, as the shape
     /// reports it; what the closest-hit query starts from for the unbounded ones.
     #[inline]
-    fn shape_hit(&self, i: PrimId, ray: &Ray, t_max: f32, scratch: &Scratch) -> Option<ShapeHit> {
+    fn shape_hit(
+        &self,
+        i: PrimId,
+        ray: &Ray,
+        t_max: f32,
+        scratch: &mut MovingScratch,
+    ) -> Option<ShapeHit> {
         match self.kind_of(i as usize) {
             Kind::Sphere => self.sphere(i as usize).intersect(ray, t_max),
             Kind::Shape(k) => self.objects[k as usize].hit(ray, t_max),
@@ -448,7 +461,7 @@ impl Aggregate {
         &self,
         k: u32,
         ray: &Ray,
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
         f: impl FnOnce(&Primitive) -> R,
     ) -> Option<R> {
         self.moving.as_ref()?.with(k, ray, scratch, f)
@@ -462,35 +475,30 @@ impl Aggregate {
         k: u32,
         ray: &Ray,
         hit: &ShapeHit,
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
     ) -> Option<SurfaceHit> {
         let moving = self.moving.as_ref()?;
         moving.placed_with(k, ray.time, scratch, |p| placed_surface(p, ray, hit.t, hit))
     }
 
-    /// Whether [`Aggregate::moving_blocks`] answers.
-    pub fn answers_moving_blocks(&self) -> bool {
-        self.moving.as_ref().is_none_or(|m| m.answers_blocks())
-    }
-
-    /// Whether a moving shape blocks a shadow ray before `t_max` at the ray's time, leaving
-    /// moving entry `from` outwards (see `Moving::blocks`); `Some(false)` when nothing moves.
+    /// What the moving shapes do to a shadow ray before `t_max` at the ray's time, leaving
+    /// moving entry `from` outwards (see `Moving::blocks`); `Clear` when nothing moves.
     #[inline]
-    pub fn moving_blocks(
+    pub(crate) fn moving_blocks(
         &self,
         ray: &Ray,
         t_max: f32,
         from: Option<u32>,
-        scratch: &Scratch,
-    ) -> Option<bool> {
+        scratch: &mut MovingScratch,
+    ) -> MovingShadow {
         self.moving
             .as_ref()
-            .map_or(Some(false), |m| m.blocks(ray, t_max, from, scratch))
+            .map_or(MovingShadow::Clear, |m| m.blocks(ray, t_max, from, scratch))
     }
 
     /// Per material of `scene` (whose geometry this is): whether some primitive draws with
     /// it.
-    pub fn used_materials(&self, scene: &Scene) -> Vec<bool> {
+    pub(crate) fn used_materials(&self, scene: &Scene) -> Vec<bool> {
         let mut used = vec![false; scene.materials.len()];
         let prototype_materials = scene
             .instanced
@@ -512,7 +520,7 @@ impl Aggregate {
     }
 
     /// Bytes the geometry holds (primitives and hierarchy).
-    pub fn memory_bytes(&self) -> usize {
+    pub(crate) fn memory_bytes(&self) -> usize {
         self.material.capacity() * 4
             + self.kind.capacity() * 4
             + (self.spheres.capacity() + self.bounds_min.capacity() + self.bounds_max.capacity())

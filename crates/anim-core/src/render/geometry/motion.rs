@@ -18,13 +18,12 @@
 //! static shape.
 
 use super::Primitive;
-use crate::limits::{MOTION_MAX_PLACED, MOTION_TIME_STEPS};
+use crate::limits::{motion_step, motion_step_middle, MOTION_MAX_PLACED, MOTION_TIME_STEPS};
 use crate::math::{Aabb, Ray, Transform};
 use crate::scene::motion::Motion;
 use crate::scene::{Instance, Scene};
 use crate::shape::{BoxRay, Geometry};
 use glam::{Affine3A, DVec3, Vec3A, Vec4};
-use std::cell::{Cell, RefCell};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
 
@@ -82,7 +81,7 @@ impl Pose {
     }
 }
 
-/// Numbers the moving parts made, so that a thread's cache knows whose entries it holds.
+/// Numbers the moving parts made, so that a worker's scratch knows whose entries it holds.
 static NEXT_ID: AtomicU64 = AtomicU64::new(1);
 
 #[derive(Default)]
@@ -95,43 +94,58 @@ struct Placed {
     entries: Vec<(u64, Option<Primitive>)>,
 }
 
-/// What one worker's queries keep between rays: owned by the worker (`TraceState`) and
-/// handed to every query, so nothing flows between layers behind the callers' backs.
-pub struct Scratch {
-    /// While adaptive sampling's first pass watches a centre sample ([`Scratch::watch`]): the
+/// What one worker's queries keep of the moving shapes between rays: owned by the worker
+/// (inside the facade's `Scratch`) and handed to every query, so nothing flows between
+/// layers behind the callers' backs.
+pub struct MovingScratch {
+    /// While a camera sample's sweep is measured ([`MovingScratch::measure_sweep`]): the
     /// largest angle (radians, as the eye sees it) swept by the moving shapes its rays may
-    /// have met at some instant of the exposure. NaN while nobody watches, so that the test
-    /// in [`Moving::with`] is one comparison that fails.
-    watched: Cell<f32>,
+    /// have met at some instant of the exposure. NaN otherwise, so that the test in
+    /// [`Moving::with`] is one comparison that fails.
+    swept: f32,
     /// The moving entries placed at the time of the worker's latest ray: every ray of a
     /// camera sample (primary, shadow, reflected) has that sample's time, so each entry is
     /// placed once per sample, not once per test. Only saves work: an entry placed again at
     /// the same time is the same floats.
-    placed: RefCell<Placed>,
+    placed: Placed,
 }
 
-impl Default for Scratch {
+impl Default for MovingScratch {
     fn default() -> Self {
-        Scratch {
-            watched: Cell::new(f32::NAN),
-            placed: RefCell::new(Placed::default()),
+        MovingScratch {
+            swept: f32::NAN,
+            placed: Placed::default(),
         }
     }
 }
 
-impl Scratch {
-    /// Starts watching which moving shapes the queries given this scratch meet
-    /// ([`Scratch::take_touched`]).
-    pub fn watch(&self) {
-        self.watched.set(0.0);
+impl MovingScratch {
+    /// Starts measuring the largest angle swept by the moving shapes the queries given this
+    /// scratch may meet ([`MovingScratch::take_sweep`]).
+    #[inline]
+    pub fn measure_sweep(&mut self) {
+        self.swept = 0.0;
     }
 
     /// The largest angle (radians) swept, as the eye sees it, by the moving shapes that the
-    /// queries may have met at some instant since [`Scratch::watch`] (see
-    /// `Moving::met_by`); 0 when they met none. Stops watching.
-    pub fn take_touched(&self) -> f32 {
-        self.watched.replace(f32::NAN).max(0.0)
+    /// queries may have met at some instant since [`MovingScratch::measure_sweep`] (see
+    /// `Moving::met_by`); 0 when they met none, or nothing was measured. Stops measuring.
+    #[inline]
+    pub fn take_sweep(&mut self) -> f32 {
+        std::mem::replace(&mut self.swept, f32::NAN).max(0.0)
     }
+}
+
+/// What the moving shapes do to a shadow ray, at its instant ([`Moving::blocks`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MovingShadow {
+    /// No moving shape meets it before its end (or nothing moves).
+    Clear,
+    /// A moving shape blocks it, wholly or in part.
+    Blocked,
+    /// The scene's moving shapes are too many to ask one by one (`GeometryPlan::ask_moving`):
+    /// only the whole shadow ray can tell.
+    Unasked,
 }
 
 /// The moving shapes of a scene.
@@ -166,19 +180,9 @@ pub struct Moving {
     /// Per part of the exposure: the union of its `part_boxes`, which a ray that meets none
     /// of them may miss in one test (`Moving::blocks`).
     part_union: Vec<Aabb>,
-}
-
-/// The instant camera samples at `time` are taken at: the middle of its part of the
-/// exposure (`limits::MOTION_TIME_STEPS`).
-#[inline]
-pub fn quantize(time: f32) -> f32 {
-    (step(time) as f32 + 0.5) / MOTION_TIME_STEPS as f32
-}
-
-/// The part of the exposure `time` falls in (of `limits::MOTION_TIME_STEPS`).
-#[inline]
-pub fn step(time: f32) -> u32 {
-    ((time * MOTION_TIME_STEPS as f32) as u32).min(MOTION_TIME_STEPS - 1)
+    /// Whether shadow rays ask the moving shapes one by one ([`Moving::blocks`]), as the
+    /// geometry's plan decides (`GeometryPlan::ask_moving`).
+    asked: bool,
 }
 
 impl Moving {
@@ -201,16 +205,25 @@ impl Moving {
             part_boxes: Vec::new(),
             part_union: Vec::new(),
             placed: Vec::new(),
+            asked: false,
         })
     }
 
-    /// Makes room for the placed entries, once they are all added, if they fit.
-    pub fn finish(&mut self) {
+    /// The number of moving entries.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// Makes room for the placed entries, once they are all added, if they fit; and, where
+    /// shadow rays ask the moving shapes one by one (`ask`: the geometry's plan), the boxes
+    /// they ask.
+    pub fn finish(&mut self, ask: bool) {
         let cells = self.entries.len() * MOTION_TIME_STEPS as usize;
         if cells <= MOTION_MAX_PLACED {
             self.placed = (0..cells).map(|_| OnceLock::new()).collect();
         }
-        if self.answers_blocks() {
+        self.asked = ask;
+        if ask {
             let groups = self.entries.len().div_ceil(LANES);
             let unused = Vec4::splat(f32::NAN);
             let world = |part: usize, k: usize| match self.poses.get(k * POSE_PARTS + part) {
@@ -307,19 +320,14 @@ impl Moving {
             .placed
             .get(k as usize * MOTION_TIME_STEPS as usize + step as usize)?;
         Some(
-            cell.get_or_init(|| self.place(k, (step as f32 + 0.5) / MOTION_TIME_STEPS as f32))
+            cell.get_or_init(|| self.place(k, motion_step_middle(step)))
                 .as_ref(),
         )
     }
 
-    /// Whether [`Moving::blocks`] answers.
-    pub fn answers_blocks(&self) -> bool {
-        self.entries.len() <= crate::render::policy::MOVING_BLOCKS_MAX
-    }
-
-    /// Whether some moving shape blocks (wholly or in part) a ray before `t_max`, at the
-    /// ray's time, leaving the surface of entry `from` (if any) outwards; `None` when there
-    /// are more moving shapes than it pays to ask one by one.
+    /// What the moving shapes do to a ray before `t_max`, at the ray's time, leaving the
+    /// surface of entry `from` (if any) outwards: whether one blocks it (wholly or in part),
+    /// or `Unasked` when there are more moving shapes than it pays to ask one by one.
     /// For shadow rays whose light no static shape blocks (adaptive sampling's known-clear
     /// lights in frames with motion), which need not walk the whole hierarchy.
     pub fn blocks(
@@ -327,10 +335,10 @@ impl Moving {
         ray: &Ray,
         t_max: f32,
         from: Option<u32>,
-        scratch: &Scratch,
-    ) -> Option<bool> {
-        if !self.answers_blocks() {
-            return None;
+        scratch: &mut MovingScratch,
+    ) -> MovingShadow {
+        if !self.asked {
+            return MovingShadow::Unasked;
         }
         // The part of the exposure the ray's instant lies in: the shapes' bounds in it are
         // much tighter than over the whole exposure.
@@ -338,14 +346,18 @@ impl Moving {
         // Most shadow rays pass far from every moving shape: one test of the box around them
         // all says so. It misses only where every box inside it misses (the slab test is the
         // same arithmetic, and monotone in the box), so the answer is the one below.
-        let union = self.part_union.get(part)?;
+        let Some(union) = self.part_union.get(part) else {
+            return MovingShadow::Unasked;
+        };
         if union.hit_range(ray, ray.dir.recip(), 0.0, t_max).is_none() {
-            return Some(false);
+            return MovingShadow::Clear;
         }
         let boxes = BoxRay::new(ray);
         let n = self.entries.len();
         let groups = n.div_ceil(LANES);
-        let cells = self.part_boxes.get(part * groups..(part + 1) * groups)?;
+        let Some(cells) = self.part_boxes.get(part * groups..(part + 1) * groups) else {
+            return MovingShadow::Unasked;
+        };
         for (g, [min, max]) in cells.iter().enumerate() {
             let group = g * LANES;
             let live = (1u32 << (n - group).min(LANES)) - 1;
@@ -361,11 +373,11 @@ impl Moving {
                 }
                 let hit = |p: &Primitive| p.hit(ray, t_max).is_some();
                 if self.with(k as u32, ray, scratch, hit) == Some(true) {
-                    return Some(true);
+                    return MovingShadow::Blocked;
                 }
             }
         }
-        Some(false)
+        MovingShadow::Clear
     }
 
     /// Entry `k`'s poses, one per part of the exposure (see [`Pose`]).
@@ -497,15 +509,15 @@ impl Moving {
         &self,
         k: u32,
         ray: &Ray,
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
         f: impl FnOnce(&Primitive) -> R,
     ) -> Option<R> {
         let time = ray.time;
         let swept = self.sweep.get(k as usize).copied().unwrap_or(f32::INFINITY);
         // Asked also outside a traversal (a shadow ray tries the last blocker first): only a
         // ray that meets the shape at some instant counts.
-        if scratch.watched.get() < swept && self.met_by(k, ray) {
-            scratch.watched.set(swept);
+        if scratch.swept < swept && self.met_by(k, ray) {
+            scratch.swept = swept;
         }
         self.placed_with(k, time, scratch, f)
     }
@@ -517,14 +529,13 @@ impl Moving {
         &self,
         k: u32,
         time: f32,
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
         f: impl FnOnce(&Primitive) -> R,
     ) -> Option<R> {
         if !self.placed.is_empty() {
-            return self.placed_at(k, step(time))?.map(f);
+            return self.placed_at(k, motion_step(time))?.map(f);
         }
-        let mut cache = scratch.placed.borrow_mut();
-        let c = &mut *cache;
+        let c = &mut scratch.placed;
         if c.owner != self.id || c.time != time.to_bits() {
             c.owner = self.id;
             c.time = time.to_bits();
@@ -745,7 +756,7 @@ mod tests {
                 moving.add(i);
             }
         }
-        moving.finish();
+        moving.finish(true);
         assert_eq!(moving.entries.len(), 3);
         moving
     }
@@ -787,8 +798,8 @@ mod tests {
             prop_assert!(moving.met_by(k, &ray), "entry {k} hit at step {step}, not met");
             // And a shadow ray at that instant asks it (its bounds in that part hold it).
             let at = ray.at_time(u as f32);
-            let blocks = moving.blocks(&at, f32::INFINITY, None, &Scratch::default());
-            prop_assert_eq!(blocks, Some(true), "entry {} at step {}", k, step);
+            let blocks = moving.blocks(&at, f32::INFINITY, None, &mut MovingScratch::default());
+            prop_assert_eq!(blocks, MovingShadow::Blocked, "entry {} at step {}", k, step);
         }
     }
 
@@ -819,34 +830,22 @@ mod tests {
         let moving = moving_things();
         // Down through the ball's centre at the middle of the exposure, (3, 0, 0).
         let at = |time: f32| Ray::new(Vec3A::new(3.0, 0.0, 5.0), Vec3A::NEG_Z).at_time(time);
-        assert_eq!(
-            moving.blocks(&at(0.5), f32::INFINITY, None, &Scratch::default()),
-            Some(true)
-        );
+        let blocks = |ray: Ray, t_max: f32, from: Option<u32>| {
+            moving.blocks(&ray, t_max, from, &mut MovingScratch::default())
+        };
+        assert_eq!(blocks(at(0.5), f32::INFINITY, None), MovingShadow::Blocked);
         // Early on the ball is 8 units to the left; the bar and the post are never there.
-        assert_eq!(
-            moving.blocks(&at(0.1), f32::INFINITY, None, &Scratch::default()),
-            Some(false)
-        );
+        assert_eq!(blocks(at(0.1), f32::INFINITY, None), MovingShadow::Clear);
         // The light is nearer than the ball.
-        assert_eq!(
-            moving.blocks(&at(0.5), 4.0, None, &Scratch::default()),
-            Some(false)
-        );
+        assert_eq!(blocks(at(0.5), 4.0, None), MovingShadow::Clear);
         // A ray said to leave the ball's own surface (entry 1) does not ask the ball.
+        assert_eq!(blocks(at(0.5), f32::INFINITY, Some(1)), MovingShadow::Clear);
+        // Where the plan does not ask the moving shapes, neither do they answer.
+        let mut unasked = moving.clone();
+        unasked.asked = false;
         assert_eq!(
-            moving.blocks(&at(0.5), f32::INFINITY, Some(1), &Scratch::default()),
-            Some(false)
+            unasked.blocks(&at(0.5), f32::INFINITY, None, &mut MovingScratch::default()),
+            MovingShadow::Unasked
         );
-        assert!(moving.answers_blocks());
-    }
-
-    #[test]
-    fn quantized_times_are_the_middles_of_their_parts() {
-        let n = MOTION_TIME_STEPS as f32;
-        assert_eq!(quantize(0.0), 0.5 / n);
-        assert_eq!(quantize(1.0), (n - 0.5) / n);
-        assert_eq!(quantize(0.5), (n / 2.0 + 0.5) / n);
-        assert_eq!(quantize(quantize(0.3)), quantize(0.3));
     }
 }

@@ -2,7 +2,7 @@
 //! cheapest (shadow rays, and the tests that hold every strategy to brute force).
 
 use super::leaf::{offer, LANES};
-use super::{Aggregate, Candidates, Kind, PrimId, Scratch};
+use super::{Aggregate, Candidates, Kind, MovingScratch};
 use crate::math::Ray;
 use crate::shape::{BoxRay, SphereRay};
 
@@ -12,12 +12,12 @@ impl Aggregate {
     /// of several comes first is the strategy's: near first through the hierarchy, by
     /// distance from the ray's end in a list that gives distances.
     #[inline]
-    pub fn any(
+    pub(crate) fn any(
         &self,
         ray: &Ray,
         t_max: f32,
         candidates: Candidates,
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
         stop: impl FnMut(u32) -> bool,
     ) {
         match candidates {
@@ -32,28 +32,29 @@ impl Aggregate {
         }
     }
 
-    /// Something that lies on the ray before `t_max` (a primitive id, for
-    /// [`Aggregate::hit`]), if anything does; which one, of several, is left to the hierarchy.
-    pub fn occluder(&self, ray: &Ray, t_max: f32, scratch: &Scratch) -> Option<PrimId> {
-        let mut found = None;
-        self.any_hit(ray, t_max, scratch, |i| {
-            found = Some(i);
-            true
-        });
-        found
-    }
-
     /// [`Aggregate::any`] among every primitive, in the hierarchy's near-first order. Not
     /// inlined, as the queries over lists are not: the dispatch that picks one of them stays
     /// small enough to be inlined where rays are traced.
     #[inline(never)]
-    fn any_of_all(&self, ray: &Ray, t_max: f32, scratch: &Scratch, stop: impl FnMut(u32) -> bool) {
+    fn any_of_all(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        scratch: &mut MovingScratch,
+        stop: impl FnMut(u32) -> bool,
+    ) {
         self.any_hit(ray, t_max, scratch, stop)
     }
 
     /// [`Aggregate::any`] among every primitive, in the hierarchy's near-first order.
     #[inline(always)]
-    fn any_hit(&self, ray: &Ray, t_max: f32, scratch: &Scratch, mut stop: impl FnMut(u32) -> bool) {
+    fn any_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        scratch: &mut MovingScratch,
+        mut stop: impl FnMut(u32) -> bool,
+    ) {
         for i in self.unbounded..self.len() as u32 {
             if self.hit(i, ray, t_max, scratch).is_some() && stop(i) {
                 return;
@@ -95,7 +96,12 @@ impl Aggregate {
     /// Offers every primitive the ray may meet before `t_max` to `stop`, in no particular
     /// order (bounds tested, shapes not), until it returns true (then true).
     #[inline]
-    pub fn any_candidate(&self, ray: &Ray, t_max: f32, mut stop: impl FnMut(u32) -> bool) -> bool {
+    pub(crate) fn any_candidate(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut stop: impl FnMut(u32) -> bool,
+    ) -> bool {
         (self.unbounded..self.len() as u32).any(&mut stop)
             || self
                 .bvh

@@ -7,7 +7,7 @@
 //! `crate::render::sampler::packet` (camera rays of a block of pixels, traced together).
 
 use super::leaf::{fours, gather, Best, LANES};
-use super::{Aggregate, Candidates, PrimId, Primitive, Scratch, SurfaceHit};
+use super::{Aggregate, Candidates, MovingScratch, PrimId, Primitive, SurfaceHit};
 use crate::accel::Packet;
 use crate::math::Ray;
 use crate::shape::{BoxRay, SphereRay};
@@ -19,7 +19,7 @@ impl Aggregate {
         &self,
         rays: &[Ray; N],
         t_max: f32,
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
     ) -> [Option<(PrimId, SurfaceHit)>; N] {
         let Some(packet) = Packet::new(rays) else {
             return rays.map(|r| self.closest(&r, t_max, Candidates::All, scratch));
@@ -88,11 +88,11 @@ impl Aggregate {
     /// unbounded): a group is tested for the rays whose closest hit so far does not lie
     /// nearer. Each answer is `closest_listed::<true>`'s.
     #[inline(never)]
-    pub fn closest_in_tile<const N: usize>(
+    pub(crate) fn closest_in_tile<const N: usize>(
         &self,
         rays: &[Ray; N],
         (listed, near): (&[u32], &[f32]),
-        scratch: &Scratch,
+        scratch: &mut MovingScratch,
     ) -> [Option<(PrimId, SurfaceHit)>; N] {
         let lanes: [SphereRay; N] = std::array::from_fn(|r| SphereRay::new(&rays[r]));
         let mut best: [Option<Best>; N] = [None; N];

@@ -109,7 +109,7 @@ impl Adaptive<'_> {
                     (*out, *taken, *estimate) = self.refine_pixel(first, (x, y), &mut st);
                 }
                 on_pixels(row.len() as u64);
-                st.counts
+                st.scratch.counts
             })
             .reduce(RayCounts::default, RayCounts::sum);
         (pixels, taken, estimates, counts)
@@ -141,7 +141,7 @@ impl Adaptive<'_> {
                 break;
             }
         }
-        st.counts.primary += m.n as u64;
+        st.scratch.counts.primary += m.n as u64;
         let taken = m.n.min(u8::MAX as u32) as u8;
         (Vec3::from(m.mean()), taken, m.error())
     }
@@ -168,7 +168,7 @@ impl Adaptive<'_> {
                         *out = self.resume(*out, n, (x, y), first.prior(x, y), &mut st);
                     }
                 }
-                st.counts
+                st.scratch.counts
             })
             .reduce(RayCounts::default, RayCounts::sum)
     }
@@ -211,7 +211,7 @@ impl Adaptive<'_> {
                 break;
             }
         }
-        st.counts.primary += (m.n - n) as u64;
+        st.scratch.counts.primary += (m.n - n) as u64;
         Vec3::from(m.mean())
     }
 }

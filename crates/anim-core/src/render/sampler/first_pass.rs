@@ -67,7 +67,7 @@ impl<'f> FirstPass<'f> {
             sweeps: vec![Sweep::default(); if frame.shutter.is_some() { w * h } else { 0 }],
             not_clear: vec![u32::MAX; w * h],
             known_of_still: frame.shutter.is_some_and(|s| !s.lights_move())
-                && frame.integrator.scene.geometry.answers_moving_blocks(),
+                && frame.integrator.scene.plan().0.ask_moving,
         };
         let counts = match frame.shutter {
             None => pass.trace_still(),
@@ -89,7 +89,7 @@ impl<'f> FirstPass<'f> {
             .map(|(y, (row, not_clear_row))| {
                 let mut st = TraceState::default();
                 if packet::trace_centres(frame, y, row, not_clear_row, &mut st) {
-                    return st.counts;
+                    return st.scratch.counts;
                 }
                 for (x, (px, nc)) in row.iter_mut().zip(not_clear_row).enumerate() {
                     let ray = frame.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
@@ -99,8 +99,8 @@ impl<'f> FirstPass<'f> {
                     *px = (sample.radiance, sample.prim);
                     *nc = sample.not_clear;
                 }
-                st.counts.primary += row.len() as u64;
-                st.counts
+                st.scratch.counts.primary += row.len() as u64;
+                st.scratch.counts
             })
             .reduce(RayCounts::default, RayCounts::sum)
     }
@@ -116,7 +116,7 @@ impl<'f> FirstPass<'f> {
         // hit is (see `KnownNear`); otherwise, only while the camera holds still too (so
         // that the refined samples hit near the centres), for centres none of whose rays may
         // meet anything moving.
-        let of_still = frame.integrator.scene.geometry.answers_moving_blocks();
+        let of_still = frame.integrator.scene.plan().0.ask_moving;
         let shadows_hold = !shutter.lights_move() && (of_still || !shutter.camera_moves());
         self.centres
             .par_chunks_mut(w)
@@ -129,12 +129,12 @@ impl<'f> FirstPass<'f> {
                 for (x, ((px, sw), nc)) in pixels.enumerate() {
                     let (x, y) = (x as u32, y as u32);
                     let ray = frame.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
-                    st.scratch.watch();
-                    let sample = frame
-                        .integrator
-                        .camera_sample(&ray, &PixelPrior::NONE, &mut st);
+                    let sample =
+                        frame
+                            .integrator
+                            .camera_sample_swept(&ray, &PixelPrior::NONE, &mut st);
                     *px = (sample.radiance, sample.prim);
-                    let swept = st.scratch.take_touched();
+                    let swept = sample.swept;
                     if shadows_hold && (of_still || swept == 0.0) {
                         *nc = sample.not_clear;
                         if of_still {
@@ -154,8 +154,8 @@ impl<'f> FirstPass<'f> {
                         sw.streak = shutter.camera_sweep(frame.camera, x, y, sample.t);
                     }
                 }
-                st.counts.primary += row.len() as u64;
-                st.counts
+                st.scratch.counts.primary += row.len() as u64;
+                st.scratch.counts
             })
             .reduce(RayCounts::default, RayCounts::sum)
     }

@@ -27,7 +27,7 @@ const ROW_RUN: usize = 8;
 /// Whether the camera rays of `frame` are traced in packets (the scene's plan says whether
 /// its hierarchy is deep enough for it to pay).
 pub(super) fn packets_apply(frame: &Frame) -> bool {
-    frame.shutter.is_none() && frame.integrator.scene.view.plan().camera_packets
+    frame.shutter.is_none() && frame.integrator.scene.plan().1.camera_packets
 }
 
 /// Each camera ray's radiance and primitive, and in `not_clear` the lights some shadow ray
@@ -39,7 +39,9 @@ pub(super) fn trace_primaries<const N: usize>(
     not_clear: &mut [u32; N],
 ) -> [(Vec3A, u32); N] {
     let integrator = frame.integrator;
-    let hits = integrator.scene.intersect_camera_packet(rays, &st.scratch);
+    let hits = integrator
+        .scene
+        .intersect_camera_packet(rays, &mut st.scratch);
     let mut out = [(Vec3A::ZERO, 0); N];
     for (r, hit) in hits.iter().enumerate() {
         let sample = integrator.shade_camera_hit(&rays[r], hit.as_ref(), &PixelPrior::NONE, st);
@@ -81,6 +83,6 @@ pub fn trace_centres(
         *px = (sample.radiance, sample.prim);
         *nc = sample.not_clear;
     }
-    st.counts.primary += row.len() as u64;
+    st.scratch.counts.primary += row.len() as u64;
     true
 }

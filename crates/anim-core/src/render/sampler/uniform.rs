@@ -33,10 +33,10 @@ pub(super) fn render(
                     let (x, y) = (k as u32 % width, y0 + k as u32 / width);
                     *out = uniform_pixel(frame, (x, y), &offsets, &mut st);
                 }
-                st.counts.primary += (band.len() * offsets.len()) as u64;
+                st.scratch.counts.primary += (band.len() * offsets.len()) as u64;
             }
             on_pixels(band.len() as u64);
-            st.counts
+            st.scratch.counts
         })
         .reduce(RayCounts::default, RayCounts::sum);
     (pixels, counts)
@@ -87,7 +87,7 @@ fn render_band(
             }
         }
     }
-    st.counts.primary += (band.len() * offsets.len()) as u64;
+    st.scratch.counts.primary += (band.len() * offsets.len()) as u64;
     true
 }
 
