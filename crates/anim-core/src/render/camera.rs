@@ -12,6 +12,8 @@ use glam::{DVec3, Vec3A};
 pub struct PinholeCamera {
     /// Its image-plane distance is `(w/2)/tan(fov/2)` pixels.
     view: ImageView,
+    /// The angle one pixel spans at the image centre (radians).
+    pixel_angle: f32,
 }
 
 /// Why a camera cannot make rays.
@@ -46,6 +48,8 @@ impl PinholeCamera {
                 half_w: width as f32 / 2.0,
                 half_h: height as f32 / 2.0,
             },
+            pixel_angle: (2.0 * (cam.fov_x_deg.to_radians() / 2.0).tan() / width.max(1) as f64)
+                as f32,
         })
     }
 
@@ -57,6 +61,11 @@ impl PinholeCamera {
     /// The image the rays pass through.
     pub fn view(&self) -> ImageView {
         self.view
+    }
+
+    /// The angle one pixel spans at the image centre (radians).
+    pub fn pixel_angle(&self) -> f32 {
+        self.pixel_angle
     }
 
     /// World units per pixel at the depth of `p`: a move of the eye by δ across the view

@@ -3,6 +3,7 @@
 //! ([`FirstPass::refinement`]), and what a refined pixel's samples may take as known of the
 //! lights ([`FirstPass::prior`]).
 
+use super::motion::{streak_pairs, MotionProbe};
 use super::packet;
 use super::pattern::{tone3, FLAT_CONTRAST};
 use super::Frame;
@@ -16,11 +17,11 @@ use rayon::prelude::*;
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Sweep {
     /// Its rays may meet a moving shape (`Moving::met_by`), and it changes during the exposure
-    /// (`Shutter::changes`).
+    /// (`MotionProbe::changes`).
     touched: bool,
     /// The ends of the streak the camera's motion draws its hit point along (pixels from
     /// its centre), along which the image must be flat for it to keep its centre sample;
-    /// `None` when it sweeps too far for that (`Shutter::camera_sweep`).
+    /// `None` when it sweeps too far for that (`MotionProbe::camera_sweep`).
     streak: Option<[(f32, f32); 2]>,
     /// How far along its centre ray the surface it hit lies, where its shadow rays' findings
     /// are kept for the shapes that hold still (NaN where they are not).
@@ -117,6 +118,7 @@ impl<'f> FirstPass<'f> {
         // that the refined samples hit near the centres), for centres none of whose rays may
         // meet anything moving.
         let of_still = frame.integrator.scene.plan().0.ask_moving;
+        let probe = MotionProbe::new(frame, shutter);
         let shadows_hold = !shutter.lights_move() && (of_still || !shutter.camera_moves());
         self.centres
             .par_chunks_mut(w)
@@ -141,17 +143,9 @@ impl<'f> FirstPass<'f> {
                             sw.depth = sample.t.unwrap_or(f32::NAN);
                         }
                     }
-                    sw.touched = swept > 0.0
-                        && shutter.changes(
-                            frame.integrator,
-                            frame.camera,
-                            (x, y),
-                            *px,
-                            swept,
-                            &mut st,
-                        );
+                    sw.touched = swept > 0.0 && probe.changes((x, y), *px, swept, &mut st);
                     if shutter.camera_moves() {
-                        sw.streak = shutter.camera_sweep(frame.camera, x, y, sample.t);
+                        sw.streak = probe.camera_sweep(x, y, sample.t);
                     }
                 }
                 st.scratch.counts.primary += row.len() as u64;
@@ -216,7 +210,7 @@ impl<'f> FirstPass<'f> {
             d
         };
         let mut bias = 0.0f32;
-        for [a, b] in Shutter::streak_pairs(x, y, ends) {
+        for [a, b] in streak_pairs(x, y, ends) {
             let (a, b) = (at(a).map(&mut seen), at(b).map(&mut seen));
             let pair = match (a, b) {
                 (Some(a), Some(b)) => (a + b) * 0.5,

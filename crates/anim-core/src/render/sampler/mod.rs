@@ -6,10 +6,12 @@
 //!   needs them (`first_pass`), at the points of each pixel's own scrambled Sobol pattern
 //!   ([`pattern`]). What the first pass learned travels to the integrator as a value, the
 //!   `PixelPrior` of the first samples it adds (`pattern::PRIOR_SAMPLES`).
+//!   In a frame with motion, `motion` answers what the first pass asks of it.
 //! - `packet`: camera rays of still frames, traced a block at a time.
 
 mod adaptive;
 mod first_pass;
+mod motion;
 mod packet;
 pub mod pattern;
 mod uniform;
