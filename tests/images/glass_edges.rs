@@ -20,61 +20,44 @@ fn to_u8(c: f64) -> u8 {
 /// 8-bit result").
 const NEGLIGIBLE: f64 = 0.5 / 255.0;
 
-/// Radiance along a ray travelling on a straight line through planar interfaces met at
-/// normal incidence, each of which reflects it straight back or lets it through undeflected
-/// (so every path stays on the line): the formula of docs/shading.md §3 with black local
-/// colour, evaluated over all paths exactly as the recursion does. `interfaces[i]` is the
-/// opacity of the surface met at position i (positions ascending along the line); the ray
-/// starts before position `at` going forwards (`dir = 1`) or after position `at` going
-/// backwards (`dir = -1`); past either end it sees the background `bg`.
-#[allow(clippy::too_many_arguments)]
-fn along_line(
-    interfaces: &[f64],
+/// A straight line through planar interfaces met at normal incidence, each of which
+/// reflects a ray straight back or lets it through undeflected (so every path stays on the
+/// line): `interfaces[i]` is the opacity of the surface met at position i (positions
+/// ascending along the line), each with reflectance `f0`; past either end a ray sees the
+/// background `bg`. Rays are cut as the renderer cuts them: at `max_depth` bounces, and where
+/// their weight times `max_radiance` cannot change the 8-bit result.
+struct Line<'a> {
+    interfaces: &'a [f64],
     f0: f64,
     bg: f64,
     max_radiance: f64,
-    at: isize,
-    dir: isize,
-    depth: u32,
-    weight: f64,
     max_depth: u32,
-) -> f64 {
-    if at < 0 || at >= interfaces.len() as isize {
-        return bg;
+}
+
+impl Line<'_> {
+    /// Radiance along a ray on the line with black local colour: the formula of
+    /// docs/shading.md §3, evaluated over all paths exactly as the recursion does. The ray
+    /// starts before position `at` going forwards (`dir = 1`) or after position `at` going
+    /// backwards (`dir = -1`), after `depth` bounces, with share `weight` of the pixel.
+    fn radiance(&self, at: isize, dir: isize, depth: u32, weight: f64) -> f64 {
+        if at < 0 || at >= self.interfaces.len() as isize {
+            return self.bg;
+        }
+        let alpha = self.interfaces[at as usize];
+        let f0 = self.f0;
+        let (w_reflect, w_refract) = ((1.0 - alpha) * f0, (1.0 - alpha) * (1.0 - f0));
+        let worth = |w: f64| {
+            depth < self.max_depth && w > 0.0 && weight * w * self.max_radiance >= NEGLIGIBLE
+        };
+        let mut c = 0.0;
+        if worth(w_reflect) {
+            c += w_reflect * self.radiance(at - dir, -dir, depth + 1, weight * w_reflect);
+        }
+        if worth(w_refract) {
+            c += w_refract * self.radiance(at + dir, dir, depth + 1, weight * w_refract);
+        }
+        c
     }
-    let alpha = interfaces[at as usize];
-    let (w_reflect, w_refract) = ((1.0 - alpha) * f0, (1.0 - alpha) * (1.0 - f0));
-    let worth = |w: f64| depth < max_depth && w > 0.0 && weight * w * max_radiance >= NEGLIGIBLE;
-    let mut c = 0.0;
-    if worth(w_reflect) {
-        c += w_reflect
-            * along_line(
-                interfaces,
-                f0,
-                bg,
-                max_radiance,
-                at - dir,
-                -dir,
-                depth + 1,
-                weight * w_reflect,
-                max_depth,
-            );
-    }
-    if worth(w_refract) {
-        c += w_refract
-            * along_line(
-                interfaces,
-                f0,
-                bg,
-                max_radiance,
-                at + dir,
-                dir,
-                depth + 1,
-                weight * w_refract,
-                max_depth,
-            );
-    }
-    c
 }
 
 fn fresnel_normal(ior: f64) -> f64 {
@@ -119,17 +102,14 @@ fn nested_glass_spheres_along_the_axis() {
             glass("inner", alpha_inner, ior)
         );
         let img = render(&sdf);
-        let c = along_line(
-            &[alpha_outer, alpha_inner, alpha_inner, alpha_outer],
-            fresnel_normal(ior),
+        let line = Line {
+            interfaces: &[alpha_outer, alpha_inner, alpha_inner, alpha_outer],
+            f0: fresnel_normal(ior),
             bg,
-            bg,
-            0,
-            1,
-            0,
-            1.0,
-            8,
-        );
+            max_radiance: bg,
+            max_depth: 8,
+        };
+        let c = line.radiance(0, 1, 0, 1.0);
         assert_close(
             img.at(16, 16),
             to_u8(c),
@@ -160,7 +140,16 @@ fn glass_boxes_sharing_a_face_cross_it_once() {
     );
     let img = render(&sdf);
     let f0 = fresnel_normal(ior);
-    let line = |n: usize| along_line(&vec![alpha; n], f0, bg, bg, 0, 1, 0, 1.0, 8);
+    let line = |n: usize| {
+        let line = Line {
+            interfaces: &vec![alpha; n],
+            f0,
+            bg,
+            max_radiance: bg,
+            max_depth: 8,
+        };
+        line.radiance(0, 1, 0, 1.0)
+    };
     let (two, three, four) = (to_u8(line(2)), to_u8(line(3)), to_u8(line(4)));
     assert!(two > three + 2 && three > four + 2, "{two} {three} {four}");
     // The 6° view sees only box faces (the boxes span ±9.5° from 6 units away).

@@ -6,7 +6,7 @@
 //! leading coefficient vanishes for rays parallel to a generator; the equation is then linear.
 
 use super::cylinder::{
-    conservative_aabb, discriminant_noise, quadratic_roots, AxisFrame, Nearest, Part,
+    conservative_aabb, discriminant_noise, quadratic_roots, AxisFrame, Nearest, Part, Rim, Side,
 };
 use super::{NearFaces, ShapeHit};
 use crate::math::{Aabb, Ray};
@@ -202,8 +202,16 @@ impl Cone {
         let side = DVec3::new(local.x / rho, local.y / rho, -k) / norm;
         // Distance from the generator's line ρ = k·z in the point's half-plane.
         let to_side = (k * local.z - rho) / norm;
-        self.frame
-            .faces_near(local, h, r, r.min(h), side, to_side, 1.0)
+        let side = Side {
+            normal: side,
+            distance: to_side,
+        };
+        let rim = Rim {
+            z: h,
+            cap: 1.0,
+            radius: r,
+        };
+        self.frame.faces_near(local, side, rim, r.min(h))
     }
 
     /// The unit axis into the solid and the sine of the half-angle (`NearFaces::apex`).

@@ -27,6 +27,21 @@ pub(super) struct AxisFrame {
     centre: DVec3,
 }
 
+/// The side face of a shape of an `AxisFrame` near a point, as `AxisFrame::faces_near` reads
+/// it: its unit normal there (in the frame) and the point's distance from it.
+pub(super) struct Side {
+    pub normal: DVec3,
+    pub distance: f64,
+}
+
+/// The rim where a cap meets the side, as `AxisFrame::faces_near` reads it: the cap's plane
+/// at local height `z` with outward normal `cap`·w, and the side's radius there.
+pub(super) struct Rim {
+    pub z: f64,
+    pub cap: f64,
+    pub radius: f64,
+}
+
 /// A ray in an `AxisFrame`: its origin moved to `t = t_shift` along the world ray, then
 /// expressed in the frame. World `t` = `t_shift` + local `t`.
 pub(super) struct LocalRay {
@@ -92,23 +107,16 @@ impl AxisFrame {
         DVec3::new(rel.dot(self.u), rel.dot(self.v), rel.dot(self.w))
     }
 
-    /// The side and the cap at local height `z` (outward normal `cap`·w) near local point
-    /// `local` of a shape of `radius` there: on the rim itself both at distance 0 (a hit
-    /// `intersect` snapped onto the rim lies on it to within rounding; one it left alone lies
-    /// at least the edge band away, so half the band tells them apart); elsewhere each with
-    /// the point's distance from its plane, `to_side` for the side (whose unit normal there
-    /// is `side`).
-    #[allow(clippy::too_many_arguments)]
-    pub fn faces_near(
-        &self,
-        local: DVec3,
-        z: f64,
-        radius: f64,
-        smallest: f64,
-        side: DVec3,
-        to_side: f64,
-        cap: f64,
-    ) -> NearFaces {
+    /// The side and the cap near local point `local` of a shape whose smallest measure is
+    /// `smallest`: on the rim itself both at distance 0 (a hit `intersect` snapped onto the
+    /// rim lies on it to within rounding; one it left alone lies at least the edge band away,
+    /// so half the band tells them apart); elsewhere each with the point's distance from it.
+    pub fn faces_near(&self, local: DVec3, side: Side, rim: Rim, smallest: f64) -> NearFaces {
+        let Side {
+            normal: side,
+            distance: to_side,
+        } = side;
+        let Rim { z, cap, radius } = rim;
         let rho = (local.x * local.x + local.y * local.y).sqrt();
         let half_band = 0.5 * self.edge_band(local, smallest);
         let to_cap = (local.z - z).abs();
@@ -414,8 +422,12 @@ impl Cylinder {
         } else {
             (h, 1.0)
         };
-        self.frame
-            .faces_near(local, z, r, r.min(h), side, r - rho, cap)
+        let side = Side {
+            normal: side,
+            distance: r - rho,
+        };
+        let rim = Rim { z, cap, radius: r };
+        self.frame.faces_near(local, side, rim, r.min(h))
     }
 }
 

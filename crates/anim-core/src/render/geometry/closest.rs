@@ -4,7 +4,7 @@
 //! composite tree's order, whatever order the primitives are tested in: every strategy gives
 //! the same answer to the bit.
 
-use super::leaf::Best;
+use super::leaf::{Best, Kept, LaneRay};
 use super::{placed_surface, sphere_surface, Aggregate, Kind, MovingScratch, PrimId, SurfaceHit};
 use crate::math::Ray;
 use crate::render::geometry::Primitive;
@@ -83,9 +83,16 @@ impl Aggregate {
             }
         } else {
             let boxes = BoxRay::new(ray);
+            let at = LaneRay {
+                ray,
+                spheres: &lanes,
+            };
             let mut leaf = |leaf: &[u32], t_max| {
-                let lanes = (&lanes, &boxes);
-                self.closest_in_leaf(lanes, ray, leaf, t_max, &mut best, &mut won, scratch)
+                let kept = Kept {
+                    best: &mut best,
+                    won: &mut won,
+                };
+                self.closest_in_leaf(at, &boxes, leaf, t_max, kept, scratch)
             };
             match flat {
                 Some(all) => _ = leaf(all, t_best),

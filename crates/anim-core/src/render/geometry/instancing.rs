@@ -26,6 +26,15 @@ use glam::Vec3A;
 /// rounding of a ray moved into a prototype's frame).
 const CULL_MARGIN: f32 = 1e-3;
 
+/// A walk through the prototypes along one ray: the ray (in the world), how far it still
+/// looks (which a closest-hit walk shortens as it goes), and what it does with each shape
+/// the ray may meet: `shape(id, primitive)`, going on while that returns true.
+struct Walk<'w> {
+    ray: &'w Ray,
+    limit: &'w dyn Fn() -> f32,
+    shape: &'w mut dyn FnMut(u32, &Primitive) -> bool,
+}
+
 #[derive(Clone, Debug)]
 struct Compiled {
     /// Over the entries: leaf `e` for `e < leaves`, then nested use `e - leaves`.
@@ -212,17 +221,9 @@ impl Instances {
         Ray::new(Vec3A::from(o.as_vec3()), Vec3A::from(d.as_vec3()))
     }
 
-    /// Visits, through top-level use `u`, every shape the ray may meet before `limit()`:
-    /// `shape(id, primitive)` for each, as long as it returns true.
-    fn visit(
-        &self,
-        u: &Use,
-        frame: &Transform,
-        base: u32,
-        ray: &Ray,
-        limit: &dyn Fn() -> f32,
-        shape: &mut dyn FnMut(u32, &Primitive) -> bool,
-    ) -> bool {
+    /// Visits, through use `u` (in `frame`, its shapes numbered from `base`), every shape the
+    /// walk's ray may meet before its limit, as long as the walk goes on.
+    fn visit(&self, u: &Use, frame: &Transform, base: u32, walk: &mut Walk) -> bool {
         let inst = &self.scene.instanced;
         let (Some(p), Some(c)) = (
             inst.prototypes.get(u.prototype as usize),
@@ -230,33 +231,24 @@ impl Instances {
         ) else {
             return true;
         };
-        let local = Self::local_ray(&self.scene.moved(*frame), ray);
+        let local = Self::local_ray(&self.scene.moved(*frame), walk.ray);
         let mut go_on = true;
         c.bvh
-            .closest_leaves(&local, cull_limit(limit()), |leaf, _| {
+            .closest_leaves(&local, cull_limit((walk.limit)()), |leaf, _| {
                 for &e in leaf {
-                    if !self.entry(p, e, frame, base, ray, limit, shape) {
+                    if !self.entry(p, e, frame, base, walk) {
                         go_on = false;
                         // Beyond every box: the traversal ends.
                         return f32::NEG_INFINITY;
                     }
                 }
-                cull_limit(limit())
+                cull_limit((walk.limit)())
             });
         go_on
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn entry(
-        &self,
-        p: &Prototype,
-        e: u32,
-        frame: &Transform,
-        base: u32,
-        ray: &Ray,
-        limit: &dyn Fn() -> f32,
-        shape: &mut dyn FnMut(u32, &Primitive) -> bool,
-    ) -> bool {
+    /// Entry `e` of prototype `p` (a shape, or a nested use) as `visit` meets it.
+    fn entry(&self, p: &Prototype, e: u32, frame: &Transform, base: u32, walk: &mut Walk) -> bool {
         let e = e as usize;
         if let Some(leaf) = p.leaves.get(e) {
             let world = self.scene.prototype_world(p, frame, leaf.transform);
@@ -266,12 +258,12 @@ impl Instances {
                 &self.scene.moved(world),
                 leaf.material as u32,
             ) {
-                Ok(prim) => shape(self.first_id + flat, &prim),
+                Ok(prim) => (walk.shape)(self.first_id + flat, &prim),
                 Err(_) => true,
             }
         } else if let Some(nested) = p.uses.get(e - p.leaves.len()) {
             let inner = self.scene.prototype_world(p, frame, nested.slot);
-            self.visit(nested, &inner, base + nested.offset, ray, limit, shape)
+            self.visit(nested, &inner, base + nested.offset, walk)
         } else {
             true
         }
@@ -291,13 +283,10 @@ impl Instances {
         let t_cell = std::cell::Cell::new(*t_max);
         let mut found = *best;
         let first_id = self.first_id;
-        self.visit(
-            u,
-            &self.frames[k as usize],
-            u.offset,
+        let mut walk = Walk {
             ray,
-            &|| t_cell.get(),
-            &mut |id, prim| {
+            limit: &|| t_cell.get(),
+            shape: &mut |id, prim| {
                 let t_now = t_cell.get();
                 if let Some(h) = prim.hit(ray, t_now.next_up()) {
                     let key = id - first_id;
@@ -314,7 +303,8 @@ impl Instances {
                 }
                 true
             },
-        );
+        };
+        self.visit(u, &self.frames[k as usize], u.offset, &mut walk);
         *t_max = t_cell.get();
         *best = found;
     }
@@ -324,17 +314,15 @@ impl Instances {
     pub fn any(&self, k: u32, ray: &Ray, t_max: f32, stop: &mut dyn FnMut(u32) -> bool) -> bool {
         let u = &self.scene.instanced.uses[k as usize];
         let mut stopped = false;
-        self.visit(
-            u,
-            &self.frames[k as usize],
-            u.offset,
+        let mut walk = Walk {
             ray,
-            &|| t_max,
-            &mut |id, _| {
+            limit: &|| t_max,
+            shape: &mut |id, _| {
                 stopped = stop(id);
                 !stopped
             },
-        );
+        };
+        self.visit(u, &self.frames[k as usize], u.offset, &mut walk);
         stopped
     }
 
@@ -343,19 +331,17 @@ impl Instances {
     pub fn occluder(&self, k: u32, ray: &Ray, t_max: f32) -> Option<u32> {
         let u = &self.scene.instanced.uses[k as usize];
         let mut hit = None;
-        self.visit(
-            u,
-            &self.frames[k as usize],
-            u.offset,
+        let mut walk = Walk {
             ray,
-            &|| t_max,
-            &mut |id, prim| {
+            limit: &|| t_max,
+            shape: &mut |id, prim| {
                 if prim.hit(ray, t_max).is_some() {
                     hit = Some(id);
                 }
                 hit.is_none()
             },
-        );
+        };
+        self.visit(u, &self.frames[k as usize], u.offset, &mut walk);
         hit
     }
 

@@ -33,6 +33,48 @@ impl Best {
     }
 }
 
+/// A ray as the tests four at a time read it: the ray, and its lanes for packed spheres.
+#[derive(Clone, Copy)]
+pub(super) struct LaneRay<'r> {
+    pub ray: &'r Ray,
+    pub spheres: &'r SphereRay,
+}
+
+/// One group of four primitives of a leaf or of a list: the primitive in each lane (`id`),
+/// their slab tests (`classify_lanes`), and their packed spheres, loaded only if some lane
+/// is a sphere.
+pub(super) struct Four<I, S> {
+    pub id: I,
+    pub lanes: Lanes,
+    pub spheres: S,
+}
+
+/// Four packed spheres in lanes: primitive `id(k)` in lane `k`, of which the lanes `live`
+/// count.
+pub(super) struct FourSpheres<'s, I> {
+    pub spheres: &'s [Vec4; LANES],
+    pub id: I,
+    pub live: u32,
+}
+
+/// What a closest-hit query keeps as it goes: the closest hit so far, and the placed
+/// primitive of an instanced winner (for its surface).
+pub(super) struct Kept<'k> {
+    pub best: &'k mut Option<Best>,
+    pub won: &'k mut Option<Primitive>,
+}
+
+impl Kept<'_> {
+    /// The same, lent to one call.
+    #[inline(always)]
+    pub fn reborrow(&mut self) -> Kept<'_> {
+        Kept {
+            best: &mut *self.best,
+            won: &mut *self.won,
+        }
+    }
+}
+
 /// Four primitives sorted by [`Aggregate::classify`], as lane masks.
 pub(super) struct Lanes {
     pub spheres: u32,
@@ -128,25 +170,26 @@ impl Aggregate {
         let limit = t_max.next_up();
         for start in (first..end).step_by(LANES) {
             let spheres = SphereRay::lanes(self.four_spheres(start));
-            let live = (1 << (end - start).min(LANES)) - 1;
-            t_max =
-                self.closest_in_spheres(lanes, &spheres, |k| start + k, live, limit, t_max, best);
+            let group = FourSpheres {
+                spheres: &spheres,
+                id: |k| start + k,
+                live: (1 << (end - start).min(LANES)) - 1,
+            };
+            t_max = self.closest_in_spheres(lanes, group, limit, t_max, best);
         }
         t_max
     }
 
-    /// The closest hit among one leaf's primitives; returns the new `t_max`. `won` keeps the
-    /// placed primitive of an instanced winner, for its surface.
+    /// The closest hit among one leaf's primitives (their bounds slab-tested by `boxes`);
+    /// returns the new `t_max`.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn closest_in_leaf(
         &self,
-        (lanes, boxes): (&SphereRay, &BoxRay),
-        ray: &Ray,
+        ray: LaneRay,
+        boxes: &BoxRay,
         leaf: &[u32],
         mut t_max: f32,
-        best: &mut Option<Best>,
-        won: &mut Option<Primitive>,
+        mut kept: Kept,
         scratch: &mut MovingScratch,
     ) -> f32 {
         let first = leaf[0] as usize;
@@ -154,34 +197,40 @@ impl Aggregate {
         // A hit as close as the kept one is found too, to be judged by its number.
         let limit = t_max.next_up();
         for start in (first..end).step_by(LANES) {
-            let c = self.classify(boxes, start, end, limit);
-            let four_spheres = || self.four_spheres(start);
-            let group = (|k| start + k, c, four_spheres);
-            t_max = self.closest_in_four(lanes, ray, group, limit, t_max, (best, won), scratch);
+            let group = Four {
+                id: |k| start + k,
+                lanes: self.classify(boxes, start, end, limit),
+                spheres: || self.four_spheres(start),
+            };
+            t_max = self.closest_in_four(ray, group, limit, t_max, kept.reborrow(), scratch);
         }
         t_max
     }
 
-    /// One group of four primitives of a leaf (or of a list): `id` of each lane, their slab
-    /// tests `c` (`classify_lanes`), and their packed spheres, loaded only if some lane is a
-    /// sphere. Only those hit (spheres, boxes) or whose bounds the ray meets (other kinds)
-    /// are looked at, in lane order. Returns the new `t_max`.
+    /// The closest hit among one group of four primitives of a leaf (or of a list), up to
+    /// `limit` (the leaf's first `t_max`, moved up one ulp). Only those hit (spheres, boxes)
+    /// or whose bounds the ray meets (other kinds) are looked at, in lane order. Returns the
+    /// new `t_max`.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn closest_in_four(
         &self,
-        lanes: &SphereRay,
-        ray: &Ray,
-        (id, c, four_spheres): (
-            impl Fn(usize) -> usize,
-            Lanes,
-            impl FnOnce() -> [Vec4; LANES],
-        ),
+        ray: LaneRay,
+        group: Four<impl Fn(usize) -> usize, impl FnOnce() -> [Vec4; LANES]>,
         limit: f32,
         mut t_max: f32,
-        (best, won): (&mut Option<Best>, &mut Option<Primitive>),
+        kept: Kept,
         scratch: &mut MovingScratch,
     ) -> f32 {
+        let LaneRay {
+            ray,
+            spheres: lanes,
+        } = ray;
+        let Four {
+            id,
+            lanes: c,
+            spheres: four_spheres,
+        } = group;
+        let Kept { best, won } = kept;
         let (sphere_hit, sphere_t) = if c.spheres != 0 {
             lanes.hit4(four_spheres(), limit)
         } else {
@@ -254,21 +303,18 @@ impl Aggregate {
         }
     }
 
-    /// One group of four packed spheres in lanes, primitive `id(k)` in lane `k`, of which
-    /// the lanes `live` count, tested up to `limit` (the leaf's first `t_max`, moved up one
-    /// ulp); returns the new `t_max`.
+    /// The closest hit among one group of four packed spheres, tested up to `limit` (the
+    /// leaf's first `t_max`, moved up one ulp); returns the new `t_max`.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn closest_in_spheres(
         &self,
         lanes: &SphereRay,
-        spheres: &[Vec4; LANES],
-        id: impl Fn(usize) -> usize,
-        live: u32,
+        group: FourSpheres<impl Fn(usize) -> usize>,
         limit: f32,
         mut t_max: f32,
         best: &mut Option<Best>,
     ) -> f32 {
+        let FourSpheres { spheres, id, live } = group;
         let (mask, t) = lanes.hit_lanes(spheres, limit);
         let mut mask = mask & live;
         while mask != 0 {
@@ -288,23 +334,27 @@ impl Aggregate {
         t_max
     }
 
-    /// One group of four primitives of an any-hit query (of a leaf or a list): `id` of each
-    /// lane, their slab tests `c` (`classify_lanes`), and their packed spheres, loaded only
-    /// if some lane is a sphere. Offers those hit to `stop`: boxes, then spheres, then the
-    /// other kinds whose bounds the ray meets; true when `stop` did.
+    /// One group of four primitives of an any-hit query (of a leaf or a list): offers those
+    /// hit before `t_max` to `stop`: boxes, then spheres, then the other kinds whose bounds the
+    /// ray meets; true when `stop` did.
     #[inline(always)]
     pub(super) fn any_in_four(
         &self,
-        ray: &Ray,
-        lanes: &SphereRay,
+        ray: LaneRay,
         t_max: f32,
-        (id, c, four_spheres): (
-            impl Fn(usize) -> usize,
-            Lanes,
-            impl FnOnce() -> [Vec4; LANES],
-        ),
-        (stop, scratch): (&mut impl FnMut(u32) -> bool, &mut MovingScratch),
+        group: Four<impl Fn(usize) -> usize, impl FnOnce() -> [Vec4; LANES]>,
+        stop: &mut impl FnMut(u32) -> bool,
+        scratch: &mut MovingScratch,
     ) -> bool {
+        let LaneRay {
+            ray,
+            spheres: lanes,
+        } = ray;
+        let Four {
+            id,
+            lanes: c,
+            spheres: four_spheres,
+        } = group;
         if offer(&id, c.boxes_hit, stop) {
             return true;
         }

@@ -3,7 +3,7 @@
 //! primitives and the unbounded ones are tested, four at a time, and the answers are those
 //! of the same query over every primitive.
 
-use super::leaf::{fours, gather, offer};
+use super::leaf::{fours, gather, offer, Four, FourSpheres, Kept, LaneRay};
 use super::{Aggregate, MovingScratch, PrimId, SurfaceHit};
 use crate::math::Ray;
 use crate::shape::{BoxRay, SphereRay};
@@ -35,14 +35,29 @@ impl Aggregate {
             let id = |k: usize| ids[k];
             let Some(boxes) = &boxes else {
                 let spheres = SphereRay::lanes(gather(&self.spheres, ids));
-                t_max = self.closest_in_spheres(&lanes, &spheres, id, 0xF, limit, t_max, &mut best);
+                let group = FourSpheres {
+                    spheres: &spheres,
+                    id,
+                    live: 0xF,
+                };
+                t_max = self.closest_in_spheres(&lanes, group, limit, t_max, &mut best);
                 continue;
             };
             let (min, max) = (gather(&self.bounds_min, ids), gather(&self.bounds_max, ids));
-            let c = self.classify_lanes(boxes, min, max, 0xF, limit);
-            let group = (id, c, || gather(&self.spheres, ids));
-            let kept = (&mut best, &mut won);
-            t_max = self.closest_in_four(&lanes, ray, group, limit, t_max, kept, scratch);
+            let group = Four {
+                id,
+                lanes: self.classify_lanes(boxes, min, max, 0xF, limit),
+                spheres: || gather(&self.spheres, ids),
+            };
+            let kept = Kept {
+                best: &mut best,
+                won: &mut won,
+            };
+            let at = LaneRay {
+                ray,
+                spheres: &lanes,
+            };
+            t_max = self.closest_in_four(at, group, limit, t_max, kept, scratch);
         }
         self.surface_of(ray, best?, won.as_ref(), scratch)
     }
@@ -57,7 +72,8 @@ impl Aggregate {
         &self,
         ray: &Ray,
         t_max: f32,
-        (listed, near): (&[u32], &[f32]),
+        listed: &[u32],
+        near: &[f32],
         scratch: &mut MovingScratch,
         mut stop: impl FnMut(u32) -> bool,
     ) {
@@ -81,9 +97,16 @@ impl Aggregate {
                 continue;
             };
             let (min, max) = (gather(&self.bounds_min, ids), gather(&self.bounds_max, ids));
-            let c = self.classify_lanes(boxes, min, max, 0xF, t_max);
-            let group = (id, c, || gather(&self.spheres, ids));
-            if self.any_in_four(ray, &lanes, t_max, group, (&mut stop, scratch)) {
+            let group = Four {
+                id,
+                lanes: self.classify_lanes(boxes, min, max, 0xF, t_max),
+                spheres: || gather(&self.spheres, ids),
+            };
+            let at = LaneRay {
+                ray,
+                spheres: &lanes,
+            };
+            if self.any_in_four(at, t_max, group, &mut stop, scratch) {
                 return;
             }
         }

@@ -1,7 +1,7 @@
 //! Any-hit queries: whether, and what, a ray meets before a distance, in whatever order is
 //! cheapest (shadow rays, and the tests that hold every strategy to brute force).
 
-use super::leaf::{offer, LANES};
+use super::leaf::{offer, Four, LaneRay, LANES};
 use super::{Aggregate, Candidates, Kind, MovingScratch};
 use crate::math::Ray;
 use crate::shape::{BoxRay, SphereRay};
@@ -23,12 +23,12 @@ impl Aggregate {
         match candidates {
             Candidates::All => self.any_of_all(ray, t_max, scratch, stop),
             Candidates::Listed { ids, near: None } => {
-                self.any_listed::<false>(ray, t_max, (ids, &[]), scratch, stop)
+                self.any_listed::<false>(ray, t_max, ids, &[], scratch, stop)
             }
             Candidates::Listed {
                 ids,
                 near: Some(near),
-            } => self.any_listed::<true>(ray, t_max, (ids, near), scratch, stop),
+            } => self.any_listed::<true>(ray, t_max, ids, near, scratch, stop),
         }
     }
 
@@ -82,9 +82,16 @@ impl Aggregate {
         let leaf = |leaf: &[u32]| {
             let (first, end) = (leaf[0] as usize, leaf[0] as usize + leaf.len());
             (first..end).step_by(LANES).any(|start| {
-                let c = self.classify(&boxes, start, end, t_max);
-                let group = (|k| start + k, c, || self.four_spheres(start));
-                self.any_in_four(ray, &lanes, t_max, group, (&mut stop, scratch))
+                let group = Four {
+                    id: |k| start + k,
+                    lanes: self.classify(&boxes, start, end, t_max),
+                    spheres: || self.four_spheres(start),
+                };
+                let at = LaneRay {
+                    ray,
+                    spheres: &lanes,
+                };
+                self.any_in_four(at, t_max, group, &mut stop, scratch)
             })
         };
         match flat {

@@ -6,7 +6,7 @@
 //! hierarchy), `crate::render::geometry::packet` (closest hits of a packet) and
 //! `crate::render::sampler::packet` (camera rays of a block of pixels, traced together).
 
-use super::leaf::{fours, gather, Best, LANES};
+use super::leaf::{fours, gather, Best, FourSpheres, Kept, LaneRay, LANES};
 use super::{Aggregate, Candidates, MovingScratch, PrimId, Primitive, SurfaceHit};
 use crate::accel::Packet;
 use crate::math::Ray;
@@ -54,15 +54,13 @@ impl Aggregate {
                         let r = rays.trailing_zeros() as usize;
                         rays &= rays - 1;
                         let t = t_max[r];
-                        t_max[r] = self.closest_in_spheres(
-                            &lanes[r],
-                            &spheres,
-                            |k| first + k,
-                            (1 << (end - first).min(LANES)) - 1,
-                            t.next_up(),
-                            t,
-                            &mut best[r],
-                        );
+                        let group = FourSpheres {
+                            spheres: &spheres,
+                            id: |k| first + k,
+                            live: (1 << (end - first).min(LANES)) - 1,
+                        };
+                        t_max[r] =
+                            self.closest_in_spheres(&lanes[r], group, t.next_up(), t, &mut best[r]);
                     }
                 });
             return std::array::from_fn(|r| {
@@ -76,9 +74,15 @@ impl Aggregate {
         let boxes: [BoxRay; N] = std::array::from_fn(|r| BoxRay::new(&rays[r]));
         self.bvh
             .closest_leaves_packet(&packet, &mut t_best, |r, leaf, t_max| {
-                let ray_lanes = (&lanes[r], &boxes[r]);
-                let (best, won) = (&mut best[r], &mut won[r]);
-                self.closest_in_leaf(ray_lanes, &rays[r], leaf, t_max, best, won, scratch)
+                let at = LaneRay {
+                    ray: &rays[r],
+                    spheres: &lanes[r],
+                };
+                let kept = Kept {
+                    best: &mut best[r],
+                    won: &mut won[r],
+                };
+                self.closest_in_leaf(at, &boxes[r], leaf, t_max, kept, scratch)
             });
         std::array::from_fn(|r| self.surface_of(&rays[r], best[r]?, won[r].as_ref(), scratch))
     }
@@ -115,11 +119,14 @@ impl Aggregate {
             while rays != 0 {
                 let r = rays.trailing_zeros() as usize;
                 rays &= rays - 1;
+                let group = FourSpheres {
+                    spheres: &spheres,
+                    id: |k| ids[k],
+                    live: 0xF,
+                };
                 t_max[r] = self.closest_in_spheres(
                     &lanes[r],
-                    &spheres,
-                    |k| ids[k],
-                    0xF,
+                    group,
                     f32::INFINITY,
                     t_max[r],
                     &mut best[r],

@@ -8,7 +8,7 @@
 //! transform).
 
 use super::definitions::{Definitions, ObjectKind};
-use super::jobs::{Expansion, Flatten};
+use super::jobs::{Expansion, Flatten, Walked};
 use super::Builder;
 use crate::limits::{
     scene_memory, INSTANCE_BUDGET_SHARE, INSTANCE_MAX_FLAT, INSTANCE_MIN_SHAPES, MAX_NESTING,
@@ -225,17 +225,16 @@ impl Builder<'_> {
     /// use of its prototype, making the prototype the first time. False when it is not
     /// instanced here (not chosen, or listed so deep that the flattening must check the
     /// nesting limit on its own walk): the caller then flattens it.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn use_prototype<'s>(
         &mut self,
-        d: &Definitions<'s>,
-        moved: &[bool],
+        walked: Walked<'_, 's>,
         i: usize,
         slot: u32,
         node: u32,
         stack: &mut Vec<&'s str>,
         out: &mut Flatten,
     ) -> bool {
+        let d = walked.defs;
         let b = &out.inst;
         if !b.plan.instanced.get(i).copied().unwrap_or(false)
             || stack.len() + b.plan.height[i] as usize > MAX_NESTING
@@ -249,7 +248,7 @@ impl Builder<'_> {
             let target = std::mem::take(&mut out.inst.target);
             stack.push(d.objects[i].name);
             for c in children(d, i) {
-                self.flatten(d, moved, c, 0, node, stack, out);
+                self.flatten(walked, c, 0, node, stack, out);
             }
             stack.pop();
             let leaves = std::mem::replace(&mut out.instances, instances);

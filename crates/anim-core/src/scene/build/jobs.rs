@@ -267,8 +267,9 @@ impl Builder<'_> {
             flat.instances
                 .reserve_exact(usize::try_from(shapes).unwrap_or(0));
             let mut stack = Vec::new();
+            let walked = Walked { defs: d, moved };
             for &root in roots {
-                self.flatten(d, moved, root, 0, NO_NAME, &mut stack, &mut flat);
+                self.flatten(walked, root, 0, NO_NAME, &mut stack, &mut flat);
             }
         }
         flat.instances.shrink_to_fit();
@@ -284,17 +285,16 @@ impl Builder<'_> {
 
     /// Appends the instances below object `i`, listed in transform slot `slot` under path
     /// node `path`. `stack` holds the composites being expanded, to stop at cycles.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn flatten<'s>(
         &mut self,
-        d: &Definitions<'s>,
-        moved: &[bool],
+        walked: Walked<'_, 's>,
         i: usize,
         slot: u32,
         path: u32,
         stack: &mut Vec<&'s str>,
         out: &mut Flatten,
     ) {
+        let Walked { defs: d, moved } = walked;
         if self.too_many_reported {
             return; // the scene is refused anyway; do not walk the rest of a huge tree
         }
@@ -360,13 +360,13 @@ impl Builder<'_> {
                 }
                 let id = out.name_id(i, object);
                 let node = out.names.add_path(path, id);
-                if self.use_prototype(d, moved, i, slot, node, stack, out) {
+                if self.use_prototype(walked, i, slot, node, stack, out) {
                     return;
                 }
                 stack.push(name);
                 for &child in children {
                     if let Some(&c) = d.object_index.get(child) {
-                        self.flatten(d, moved, c, slot, node, stack, out);
+                        self.flatten(walked, c, slot, node, stack, out);
                     }
                 }
                 stack.pop();
@@ -414,6 +414,14 @@ impl Flatten {
         }
         self.name_ids[i]
     }
+}
+
+/// What the flattening walks: the definitions, and per object whether a `motion` line moves
+/// it (then it gets a transform slot of its own).
+#[derive(Clone, Copy)]
+pub(super) struct Walked<'a, 's> {
+    pub defs: &'a Definitions<'s>,
+    pub moved: &'a [bool],
 }
 
 /// The objects a scene is drawn from, and what each expands to.
