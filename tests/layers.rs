@@ -14,6 +14,11 @@
 //! anim-core:           load → render → scene → sdf → shape → accel → math → limits →
 //!                      {diag, util}
 //! ```
+//!
+//! Inside the render core the same holds between its modules ([`RENDER_ORDER`]: entry →
+//! samplers → {exposure, integrator} → facade → view → geometry → {policy, leaves}), the
+//! integrator and the samplers ask the compiled scene through the facade alone, and no
+//! folder of the core has modules that import each other round a loop.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -46,6 +51,26 @@ const CRATES: &[(&str, &[&[&str]])] = &[
         ],
     ),
 ];
+
+/// The render core (`crates/anim-core/src/render`), top to bottom: a file may import only
+/// modules of lower groups (or files of its own module). `mod` is the entry
+/// (`render/mod.rs`); then the samplers; the exposure (`motion`) and the integrator; the
+/// facade (`compile`); the view and the geometry it asks (the view's lookups are built
+/// over the geometry's bounds, so it sits above it); the policy and the leaves every layer
+/// may read.
+const RENDER_ORDER: &[&[&str]] = &[
+    &["mod"],
+    &["sampler"],
+    &["motion", "integrator"],
+    &["compile"],
+    &["view"],
+    &["geometry"],
+    &["policy", "shading", "camera", "film", "settings", "counts"],
+];
+
+/// The render modules that ask the compiled scene only through its facade: they name
+/// nothing of `render::geometry`.
+const SEALED_OFF: &[&str] = &["integrator", "sampler"];
 
 /// About as much as one reader holds in mind; tests beside the code may run longer.
 const MAX_LINES: usize = 900;
@@ -316,6 +341,250 @@ fn no_circles_in(krate: &Crate) {
         circles.is_empty(),
         "import circles:\n{}",
         circles.join("\n")
+    );
+}
+
+/// Module path → the module files it refers to (test files and tests beside the code left
+/// out).
+type Refs = BTreeMap<Vec<String>, BTreeSet<Vec<String>>>;
+
+impl Crate {
+    fn refs(&self) -> Refs {
+        self.files
+            .keys()
+            .filter(|m| !self.is_test_file(m))
+            .map(|m| {
+                let targets = self.references(m);
+                let kept = targets.into_iter().filter(|t| !self.is_test_file(t));
+                (m.clone(), kept.collect())
+            })
+            .collect()
+    }
+
+    fn core() -> Crate {
+        Crate::all()
+            .into_iter()
+            .find(|k| k.src == "crates/anim-core/src")
+            .unwrap()
+    }
+}
+
+/// Where a module of the render core sits in [`RENDER_ORDER`]: its name there (`mod` for
+/// the entry) and its group; `None` outside `render`.
+fn render_place(module: &[String]) -> Option<(&str, Option<usize>)> {
+    if module.first().is_none_or(|m| m != "render") {
+        return None;
+    }
+    let name = module.get(1).map_or("mod", String::as_str);
+    Some((name, RENDER_ORDER.iter().position(|g| g.contains(&name))))
+}
+
+/// The imports of `refs` that run against [`RENDER_ORDER`]: from a module of the render
+/// core to one of its own group or a higher one.
+fn render_order_problems(refs: &Refs) -> Vec<String> {
+    let mut problems = Vec::new();
+    for (module, targets) in refs {
+        let Some((name, from)) = render_place(module) else {
+            continue;
+        };
+        let Some(from) = from else {
+            problems.push(format!("render::{name} is not in RENDER_ORDER"));
+            continue;
+        };
+        for target in targets {
+            let Some((to_name, to)) = render_place(target) else {
+                continue;
+            };
+            if to_name == name && name != "mod" {
+                continue;
+            }
+            if to.is_none_or(|to| to <= from) {
+                problems.push(format!(
+                    "{} imports {} (render::{name} may import only lower groups of RENDER_ORDER)",
+                    module.join("::"),
+                    target.join("::")
+                ));
+            }
+        }
+    }
+    problems
+}
+
+/// The modules of [`SEALED_OFF`] that name something of `render::geometry`.
+fn sealing_problems(refs: &Refs) -> Vec<String> {
+    let mut problems = Vec::new();
+    for (module, targets) in refs {
+        match render_place(module) {
+            Some((name, _)) if SEALED_OFF.contains(&name) => {}
+            _ => continue,
+        }
+        for target in targets {
+            if render_place(target).is_some_and(|(to, _)| to == "geometry") {
+                problems.push(format!(
+                    "{} names {}: it asks the facade (render::compile) only",
+                    module.join("::"),
+                    target.join("::")
+                ));
+            }
+        }
+    }
+    problems
+}
+
+/// Circles between the modules of one folder: for each folder, its files and subfolders,
+/// with an arrow from one to another where a file inside the first imports a file inside
+/// the second (the folder's own face, its `mod.rs`, left out: its files may read it). A
+/// circle between two files is one between their folders too, and so is one through
+/// modules the files never name each other in.
+fn module_circles(refs: &Refs) -> Vec<String> {
+    // The child of `folder` that `module` lies in, if it lies below it.
+    let child = |folder: &[String], module: &[String]| {
+        (module.len() > folder.len() && module.starts_with(folder))
+            .then(|| module[..folder.len() + 1].to_vec())
+    };
+    let folders: BTreeSet<Vec<String>> = refs
+        .keys()
+        .flat_map(|m| (0..m.len()).map(|n| m[..n].to_vec()))
+        .collect();
+    let mut circles = Vec::new();
+    for folder in &folders {
+        let mut edges: BTreeMap<Vec<String>, BTreeSet<Vec<String>>> = BTreeMap::new();
+        for (module, targets) in refs {
+            let Some(from) = child(folder, module) else {
+                continue;
+            };
+            for to in targets.iter().filter_map(|t| child(folder, t)) {
+                if to != from {
+                    edges.entry(from.clone()).or_default().insert(to);
+                }
+            }
+        }
+        circles.extend(find_circles(&edges));
+    }
+    circles
+}
+
+/// The circles of a directed graph, each as `a -> b -> … -> a`.
+fn find_circles(edges: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>) -> Vec<String> {
+    fn visit(
+        node: &Vec<String>,
+        edges: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>,
+        state: &mut BTreeMap<Vec<String>, u8>,
+        stack: &mut Vec<Vec<String>>,
+        circles: &mut Vec<String>,
+    ) {
+        state.insert(node.clone(), 1);
+        stack.push(node.clone());
+        for next in edges.get(node).into_iter().flatten() {
+            match state.get(next).copied().unwrap_or(0) {
+                0 => visit(next, edges, state, stack, circles),
+                1 => {
+                    let start = stack.iter().position(|n| n == next).unwrap();
+                    let names: Vec<String> = stack[start..].iter().map(|n| n.join("::")).collect();
+                    circles.push(format!("{} -> {}", names.join(" -> "), next.join("::")));
+                }
+                _ => {}
+            }
+        }
+        stack.pop();
+        state.insert(node.clone(), 2);
+    }
+    let mut state = BTreeMap::new();
+    let mut circles = Vec::new();
+    for node in edges.keys() {
+        if !state.contains_key(node) {
+            visit(node, edges, &mut state, &mut Vec::new(), &mut circles);
+        }
+    }
+    circles
+}
+
+#[test]
+fn the_render_core_runs_downhill() {
+    let problems = render_order_problems(&Crate::core().refs());
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// The integrator and the samplers ask the compiled scene through its facade alone: they
+/// neither import `render::geometry` nor reach the aggregate through the facade's accessor
+/// for tools.
+#[test]
+fn the_facade_is_sealed() {
+    let core = Crate::core();
+    let mut problems = sealing_problems(&core.refs());
+    for (module, file) in &core.files {
+        match render_place(module) {
+            Some((name, _)) if SEALED_OFF.contains(&name) => {}
+            _ => continue,
+        }
+        let text = std::fs::read_to_string(file).unwrap();
+        let code = text.split("#[cfg(test)]").next().unwrap_or("");
+        if code_lines(code).any(|l| l.contains(".aggregate()")) {
+            problems.push(format!("{} asks for the aggregate", module.join("::")));
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// No import circle anywhere in the core: not between two files, nor between the modules of
+/// any folder (the layers of the core, the render core's modules, the files of a folder).
+#[test]
+fn the_core_has_no_import_circle() {
+    let circles = module_circles(&Crate::core().refs());
+    assert!(
+        circles.is_empty(),
+        "import circles:\n{}",
+        circles.join("\n")
+    );
+}
+
+/// The three checks above find what they claim, on imports written to break them.
+#[test]
+fn the_render_checks_catch_wrong_imports() {
+    let path = |p: &str| p.split("::").map(String::from).collect::<Vec<String>>();
+    let refs = |pairs: &[(&str, &str)]| {
+        let mut refs = Refs::new();
+        for (from, to) in pairs {
+            refs.entry(path(from)).or_default().insert(path(to));
+        }
+        refs
+    };
+    // Downhill, sealed, and no circle.
+    let good = refs(&[
+        ("render", "render::sampler"),
+        ("render::sampler::adaptive", "render::integrator"),
+        ("render::sampler::adaptive", "render::sampler::pattern"),
+        ("render::integrator", "render::compile"),
+        ("render::compile", "render::geometry"),
+        ("render::geometry::closest", "render::geometry::leaf"),
+        ("render::geometry::leaf", "render::policy"),
+    ]);
+    assert!(render_order_problems(&good).is_empty());
+    assert!(sealing_problems(&good).is_empty());
+    assert!(module_circles(&good).is_empty());
+    // Back up from the facade to the integrator, sideways from the exposure to the
+    // integrator, and up to the entry.
+    for (from, to) in [
+        ("render::compile", "render::integrator"),
+        ("render::motion", "render::integrator"),
+        ("render::sampler::adaptive", "render"),
+    ] {
+        let problems = render_order_problems(&refs(&[(from, to)]));
+        assert_eq!(problems.len(), 1, "{from} -> {to}: {problems:?}");
+    }
+    // The integrator past the facade.
+    let past = refs(&[("render::integrator", "render::geometry::motion")]);
+    assert_eq!(sealing_problems(&past).len(), 1);
+    // Two modules of a folder round a loop, though no two files import each other.
+    let circle = refs(&[
+        ("render::motion", "render::sampler::pattern"),
+        ("render::sampler::first_pass", "render::motion"),
+    ]);
+    assert_eq!(
+        module_circles(&circle).len(),
+        1,
+        "{:?}",
+        module_circles(&circle)
     );
 }
 
