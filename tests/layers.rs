@@ -281,6 +281,10 @@ fn imports_run_down_the_layers() {
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
 
+/// Module path → the module files it refers to (test files and tests beside the code left
+/// out).
+type Refs = BTreeMap<Vec<String>, BTreeSet<Vec<String>>>;
+
 /// Within a module, no two files import each other, directly or round a loop. A folder's
 /// `mod.rs` is the folder's face (it declares and re-exports its files), so references
 /// between it and its own files are not counted.
@@ -292,61 +296,22 @@ fn no_import_circles_between_files() {
 }
 
 fn no_circles_in(krate: &Crate) {
-    let mut edges: BTreeMap<Vec<String>, BTreeSet<Vec<String>>> = BTreeMap::new();
-    for module in krate.files.keys() {
-        if krate.is_test_file(module) {
-            continue;
-        }
-        let targets = krate
-            .references(module)
-            .into_iter()
-            .filter(|t| !krate.is_test_file(t))
-            .filter(|t| !(t.len() < module.len() && module.starts_with(t)))
-            .filter(|t| !(module.len() < t.len() && t.starts_with(module)))
-            .collect();
-        edges.insert(module.clone(), targets);
-    }
-    // Depth-first search for a back edge.
-    fn visit(
-        node: &Vec<String>,
-        edges: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>,
-        state: &mut BTreeMap<Vec<String>, u8>,
-        stack: &mut Vec<Vec<String>>,
-        circles: &mut Vec<String>,
-    ) {
-        state.insert(node.clone(), 1);
-        stack.push(node.clone());
-        for next in edges.get(node).into_iter().flatten() {
-            match state.get(next).copied().unwrap_or(0) {
-                0 => visit(next, edges, state, stack, circles),
-                1 => {
-                    let start = stack.iter().position(|n| n == next).unwrap();
-                    let names: Vec<String> = stack[start..].iter().map(|n| n.join("::")).collect();
-                    circles.push(format!("{} -> {}", names.join(" -> "), next.join("::")));
-                }
-                _ => {}
-            }
-        }
-        stack.pop();
-        state.insert(node.clone(), 2);
-    }
-    let mut state = BTreeMap::new();
-    let mut circles = Vec::new();
-    for node in edges.keys() {
-        if !state.contains_key(node) {
-            visit(node, &edges, &mut state, &mut Vec::new(), &mut circles);
-        }
-    }
+    let edges: Refs = krate
+        .refs()
+        .into_iter()
+        .map(|(module, targets)| {
+            let related = |t: &Vec<String>| t.starts_with(&module) || module.starts_with(t);
+            let others = targets.into_iter().filter(|t| !related(t)).collect();
+            (module, others)
+        })
+        .collect();
+    let circles = find_circles(&edges);
     assert!(
         circles.is_empty(),
         "import circles:\n{}",
         circles.join("\n")
     );
 }
-
-/// Module path → the module files it refers to (test files and tests beside the code left
-/// out).
-type Refs = BTreeMap<Vec<String>, BTreeSet<Vec<String>>>;
 
 impl Crate {
     fn refs(&self) -> Refs {
@@ -448,7 +413,7 @@ fn module_circles(refs: &Refs) -> Vec<String> {
         .collect();
     let mut circles = Vec::new();
     for folder in &folders {
-        let mut edges: BTreeMap<Vec<String>, BTreeSet<Vec<String>>> = BTreeMap::new();
+        let mut edges = Refs::new();
         for (module, targets) in refs {
             let Some(from) = child(folder, module) else {
                 continue;
@@ -465,10 +430,10 @@ fn module_circles(refs: &Refs) -> Vec<String> {
 }
 
 /// The circles of a directed graph, each as `a -> b -> … -> a`.
-fn find_circles(edges: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>) -> Vec<String> {
+fn find_circles(edges: &Refs) -> Vec<String> {
     fn visit(
         node: &Vec<String>,
-        edges: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>,
+        edges: &Refs,
         state: &mut BTreeMap<Vec<String>, u8>,
         stack: &mut Vec<Vec<String>>,
         circles: &mut Vec<String>,

@@ -80,14 +80,7 @@ fn lit_scene(
             .collect::<Vec<_>>()
             .into(),
         transforms,
-        lights: lights
-            .iter()
-            .map(|&position| anim_core::scene::Light {
-                name: "l".into(),
-                position,
-                intensity: Vec3::ONE,
-            })
-            .collect(),
+        lights: white_lights(lights),
         ..Scene::default()
     };
     (scene, prims)

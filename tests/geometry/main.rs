@@ -117,6 +117,18 @@ impl Compiled {
     }
 }
 
+/// White point lights of intensity 1 at `positions`.
+fn white_lights(positions: &[DVec3]) -> Vec<anim_core::scene::Light> {
+    positions
+        .iter()
+        .map(|&position| anim_core::scene::Light {
+            name: "l".into(),
+            position,
+            intensity: Vec3::ONE,
+        })
+        .collect()
+}
+
 /// A view from `camera` of a `width`×`height` image, as a render traces it (with more camera
 /// rays than any scene has shapes, so that every lookup the plan allows is built).
 fn viewpoint(camera: &Camera, (width, height): (u32, u32), motion: bool) -> Viewpoint {

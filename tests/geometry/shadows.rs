@@ -116,14 +116,7 @@ fn glass_scene(
         materials,
         instances: instances.into(),
         transforms,
-        lights: lights
-            .iter()
-            .map(|&position| anim_core::scene::Light {
-                name: "l".into(),
-                position,
-                intensity: Vec3::ONE,
-            })
-            .collect(),
+        lights: white_lights(lights),
         ..Scene::default()
     };
     (scene, prims)

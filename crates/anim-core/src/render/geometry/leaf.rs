@@ -214,25 +214,17 @@ impl Aggregate {
     #[inline(always)]
     pub(super) fn closest_in_four(
         &self,
-        ray: LaneRay,
+        at: LaneRay,
         group: Four<impl Fn(usize) -> usize, impl FnOnce() -> [Vec4; LANES]>,
         limit: f32,
         mut t_max: f32,
         kept: Kept,
         scratch: &mut MovingScratch,
     ) -> f32 {
-        let LaneRay {
-            ray,
-            spheres: lanes,
-        } = ray;
-        let Four {
-            id,
-            lanes: c,
-            spheres: four_spheres,
-        } = group;
+        let (ray, c, id) = (at.ray, &group.lanes, &group.id);
         let Kept { best, won } = kept;
         let (sphere_hit, sphere_t) = if c.spheres != 0 {
-            lanes.hit4(four_spheres(), limit)
+            at.spheres.hit4((group.spheres)(), limit)
         } else {
             (0, Vec4::ZERO)
         };
@@ -340,33 +332,28 @@ impl Aggregate {
     #[inline(always)]
     pub(super) fn any_in_four(
         &self,
-        ray: LaneRay,
+        at: LaneRay,
         t_max: f32,
         group: Four<impl Fn(usize) -> usize, impl FnOnce() -> [Vec4; LANES]>,
         stop: &mut impl FnMut(u32) -> bool,
         scratch: &mut MovingScratch,
     ) -> bool {
-        let LaneRay {
-            ray,
-            spheres: lanes,
-        } = ray;
-        let Four {
-            id,
-            lanes: c,
-            spheres: four_spheres,
-        } = group;
-        if offer(&id, c.boxes_hit, stop) {
+        let (c, id) = (&group.lanes, &group.id);
+        if offer(id, c.boxes_hit, stop) {
             return true;
         }
-        if c.spheres != 0 && offer(&id, lanes.hit4(four_spheres(), t_max).0 & c.spheres, stop) {
-            return true;
+        if c.spheres != 0 {
+            let hit = at.spheres.hit4((group.spheres)(), t_max).0;
+            if offer(id, hit & c.spheres, stop) {
+                return true;
+            }
         }
         let mut near = c.others_near;
         while near != 0 {
             let k = near.trailing_zeros() as usize;
             near &= near - 1;
             if self
-                .other_hit(id(k), ray, t_max, scratch)
+                .other_hit(id(k), at.ray, t_max, scratch)
                 .is_some_and(&mut *stop)
             {
                 return true;
