@@ -7,13 +7,16 @@
 //!           ──sampler──▶ camera ray (camera, motion) ──integrator──▶ radiance ──▶ film
 //! ```
 //!
-//! [`compile`] builds the three parts of a [`compile::RenderScene`] and holds the one query
-//! surface the integrator asks (closest hit, occlusion, with a hint of what the ray is);
-//! [`policy`] is the table that picks which structure answers which ray; [`geometry`] holds
-//! the primitives and their hierarchy, [`view`] the candidate lists of rays from the eye and
-//! the lights, [`shading`] the materials and lights. [`sampler`] places the samples,
-//! [`camera`] and [`motion`] make their rays, [`integrator`] shades them (docs/shading.md),
-//! and [`film`] turns the radiance into image files.
+//! The modules run downhill, each importing only those below it (`tests/layers.rs` checks
+//! it): this entry (`render_job`, [`Prepared`], [`Rendered`]) → [`sampler`] (where the
+//! samples go, and what adaptive sampling asks of the motion) → [`motion`] (the exposure:
+//! the camera at an instant) and [`integrator`] (Whitted shading, docs/shading.md) →
+//! [`compile`] (the facade: the [`compile::RenderScene`] and every question a ray asks of
+//! it, with the worker's [`compile::Scratch`]) → [`view`] (candidate lists of rays from the
+//! eye and the lights) → [`geometry`] (the [`geometry::Aggregate`]: the primitives and their
+//! hierarchy) → [`policy`] (which structure answers which ray) and the leaves: [`shading`]
+//! (materials and lights), [`camera`], [`film`] (radiance to image files), the settings and
+//! the ray counts. The integrator and the samplers never name the geometry.
 
 pub mod camera;
 pub mod compile;

@@ -1,17 +1,17 @@
 //! The camera-free part of a compiled scene, the [`Aggregate`] (pbrt's and Mitsuba's name for
 //! the structure that answers rays over every primitive): every primitive placed in the
 //! world, the hierarchy over them, the instanced composites and the shapes that move. Built
-//! once from a scene description ([`Aggregate::build`]), immutable afterwards and shared
+//! once from a scene description (`Aggregate::build`), immutable afterwards and shared
 //! (`Arc`) by whatever renders that scene. Only the facade (`super::compile`) asks it rays;
 //! the integrator and the samplers never name it.
 //!
 //! It answers two questions about a ray, each in its own file: the closest hit
 //! (`closest.rs`) and whether, and what, the ray meets before a distance (`occlusion.rs`);
 //! both for every primitive (walking the hierarchy, or one flat leaf in a small scene) or for
-//! a list of candidates a [`super::view::View`] looked up ([`Candidates`]). `packet.rs` asks
+//! a list of candidates a [`super::view::View`] looked up (`Candidates`). `packet.rs` asks
 //! the closest hit for several coherent rays at once. A leaf's primitives are tested four at
 //! a time (`leaf.rs`). Instanced composites (`instancing.rs`) and moving shapes (`motion.rs`)
-//! are primitives of the table like the others: a [`Kind`] says which, and each answers the
+//! are primitives of the table like the others: a `Kind` says which, and each answers the
 //! same two questions.
 
 mod closest;

@@ -8,8 +8,10 @@
 //! `crate::sdf::parse::motion` (the `motion` lines), `crate::scene::motion` (what moves in a
 //! scene) with `crate::scene::build::motion` (made from the lines),
 //! `crate::render::geometry::motion` (moving shapes as primitives), `crate::render::motion`
-//! (the exposure, as the samplers see it), and the animation pipeline's `keyframe::motion`
-//! (the lines a spec with a `shutter` writes).
+//! (the exposure: the camera at an instant), `crate::render::sampler::motion` (what adaptive
+//! sampling asks of the motion), and the animation pipeline's `keyframe::motion` (the lines
+//! a spec with a `shutter` writes). The instants of the exposure are `crate::limits`'s
+//! (`MOTION_TIME_STEPS`, `quantized_time`).
 //!
 //! Static geometry pays nothing: its primitives and their tests are those of a frame without
 //! motion. A moving shape is placed by `Motion::slot_matrix` at the ray's time, a function of
@@ -136,7 +138,7 @@ impl MovingScratch {
     }
 }
 
-/// What the moving shapes do to a shadow ray, at its instant ([`Moving::blocks`]).
+/// What the moving shapes do to a shadow ray, at its instant (`Moving::blocks`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MovingShadow {
     /// No moving shape meets it before its end (or nothing moves).

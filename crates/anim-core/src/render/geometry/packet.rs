@@ -13,8 +13,8 @@ use crate::math::Ray;
 use crate::shape::{BoxRay, SphereRay};
 
 impl Aggregate {
-    /// [`Aggregate::closest`] of each ray among every primitive, all up to `t_max`. Rays
-    /// whose directions do not share an octant are traced one by one.
+    /// The closest hit (as `Aggregate::closest` finds it) of each ray among every primitive,
+    /// all up to `t_max`. Rays whose directions do not share an octant are traced one by one.
     pub fn closest_packet<const N: usize>(
         &self,
         rays: &[Ray; N],
