@@ -1,14 +1,17 @@
 #!/usr/bin/env python3
 """Drives the page of a running `anim preview` in headless Chromium (Playwright), as an
 animator would: waits for the frames, reads the pixels on screen, scrubs, edits the spec on
-disk, breaks it, fixes it. tests/preview/browser.rs runs it and compares the pixels with
-`anim render`'s.
+disk, breaks it, fixes it, edits a file the base scene includes. tests/preview/browser.rs
+runs it and compares the pixels with `anim render`'s.
 
     preview-browser.py --url http://127.0.0.1:PORT/ --spec SPEC --edited FILE --broken FILE
                        --frames N --out DIR [--chromium /usr/bin/chromium]
+                       [--included FILE --included-edited FILE]
 
 Writes into DIR: first.ppm, last.ppm (frames 0 and N-1 at full quality), edited.ppm (frame
-0 after the edit), screenshot.png, and result.json (what was seen, with timings).
+0 after the edit), included.ppm (frame 0 after the included file was replaced by
+--included-edited, once it shows within 5 s), screenshot.png, and result.json (what was seen,
+with timings).
 
     preview-browser.py --url URL --frames N --screenshot OUT.png [--at FRAME]
 
@@ -75,12 +78,26 @@ def screenshot(a):
     return 0
 
 
+def edit_included(page, a, result):
+    """Replaces the included file and waits (5 s at most) for frame 0 to change on screen."""
+    scrub(page, 0)
+    before = shown(page, 0, "full")
+    edited_at = time.monotonic()
+    a.included.write_text(a.included_edited.read_text())
+    shown(page, 0, version_not=before["version"], timeout=5000)
+    result["included_edit_to_screen_s"] = time.monotonic() - edited_at
+    shown(page, 0, "full")
+    write_ppm(a.out / "included.ppm", page.eval_on_selector("#frame", READ_PIXELS))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--url", required=True)
     ap.add_argument("--spec", type=pathlib.Path)
     ap.add_argument("--edited", type=pathlib.Path)
     ap.add_argument("--broken", type=pathlib.Path)
+    ap.add_argument("--included", type=pathlib.Path)
+    ap.add_argument("--included-edited", type=pathlib.Path)
     ap.add_argument("--frames", required=True, type=int)
     ap.add_argument("--out", type=pathlib.Path)
     ap.add_argument("--chromium", default="/usr/bin/chromium")
@@ -140,6 +157,9 @@ def main():
         a.spec.write_text(a.edited.read_text())
         page.wait_for_selector("#diagnostics", state="hidden", timeout=10000)
         result["fixed"] = True
+
+        if a.included:
+            edit_included(page, a, result)
 
         page.click("#export")
         page.wait_for_function(

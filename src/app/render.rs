@@ -96,15 +96,7 @@ fn render_dir(dir: &Path, config: &RenderConfig) -> bool {
 fn print_summary(dir: &Path, s: &Summary, quiet: bool) {
     if !quiet {
         for (d, count) in &s.warnings {
-            if *count > 1 {
-                eprintln!(
-                    "{d}\n  (and in {} other frame{})",
-                    count - 1,
-                    plural(count - 1)
-                );
-            } else {
-                eprintln!("{d}");
-            }
+            eprintln!("{}", in_frames(&d.to_string(), *count));
         }
     }
     if !s.failed.is_empty() {
@@ -153,4 +145,18 @@ fn print_summary(dir: &Path, s: &Summary, quiet: bool) {
         s.failed.len(),
         secs
     );
+}
+
+/// A warning that `count` frames of a run had, as the run's summary shows it (the preview's
+/// page too): the first frame's, and how many others had it.
+pub(super) fn in_frames(warning: &str, count: usize) -> String {
+    if count > 1 {
+        let others = count - 1;
+        format!(
+            "{warning}\n  (and in {others} other frame{})",
+            plural(others)
+        )
+    } else {
+        warning.to_string()
+    }
 }

@@ -11,6 +11,8 @@
 //! - `bench`: `anim bench` at its tiny size, and the files it writes.
 //! - `animator`: aim, orientation keys, the inclusive end, curves kept in range, materials,
 //!   visibility, reuse, the early check of the base scene, and the example specs' frames.
+//! - `service`: the one way from a scene file to images in memory, which `anim render` and
+//!   `anim preview` share, and the files a frame's fingerprint follows.
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -20,4 +22,5 @@ mod bench;
 mod frames;
 mod holds;
 mod keyframe_spec;
+mod service;
 mod split;

@@ -1,10 +1,15 @@
 //! The page in a real browser: headless Chromium driven by `scripts/preview-browser.py`
 //! (Playwright). It waits for the frames, reads the pixels on screen, scrubs, edits the spec,
-//! breaks and fixes it; this test checks what it saw. Where Chromium or Playwright is
+//! breaks and fixes it, edits the materials file the base scene includes; this test checks
+//! what it saw. Where Chromium or Playwright is
 //! missing the test says so and passes, unless `CI` is set: CI installs both (`.ci/run`).
 
 use crate::common::read_ppm;
-use crate::session::{rendered_by_anim_render, spec, Preview, EDITED_KEY, FIRST_KEY, FRAMES};
+use crate::common::Rgb8;
+use crate::session::{
+    materials, red_floor, rendered_by_anim_render, spec, Preview, EDITED_KEY, FIRST_KEY, FRAMES,
+    MATERIALS,
+};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -35,6 +40,36 @@ fn same_pixels(shown: &Path, expected: &image::RgbImage) -> bool {
         && shown.data == expected.as_raw().as_slice()
 }
 
+/// The floor, grey before, is red on screen once the materials file the base scene includes
+/// says so (the script waits at most 5 s for the change to show): frame 0 as `anim render`
+/// draws it then (`expected`).
+fn the_included_edit_shows(dir: &Path, expected: &image::RgbImage) {
+    assert!(
+        same_pixels(&dir.join("included.ppm"), expected),
+        "frame 0 after the edit of {MATERIALS}"
+    );
+    let (grey, reddened) = (
+        read_ppm(&dir.join("edited.ppm")),
+        read_ppm(&dir.join("included.ppm")),
+    );
+    let pixels = reddened.width * reddened.height;
+    assert!(
+        red_pixels(&reddened) > red_pixels(&grey) + pixels / 10,
+        "{} red pixels before the edit of {MATERIALS}, {} after, of {pixels}",
+        red_pixels(&grey),
+        red_pixels(&reddened)
+    );
+}
+
+/// The pixels of `image` whose red is over twice their green and their blue.
+fn red_pixels(image: &Rgb8) -> usize {
+    image
+        .data
+        .chunks_exact(3)
+        .filter(|p| u32::from(p[0]) > 2 * u32::from(p[1]).max(u32::from(p[2])))
+        .count()
+}
+
 #[test]
 fn the_page_plays_scrubs_and_follows_edits_in_chromium() {
     if let Some(why) = missing() {
@@ -50,13 +85,17 @@ fn the_page_plays_scrubs_and_follows_edits_in_chromium() {
         return;
     }
     let preview = Preview::start();
-    let before = rendered_by_anim_render(&spec(FIRST_KEY));
-    let after = rendered_by_anim_render(&spec(EDITED_KEY));
+    let before = rendered_by_anim_render(&spec(FIRST_KEY), &materials());
+    let after = rendered_by_anim_render(&spec(EDITED_KEY), &materials());
+    let red = red_floor(&materials());
+    let red_after = rendered_by_anim_render(&spec(EDITED_KEY), &red);
     let out = tempfile::tempdir().unwrap();
     let edited = out.path().join("edited.ron");
     let broken = out.path().join("broken.ron");
+    let red_materials = out.path().join("red.sdf");
     std::fs::write(&edited, spec(EDITED_KEY)).unwrap();
     std::fs::write(&broken, spec("(0, 1.5,, 0)")).unwrap();
+    std::fs::write(&red_materials, &red).unwrap();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/preview-browser.py");
     let run = Command::new("python3")
         .arg(script)
@@ -67,6 +106,10 @@ fn the_page_plays_scrubs_and_follows_edits_in_chromium() {
         .arg(&edited)
         .arg("--broken")
         .arg(&broken)
+        .arg("--included")
+        .arg(preview.dir.path().join(MATERIALS))
+        .arg("--included-edited")
+        .arg(&red_materials)
         .args(["--frames", &FRAMES.to_string()])
         .arg("--out")
         .arg(out.path())
@@ -93,6 +136,7 @@ fn the_page_plays_scrubs_and_follows_edits_in_chromium() {
         same_pixels(&dir.join("edited.ppm"), &after[0]),
         "frame 0 after the edit"
     );
+    the_included_edit_shows(dir, &red_after[0]);
     let result = std::fs::read_to_string(dir.join("result.json")).unwrap();
     assert!(result.contains("frame 2 / 5 · 0.25 s"), "{result}");
     assert!(result.contains("\"key_marks\": 2"), "{result}");
@@ -105,6 +149,7 @@ fn the_page_plays_scrubs_and_follows_edits_in_chromium() {
         "{result}"
     );
     assert!(result.contains("\"frame_kept\": true"), "{result}");
+    assert!(result.contains("\"included_edit_to_screen_s\""), "{result}");
     // Every climbing URL the browser sent was refused with a 4xx.
     assert!(result.contains("\"all_refused\": true"), "{result}");
     // Export encodes with ffmpeg where it is installed, and says how to install it where not.

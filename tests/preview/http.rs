@@ -2,9 +2,10 @@
 //! are the pixels `anim render` writes, before and after an edit.
 
 use crate::session::{
-    all_full, per_frame, rendered_by_anim_render, request, request_with, spec, Preview, EDITED_KEY,
-    FIRST_KEY, FRAMES,
+    all_full, materials, per_frame, red_floor, rendered_by_anim_render, request, request_with,
+    small_showcase, spec, Preview, EDITED_KEY, FIRST_KEY, FRAMES, MATERIALS,
 };
+use std::process::Command;
 use std::time::Duration;
 
 #[test]
@@ -76,7 +77,7 @@ fn refuses_what_is_not_its_own() {
 #[test]
 fn serves_the_frames_anim_render_draws_and_follows_an_edit() {
     let mut preview = Preview::start();
-    let before = rendered_by_anim_render(&spec(FIRST_KEY));
+    let before = rendered_by_anim_render(&spec(FIRST_KEY), &materials());
     let state = preview.wait_for(Duration::from_secs(60), all_full);
     assert_eq!(per_frame(&state, "renders"), vec!["2"; FRAMES]);
     for (i, expected) in before.iter().enumerate() {
@@ -86,7 +87,7 @@ fn serves_the_frames_anim_render_draws_and_follows_an_edit() {
         assert!(shown == *expected, "frame {i} differs from anim render's");
     }
     std::fs::write(preview.spec_path(), spec(EDITED_KEY)).unwrap();
-    let after = rendered_by_anim_render(&spec(EDITED_KEY));
+    let after = rendered_by_anim_render(&spec(EDITED_KEY), &materials());
     let state = preview.wait_for(Duration::from_secs(60), |s| {
         all_full(s) && per_frame(s, "renders")[0] == "4"
     });
@@ -139,4 +140,141 @@ fn a_scene_file_is_one_frame_and_its_errors_are_located() {
         png,
         "the last good frame stays"
     );
+}
+
+#[test]
+fn an_edit_of_a_file_the_base_scene_includes_renders_the_frames_again() {
+    let preview = Preview::start();
+    let grey = rendered_by_anim_render(&spec(FIRST_KEY), &materials());
+    preview.wait_for(Duration::from_secs(60), all_full);
+    // The floor shows in every frame, so every frame changes.
+    let red = red_floor(&materials());
+    let reddened = rendered_by_anim_render(&spec(FIRST_KEY), &red);
+    for (i, (g, r)) in grey.iter().zip(&reddened).enumerate() {
+        assert_ne!(g, r, "frame {i} shows no floor");
+    }
+    let shows = |expected: &[image::RgbImage], renders: &str, edit: &str| {
+        let state = preview.wait_for(Duration::from_secs(60), |s| {
+            all_full(s) && per_frame(s, "renders").iter().all(|r| r == renders)
+        });
+        assert!(state.contains("\"diagnostics\":[]"), "{edit}: {state}");
+        for (i, expected) in expected.iter().enumerate() {
+            let png = preview.get(&format!("/frame/{i}.png")).1;
+            let shown = image::load_from_memory(&png).unwrap().to_rgb8();
+            assert!(shown == *expected, "frame {i} after {edit} differs");
+        }
+    };
+    let dir = preview.dir.path();
+    std::fs::write(dir.join(MATERIALS), &red).unwrap();
+    shows(&reddened, "4", "the edit of the included file");
+    // The floor moves to a file that the included file includes: the same statements.
+    let all = materials();
+    let (floor, others): (Vec<&str>, Vec<&str>) = all
+        .lines()
+        .partition(|l| l.starts_with("define material floor "));
+    std::fs::write(dir.join("floor.sdf"), format!("{}\n", floor[0])).unwrap();
+    let nested = format!("include floor.sdf\n{}\n", others.join("\n"));
+    std::fs::write(dir.join(MATERIALS), nested).unwrap();
+    shows(&grey, "6", "the floor's move to floor.sdf");
+    std::fs::write(dir.join("floor.sdf"), red_floor(floor[0])).unwrap();
+    shows(
+        &reddened,
+        "8",
+        "the edit of the file the included file includes",
+    );
+}
+
+#[test]
+fn an_edit_of_a_mesh_renders_the_frames_that_draw_it_again() {
+    let triangle = |top: f64| format!("v -1 0 0\nv 1 0 0\nv 0 {top} 0\nf 1 2 3\n");
+    let preview = Preview::start_with(&[
+        ("tri.obj", triangle(1.5)),
+        (
+            "base.sdf",
+            "define material m 0.2 0.2 0.2 0.8 0.3 0.3 0 0 0 1\n\
+             define shape obj tri tri.obj m\n\
+             define light l 0 0 5 1 1 1 1\n\
+             define camera cam 60 0 0.5 4 0 0 -1 0 1 0\n"
+                .to_string(),
+        ),
+        (
+            "spec.ron",
+            r#"(scene: File("base.sdf"), camera: "cam", fps: 4, length: Frames(2),
+                resolution: (32, 24), output: "frame_{frame}.png",
+                tracks: [(target: "tri", translate: [(at: 0, value: (0, 0, 0)),
+                                                     (at: 0.25, value: (0.5, 0, 0))])])"#
+                .to_string(),
+        ),
+    ]);
+    let renders = |s: &str| per_frame(s, "renders");
+    let full = |s: &str| per_frame(s, "state") == ["full", "full"];
+    let state = preview.wait_for(Duration::from_secs(60), |s| full(s));
+    assert_eq!(renders(&state), ["2", "2"], "{state}");
+    let before = preview.get("/frame/0.png").1;
+    std::fs::write(preview.dir.path().join("tri.obj"), triangle(0.75)).unwrap();
+    let state = preview.wait_for(Duration::from_secs(60), |s| {
+        full(s) && renders(s) == ["4", "4"]
+    });
+    assert!(state.contains("\"diagnostics\":[]"), "{state}");
+    assert_ne!(preview.get("/frame/0.png").1, before);
+}
+
+/// The showcase, small, with a sphere scaled below what a float holds (`anim render` says it
+/// is not drawn) in its root.
+fn with_a_lost_sphere() -> String {
+    let root = "define shape composite root ground board lens ball pillar crate ring";
+    let scene = small_showcase();
+    assert!(scene.contains(root));
+    let tiny = format!(
+        "define shape sphere tiny 0 0 0 1 red\n{}{root} tiny",
+        "transform tiny scale 1e-8\n".repeat(6)
+    );
+    scene.replace(root, &tiny)
+}
+
+/// The warnings `anim render` prints for scene file `text`, as it prints them.
+fn warnings_of_anim_render(text: &str) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("scene.sdf"), text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_anim"))
+        .args(["render", "scene.sdf"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(out.status.success(), "{stderr}");
+    // The warnings come first, then what was written and the totals.
+    let warnings = stderr.split("\nwrote ").next().unwrap();
+    warnings.to_string() + "\n"
+}
+
+#[test]
+fn the_preview_shows_the_warnings_anim_render_prints() {
+    let scene = with_a_lost_sphere();
+    let printed = warnings_of_anim_render(&scene);
+    assert!(
+        printed.contains("warning: shape 'root/tiny' is degenerate once transformed"),
+        "{printed}"
+    );
+    // The state is JSON: lines joined by `\n`, and nothing else in them to escape.
+    assert!(!printed.contains(['"', '\\', '<', '>', '&']), "{printed}");
+    let in_state = printed.trim_end().replace('\n', "\\n");
+    let preview = Preview::start_scene_of(&scene);
+    let state = preview.wait_for(Duration::from_secs(60), |s| {
+        per_frame(s, "state") == ["full"] && s.contains("is degenerate")
+    });
+    assert!(state.contains(&in_state), "{state}\n---\n{printed}");
+    // The terminal hears of it too, once.
+    let start = std::time::Instant::now();
+    while !preview.terminal().contains(&printed) && start.elapsed() < Duration::from_secs(10) {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let terminal = preview.terminal();
+    assert_eq!(terminal.matches(&printed).count(), 1, "{terminal}");
+    // The warning goes with the shape.
+    std::fs::write(preview.dir.path().join("scene.sdf"), small_showcase()).unwrap();
+    let state = preview.wait_for(Duration::from_secs(60), |s| {
+        per_frame(s, "state") == ["full"] && !s.contains("is degenerate")
+    });
+    assert!(state.contains("\"warnings\":[]"), "{state}");
 }

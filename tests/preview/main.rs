@@ -1,12 +1,13 @@
 //! The preview contract: `anim preview` serves the animation in a browser, the small frames
-//! first and then each frame as `anim render` draws it, follows edits by rendering only the
-//! frames whose content changed, shows located diagnostics, and serves nothing but its own
-//! routes to nothing but its own address.
+//! first and then each frame as `anim render` draws it, follows edits (of the spec, the base
+//! scene, the files it includes and its meshes) by rendering only the frames whose content
+//! changed, shows located diagnostics and the warnings `anim render` prints, and serves
+//! nothing but its own routes to nothing but its own address.
 //!
-//! - `session`: starting the real binary on a small copy of `animations/orbit.ron`, and plain
-//!   HTTP requests to it.
-//! - `http`: the routes, refusals (traversal, encoded traversal, foreign `Host`) and pixels,
-//!   through plain HTTP requests.
+//! - `session`: starting the real binary on a small copy of `animations/orbit.ron` (its base
+//!   scene including its materials file), and plain HTTP requests to it.
+//! - `http`: the routes, refusals (traversal, encoded traversal, foreign `Host`), pixels, edits
+//!   and warnings, through plain HTTP requests.
 //! - `browser`: the page in headless Chromium, driven by `scripts/preview-browser.py`.
 
 #[path = "../common/mod.rs"]

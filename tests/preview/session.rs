@@ -1,10 +1,12 @@
 //! One running `anim preview`, on a small copy of `animations/orbit.ron` in a temporary
-//! folder, stopped with Ctrl-C (SIGINT) when dropped; and plain HTTP/1.1 over a socket.
+//! folder (its base scene including its materials from a file of their own), stopped with
+//! Ctrl-C (SIGINT) when dropped; and plain HTTP/1.1 over a socket.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// The test animation: the orbit, small and short, with one keyed track whose first key
@@ -33,6 +35,38 @@ pub fn showcase() -> String {
     std::fs::read_to_string(root.join("animations/showcase.sdf")).unwrap()
 }
 
+/// The file the test animation's base scene includes its materials from.
+pub const MATERIALS: &str = "materials.sdf";
+
+/// The showcase's material lines, the test animation's `materials.sdf`.
+pub fn materials() -> String {
+    showcase_lines(true)
+}
+
+/// The showcase with its materials taken from `materials.sdf`, the test animation's base scene.
+fn base_scene() -> String {
+    format!("include {MATERIALS}\n{}", showcase_lines(false))
+}
+
+/// The lines of the showcase that define materials, or the others.
+fn showcase_lines(materials: bool) -> String {
+    let text = showcase();
+    let lines = text
+        .lines()
+        .filter(|l| l.starts_with("define material ") == materials);
+    lines.map(|l| format!("{l}\n")).collect()
+}
+
+/// `materials` with the floor of the showcase red instead of grey.
+pub fn red_floor(materials: &str) -> String {
+    let grey = "define material floor  0.12 0.12 0.11  0.55 0.52 0.48  0.1 0.1 0.1   8";
+    assert!(materials.contains(grey));
+    materials.replace(
+        grey,
+        "define material floor  0.15 0.02 0.02  0.8 0.1 0.1  0.1 0.1 0.1   8",
+    )
+}
+
 pub const FIRST_KEY: &str = "(0, 0, 0)";
 pub const EDITED_KEY: &str = "(0, 1.5, 0)";
 pub const FRAMES: usize = 6;
@@ -41,23 +75,38 @@ pub struct Preview {
     pub dir: tempfile::TempDir,
     pub port: u16,
     child: Child,
+    /// What it has printed on stderr so far.
+    terminal: Arc<Mutex<String>>,
 }
 
 impl Preview {
     /// Starts `anim preview` on the test animation; returns once it prints its address.
     pub fn start() -> Preview {
         let dir = tempfile::tempdir().unwrap();
-        std::fs::write(dir.path().join("showcase.sdf"), showcase()).unwrap();
+        std::fs::write(dir.path().join("showcase.sdf"), base_scene()).unwrap();
+        std::fs::write(dir.path().join(MATERIALS), materials()).unwrap();
         std::fs::write(dir.path().join("small.ron"), spec(FIRST_KEY)).unwrap();
         Preview::launch(dir, "small.ron")
     }
 
     /// Starts `anim preview` on one scene file, `scene.sdf`: the showcase, small.
     pub fn start_scene() -> Preview {
+        Preview::start_scene_of(&small_showcase())
+    }
+
+    /// Starts `anim preview` on one scene file, `scene.sdf`, holding `scene`.
+    pub fn start_scene_of(scene: &str) -> Preview {
+        Preview::start_with(&[("scene.sdf", scene.to_string())])
+    }
+
+    /// Starts `anim preview` on the last of `files` (name, text), written first.
+    pub fn start_with(files: &[(&str, String)]) -> Preview {
         let dir = tempfile::tempdir().unwrap();
-        let scene = showcase().replace("render cam showcase.png 640 360", "render cam s.png 96 54");
-        std::fs::write(dir.path().join("scene.sdf"), scene).unwrap();
-        Preview::launch(dir, "scene.sdf")
+        for (name, text) in files {
+            std::fs::write(dir.path().join(name), text).unwrap();
+        }
+        let input = files.last().unwrap().0;
+        Preview::launch(dir, input)
     }
 
     fn launch(dir: tempfile::TempDir, input: &str) -> Preview {
@@ -73,14 +122,33 @@ impl Preview {
             .unwrap();
         let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
         let first = lines.next().unwrap().unwrap();
-        // The rest of stderr is drained so the preview never blocks writing it.
-        std::thread::spawn(move || for _ in lines {});
+        // The rest of stderr is kept, and read as it comes so the preview never blocks
+        // writing it.
+        let terminal = Arc::new(Mutex::new(String::new()));
+        let kept = terminal.clone();
+        std::thread::spawn(move || {
+            for line in lines.map_while(Result::ok) {
+                let mut kept = kept.lock().unwrap();
+                kept.push_str(&line);
+                kept.push('\n');
+            }
+        });
         let port = first
             .rsplit("http://127.0.0.1:")
             .next()
             .and_then(|p| p.trim_end_matches('/').parse().ok())
             .unwrap_or_else(|| panic!("no address in {first:?}"));
-        Preview { dir, port, child }
+        Preview {
+            dir,
+            port,
+            child,
+            terminal,
+        }
+    }
+
+    /// What the preview has printed on stderr after its address.
+    pub fn terminal(&self) -> String {
+        self.terminal.lock().unwrap().clone()
     }
 
     /// The entries of the preview's `TMPDIR`: its temporary folder while it runs.
@@ -194,10 +262,17 @@ pub fn request_with(port: u16, method: &str, path: &str, headers: &str) -> (u16,
     (status, answer[head_end + 4..].to_vec())
 }
 
-/// The frames `anim render` writes for the test animation as `spec_text` says, decoded.
-pub fn rendered_by_anim_render(spec_text: &str) -> Vec<image::RgbImage> {
+/// The showcase as one scene file, small.
+pub fn small_showcase() -> String {
+    showcase().replace("render cam showcase.png 640 360", "render cam s.png 96 54")
+}
+
+/// The frames `anim render` writes for the test animation as `spec_text` and the materials
+/// file `materials_text` say, decoded.
+pub fn rendered_by_anim_render(spec_text: &str, materials_text: &str) -> Vec<image::RgbImage> {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("showcase.sdf"), showcase()).unwrap();
+    std::fs::write(dir.path().join("showcase.sdf"), base_scene()).unwrap();
+    std::fs::write(dir.path().join(MATERIALS), materials_text).unwrap();
     std::fs::write(dir.path().join("small.ron"), spec_text).unwrap();
     let anim = env!("CARGO_BIN_EXE_anim");
     let frames = dir.path().join("frames");

@@ -53,6 +53,7 @@ pub fn run(config: &PreviewConfig, pool: &ThreadPool) -> ExitCode {
         input: config.input.clone(),
         frames_dir: temp.path().join("frames"),
         load: config.load.clone(),
+        settings: config.settings.clone(),
     };
     if project.is_spec() {
         // The frames in the temporary folder name the base scene's meshes, which were

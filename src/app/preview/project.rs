@@ -1,13 +1,12 @@
 //! What is previewed: a keyframe spec turned into frame files by the pipeline's own
 //! `run_generate` (into the preview's temporary folder), or one scene file; with the files an
-//! edit of which changes the picture, and a fingerprint of each frame's content.
+//! edit of which changes the picture (the pipeline's `referenced_files`), and each frame's
+//! fingerprint (the pipeline's `frame_hash`, which `anim render DIR`'s records hold).
 
 use anim_core::diag::Diagnostic;
-use anim_core::scene::Geometry;
-use anim_core::sdf::ast::StatementKind;
+use anim_core::render::RenderSettings;
 use anim_core::sdf::LoadOptions;
-use anim_core::util::Fnv64;
-use anim_pipeline::frames::list_frames;
+use anim_pipeline::frames::{frame_hash, list_frames, referenced_files, settings_fingerprint};
 use anim_pipeline::keyframe::spec::{self, SceneSource, Source, SpecFile};
 use anim_pipeline::keyframe::{run_generate, GenerateConfig};
 use std::path::{Path, PathBuf};
@@ -30,12 +29,13 @@ pub struct Built {
     pub warnings: Vec<String>,
 }
 
-/// The previewed file and where its frames are generated.
+/// The previewed file, where its frames are generated, and how they are read and drawn.
 #[derive(Clone, Debug)]
 pub struct Project {
     pub input: PathBuf,
     pub frames_dir: PathBuf,
     pub load: LoadOptions,
+    pub settings: RenderSettings,
 }
 
 impl Project {
@@ -44,8 +44,9 @@ impl Project {
         self.input.extension().is_some_and(|e| e == "ron")
     }
 
-    /// The files whose edits change the frames: the input, its base scene and their meshes.
-    /// Files that cannot be read are still listed, so that creating them is seen.
+    /// The files whose edits change the frames: the input, its base scene, the files that
+    /// includes and the meshes they name. Files that cannot be read are still listed, so that
+    /// creating them is seen.
     pub fn watched(&self) -> Vec<PathBuf> {
         let mut files = vec![self.input.clone()];
         let scene = if self.is_spec() {
@@ -54,7 +55,7 @@ impl Project {
             Some(self.input.clone())
         };
         if let Some(scene) = scene {
-            files.extend(mesh_files(&scene, &self.load));
+            files.extend(referenced_files(&scene, self.load.max_input));
             files.push(scene);
         }
         files.sort();
@@ -66,20 +67,17 @@ impl Project {
     /// as the terminal prints it.
     pub fn build(&self) -> Result<Built, Vec<String>> {
         let text = |ds: Vec<Diagnostic>| ds.iter().map(ToString::to_string).collect();
-        // Meshes change the pictures of every frame that draws them, whatever the frame text.
-        let mut deps = Fnv64::default();
-        // The spec itself is not one: the frame texts say all it means.
-        for f in self.watched().iter().filter(|f| **f != self.input) {
-            deps.write(&std::fs::read(f).unwrap_or_default());
-            deps.write(&[0]);
-        }
-        let deps = deps.finish();
+        let fingerprint = settings_fingerprint(&self.settings, &self.load);
+        // A frame's key is what `anim render DIR` records for it: the spec is not part of it,
+        // as the frame texts say all it means.
+        let key =
+            |path: &Path, bytes: &[u8]| frame_hash(bytes, path, &fingerprint, self.load.max_input);
         if !self.is_spec() {
             // Checked here, so that an error shows as the build's, with the last good frame.
             let loaded = anim_core::load::load_file(&self.input, &self.load).map_err(text)?;
             let bytes = std::fs::read(&self.input)
                 .map_err(|e| vec![format!("{}: error: {e}", self.input.display())])?;
-            let key = frame_key(&bytes, deps);
+            let key = key(&self.input, &bytes);
             return Ok(Built {
                 frames: vec![FrameSource {
                     path: self.input.clone(),
@@ -101,7 +99,7 @@ impl Project {
         let frames = paths
             .into_iter()
             .map(|path| {
-                let key = frame_key(&std::fs::read(&path).unwrap_or_default(), deps);
+                let key = key(&path, &std::fs::read(&path).unwrap_or_default());
                 FrameSource { path, key }
             })
             .collect();
@@ -115,13 +113,6 @@ impl Project {
     }
 }
 
-fn frame_key(sdf: &[u8], deps: u64) -> u64 {
-    let mut h = Fnv64::default();
-    h.write(&deps.to_le_bytes());
-    h.write(sdf);
-    h.finish()
-}
-
 fn read_spec(path: &Path) -> Option<SpecFile> {
     let src = Source::read(path, Source::MAX_BYTES).ok()?;
     spec::parse(&src).ok()
@@ -133,23 +124,4 @@ fn spec_scene(path: &Path) -> Option<PathBuf> {
         SceneSource::File(rel) => Some(path.parent().unwrap_or(Path::new("")).join(rel)),
         SceneSource::Inline(_) => None,
     }
-}
-
-/// The OBJ files a scene file reads, relative to its folder.
-fn mesh_files(scene: &Path, load: &LoadOptions) -> Vec<PathBuf> {
-    let Ok(text) = std::fs::read_to_string(scene) else {
-        return Vec::new();
-    };
-    let dir = scene.parent().unwrap_or(Path::new(""));
-    let (statements, _) = anim_core::sdf::parse(&text, scene, load);
-    statements
-        .iter()
-        .filter_map(|s| match &s.kind {
-            StatementKind::Shape {
-                geometry: Geometry::Mesh(m),
-                ..
-            } => Some(dir.join(&m.file)),
-            _ => None,
-        })
-        .collect()
 }

@@ -1,11 +1,14 @@
-//! The render workers: each takes the most wanted frame, renders it with the same library
-//! calls as `anim render` (load, then `render_job`) and hands back a PNG in memory.
+//! The render workers: each takes the most wanted frame and renders it into memory through the
+//! pipeline's one way from a scene file to an image (`frames::render_to_memory`, as `anim
+//! render` does), at the quality the preview asks for, as a PNG.
 
-use super::state::{Job, Quality, Shared};
-use anim_core::load::load_file;
-use anim_core::render::{film, render_job, RenderSettings};
+use super::state::{Drawing, Job, Quality, Shared};
+use anim_core::diag::Diagnostic;
+use anim_core::render::film::ImageFormat;
+use anim_core::render::RenderSettings;
+use anim_core::scene::RenderJob;
 use anim_core::sdf::LoadOptions;
-use image::ImageEncoder as _;
+use anim_pipeline::frames::{self, Encoded, ImageSink, NoProgress};
 use std::time::Duration;
 
 /// The small pass draws frames at this fraction of their size (each side).
@@ -29,54 +32,72 @@ pub fn worker(shared: &Shared, load: &LoadOptions, settings: &RenderSettings) {
         let result = render(&job, load, settings);
         let mut state = shared.lock();
         state.finish(&job, result);
-        shared.touch(&mut state);
+        shared.publish(state);
     }
 }
 
-/// Frame `job` as PNG bytes, or the error as the terminal shows it.
-pub fn render(job: &Job, load: &LoadOptions, settings: &RenderSettings) -> Result<Vec<u8>, String> {
-    let joined = |ds: Vec<anim_core::diag::Diagnostic>| {
+/// Frame `job` as a PNG with the warnings `anim render` gives it, or every diagnostic as the
+/// terminal shows them.
+pub fn render(job: &Job, load: &LoadOptions, settings: &RenderSettings) -> Result<Drawing, String> {
+    let joined = |ds: &[Diagnostic]| {
         ds.iter()
             .map(ToString::to_string)
             .collect::<Vec<_>>()
             .join("\n")
     };
-    let loaded = load_file(&job.path, load).map_err(joined)?;
-    let Some(scene) = loaded.jobs.first() else {
-        return Err(format!("{}: error: no render line", job.path.display()));
+    let mut draft = Draft {
+        quality: job.quality,
+        settings,
+        png: None,
     };
-    let settings = match job.quality {
-        Quality::Full => settings.clone(),
-        Quality::Small => RenderSettings {
-            width: Some(scene.width.div_ceil(SMALL_DIVISOR).max(1)),
-            height: Some(scene.height.div_ceil(SMALL_DIVISOR).max(1)),
-            spp: Some(1),
-            ..settings.clone()
-        },
-    };
-    let (width, height, _) = settings.resolve(scene);
-    let needed = anim_core::limits::image_memory(width, height);
-    if needed > settings.max_memory {
-        return Err(format!(
-            "{}: error: a {width}×{height} image needs more memory than allowed (--max-memory)",
-            job.path.display()
-        ));
+    let drawn = frames::render_to_memory(&job.path, load, &mut draft, &NoProgress)
+        .map_err(|ds| joined(&ds))?;
+    match draft.png {
+        Some(png) => Ok(Drawing {
+            png,
+            warnings: drawn.warnings,
+        }),
+        None => Err(format!("{}: error: no render line", job.path.display())),
     }
-    let rendered = render_job(scene, &settings, &|_| {})
-        .map_err(|e| format!("{}: error: camera: {e:?}", job.path.display()))?;
-    encode_png(&film::to_rgb8(&rendered.image), width, height)
 }
 
-/// PNG bytes of 8-bit RGB, encoded as the renderer's film encodes its PNG files.
-pub fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>, String> {
-    let mut out = Vec::new();
-    let encoder = image::codecs::png::PngEncoder::new_with_quality(
-        &mut out,
-        image::codecs::png::CompressionType::Fast,
-        image::codecs::png::FilterType::Adaptive,
-    );
-    encoder
-        .write_image(rgb, width, height, image::ExtendedColorType::Rgb8)
-        .map_err(|e| format!("cannot encode the image: {e}"))?;
-    Ok(out)
+/// What the preview asks of a frame's file: its first image (the page shows one per frame),
+/// as a PNG, small or as `anim render` draws it.
+struct Draft<'a> {
+    quality: Quality,
+    settings: &'a RenderSettings,
+    png: Option<Vec<u8>>,
+}
+
+impl ImageSink for Draft<'_> {
+    type Target = ();
+
+    fn settings(&self, index: usize, job: &RenderJob) -> Option<RenderSettings> {
+        if index > 0 {
+            return None;
+        }
+        Some(match self.quality {
+            Quality::Full => self.settings.clone(),
+            Quality::Small => RenderSettings {
+                width: Some(job.width.div_ceil(SMALL_DIVISOR).max(1)),
+                height: Some(job.height.div_ceil(SMALL_DIVISOR).max(1)),
+                spp: Some(1),
+                ..self.settings.clone()
+            },
+        })
+    }
+
+    fn check(
+        &mut self,
+        _job: &RenderJob,
+        _settings: &RenderSettings,
+        _warnings: &mut Vec<Diagnostic>,
+    ) -> Result<((), ImageFormat), Vec<Diagnostic>> {
+        Ok(((), ImageFormat::Png))
+    }
+
+    fn take(&mut self, _job: &RenderJob, (): (), image: Encoded) -> Result<(), Vec<Diagnostic>> {
+        self.png = Some(image.image);
+        Ok(())
+    }
 }

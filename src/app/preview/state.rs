@@ -1,8 +1,11 @@
 //! What the preview knows, shared by the server, the render workers and the watcher: each
-//! frame's source and images, the diagnostics of the last build, and where the playhead is.
-//! Images are whole PNG files in memory, swapped in only once complete.
+//! frame's source and images, the diagnostics of the last build, the warnings of the build and
+//! of the frames, and where the playhead is. Images are whole PNG files in memory, swapped in
+//! only once complete.
 
 use super::project::Built;
+use anim_core::diag::Diagnostic;
+use anim_pipeline::frames::distinct_warnings;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
@@ -22,6 +25,15 @@ pub enum Quality {
 pub struct Image {
     pub png: Arc<Vec<u8>>,
     pub key: u64,
+    /// What rendering it warned of.
+    pub warnings: Vec<Diagnostic>,
+}
+
+/// What a worker made of a frame: the PNG, and the warnings `anim render` gives the frame.
+#[derive(Clone, Debug)]
+pub struct Drawing {
+    pub png: Vec<u8>,
+    pub warnings: Vec<Diagnostic>,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -100,6 +112,8 @@ pub struct State {
     pub stop: bool,
     /// Builds applied so far (0 until the first one ends).
     pub builds: u64,
+    /// The warnings shown when the terminal last heard of them.
+    printed: Vec<String>,
 }
 
 /// The state with the two wake-ups: `changed` for the page's event streams, `work` for the
@@ -134,6 +148,17 @@ impl Shared {
         match cv.wait_timeout(guard, timeout) {
             Ok((g, _)) => g,
             Err(e) => e.into_inner().0,
+        }
+    }
+
+    /// Wakes everyone after a change made under `state` (a build or a frame taken in), and
+    /// prints the warnings it brought.
+    pub fn publish(&self, mut state: MutexGuard<'_, State>) {
+        self.touch(&mut state);
+        let news = state.new_warnings();
+        drop(state);
+        for warning in news {
+            eprintln!("{warning}");
         }
     }
 
@@ -199,7 +224,7 @@ impl State {
     }
 
     /// Stores what a worker made of `job` (dropped if the frame changed meanwhile).
-    pub fn finish(&mut self, job: &Job, result: Result<Vec<u8>, String>) {
+    pub fn finish(&mut self, job: &Job, result: Result<Drawing, String>) {
         let Some(frame) = self.frames.get_mut(job.index) else {
             return;
         };
@@ -209,10 +234,11 @@ impl State {
         }
         frame.renders += 1;
         match result {
-            Ok(png) => {
+            Ok(drawing) => {
                 let image = Some(Image {
-                    png: Arc::new(png),
+                    png: Arc::new(drawing.png),
                     key: job.key,
+                    warnings: drawing.warnings,
                 });
                 match job.quality {
                     Quality::Small => frame.small = image,
@@ -235,6 +261,38 @@ impl State {
                 .frames
                 .iter()
                 .all(|f| f.state() == "full" || f.state() == "error")
+    }
+
+    /// The warnings to show: the build's, then each warning of the frames drawn in full (what
+    /// `anim render` says of them) once, with the number of frames that had it.
+    fn shown_warnings(&self) -> Vec<(String, usize)> {
+        let mut shown: Vec<(String, usize)> =
+            self.warnings.iter().map(|w| (w.clone(), 1)).collect();
+        let drawn = self
+            .frames
+            .iter()
+            .filter_map(|f| f.full.as_ref().filter(|i| i.key == f.key))
+            .flat_map(|i| i.warnings.iter().cloned());
+        for (d, count) in distinct_warnings(drawn) {
+            let text = d.to_string();
+            if !shown.iter().any(|(w, _)| *w == text) {
+                shown.push((text, count));
+            }
+        }
+        shown
+    }
+
+    /// The shown warnings that were not shown when this was last asked, in order: a warning
+    /// that went away and came back is new again.
+    fn new_warnings(&mut self) -> Vec<String> {
+        let shown: Vec<String> = self.shown_warnings().into_iter().map(|(w, _)| w).collect();
+        let news = shown
+            .iter()
+            .filter(|w| !self.printed.contains(w))
+            .cloned()
+            .collect();
+        self.printed = shown;
+        news
     }
 
     /// The state as the page reads it (JSON).
@@ -265,7 +323,12 @@ impl State {
         out.push_str("],\"diagnostics\":");
         out.push_str(&json_list(&self.diagnostics));
         out.push_str(",\"warnings\":");
-        out.push_str(&json_list(&self.warnings));
+        let warnings: Vec<String> = self
+            .shown_warnings()
+            .iter()
+            .map(|(w, count)| crate::app::render::in_frames(w, *count))
+            .collect();
+        out.push_str(&json_list(&warnings));
         out.push('}');
         out
     }

@@ -1,6 +1,7 @@
-//! Following edits: the folders of the spec, its base scene and their OBJ files are watched
-//! (`notify`); a change to one of those files builds the animation again, and the state takes
-//! in the new frames, or the diagnostics with the last good frames kept.
+//! Following edits: the folders of the spec, its base scene, the files that includes (to any
+//! depth) and the OBJ files they all name are watched (`notify`); a change to one of those
+//! files builds the animation again, and the state takes in the new frames, or the
+//! diagnostics with the last good frames kept.
 
 use super::project::Project;
 use super::state::Shared;
@@ -82,8 +83,7 @@ fn rebuild(project: &Project, shared: &Shared) -> BTreeSet<PathBuf> {
         Ok(built) => state.apply(built),
         Err(diagnostics) => state.diagnostics = diagnostics,
     }
-    shared.touch(&mut state);
-    drop(state);
+    shared.publish(state);
     project.watched().iter().map(|p| absolute(p)).collect()
 }
 

@@ -155,16 +155,26 @@ pub struct ImageBytes {
     pub hash: u64,
 }
 
-/// Encodes `img` and writes it to `path` atomically.
-pub fn write_image(path: &Path, img: &HdrImage, format: ImageFormat) -> io::Result<ImageBytes> {
+/// `img` tone-mapped and encoded as `format`, in memory: the bytes of its image file.
+pub fn encode_image(img: &HdrImage, format: ImageFormat) -> io::Result<Vec<u8>> {
     let rgb = to_rgb8(img);
     let mut encoded = Vec::new();
     encode(&mut encoded, &rgb, img.width, img.height, format)?;
-    crate::util::write_atomically(path, |w| w.write_all(&encoded))?;
+    Ok(encoded)
+}
+
+/// Writes the bytes of an encoded image to `path` atomically.
+pub fn write_encoded(path: &Path, encoded: &[u8]) -> io::Result<ImageBytes> {
+    crate::util::write_atomically(path, |w| w.write_all(encoded))?;
     Ok(ImageBytes {
         len: encoded.len() as u64,
-        hash: crate::util::Fnv64::of(&encoded),
+        hash: crate::util::Fnv64::of(encoded),
     })
+}
+
+/// Encodes `img` and writes it to `path` atomically.
+pub fn write_image(path: &Path, img: &HdrImage, format: ImageFormat) -> io::Result<ImageBytes> {
+    write_encoded(path, &encode_image(img, format)?)
 }
 
 /// Where `--hdr` writes the linear radiance of the image written to `image`: beside it, with
@@ -193,12 +203,7 @@ pub fn encode_pfm(img: &HdrImage) -> Vec<u8> {
 
 /// Writes `img`'s radiance to `path` as PFM, atomically.
 pub fn write_pfm(path: &Path, img: &HdrImage) -> io::Result<ImageBytes> {
-    let encoded = encode_pfm(img);
-    crate::util::write_atomically(path, |w| w.write_all(&encoded))?;
-    Ok(ImageBytes {
-        len: encoded.len() as u64,
-        hash: crate::util::Fnv64::of(&encoded),
-    })
+    write_encoded(path, &encode_pfm(img))
 }
 
 #[cfg(test)]

@@ -40,53 +40,97 @@ pub fn settings_fingerprint(settings: &RenderSettings, load: &LoadOptions) -> St
 }
 
 /// The hash a frame's record holds: of the settings, the frame's bytes (`sdf`, read from
-/// `path`), the bytes of every file it includes (`include`), so that a change to the static
-/// part of an animation renders its frames again, and the size and modification time of
-/// every mesh they name (`hash_referenced`).
-pub(super) fn frame_hash(sdf: &[u8], path: &Path, fingerprint: &str, max_input: u64) -> u64 {
+/// `path`), the bytes of every file it includes, so that a change to the static part of an
+/// animation renders its frames again, and the size and modification time of every mesh they
+/// name (see [`visit_referenced`]). The preview keys its frames by it too.
+pub fn frame_hash(sdf: &[u8], path: &Path, fingerprint: &str, max_input: u64) -> u64 {
     let mut h = Fnv64::default();
     h.write(fingerprint.as_bytes());
     // A separator that cannot occur in the fingerprint keeps the two parts apart.
     h.write(&[0]);
     h.write(sdf);
-    hash_referenced(
-        &mut h,
+    visit_referenced(sdf, path, max_input, &mut |file, referenced| {
+        h.write_part(file.as_os_str().as_encoded_bytes());
+        match referenced {
+            Referenced::Mesh => {
+                if let Ok(meta) = std::fs::metadata(file) {
+                    h.write_part(&meta.len().to_le_bytes());
+                    let since_epoch = meta
+                        .modified()
+                        .ok()
+                        .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+                    h.write_part(&since_epoch.map_or(0, |d| d.as_nanos()).to_le_bytes());
+                }
+            }
+            Referenced::Included(Some(bytes)) => h.write_part(bytes),
+            Referenced::Included(None) => {}
+        }
+    });
+    h.finish()
+}
+
+/// The files whose edits change the pictures of scene file `path`: those it includes, to any
+/// depth, and the meshes they all name. Files that cannot be read are listed too, so that a
+/// watcher sees them made.
+pub fn referenced_files(path: &Path, max_input: u64) -> Vec<PathBuf> {
+    let Ok(sdf) = anim_core::load::read_input(path, max_input, "file") else {
+        return Vec::new();
+    };
+    let mut files = Vec::new();
+    visit_referenced(&sdf, path, max_input, &mut |file, _| {
+        files.push(file.to_path_buf());
+    });
+    files
+}
+
+/// What a scene file refers to, as [`visit_referenced`] meets it.
+enum Referenced<'a> {
+    /// An OBJ file a mesh statement names: never read (a mesh may be hundreds of megabytes,
+    /// which reading for every frame of a run would cost more than rendering some frames, and
+    /// editing it changes its time).
+    Mesh,
+    /// An included file, with its bytes when it can be read (else the frame fails to load and
+    /// is never vouched for).
+    Included(Option<&'a [u8]>),
+}
+
+/// Calls `visit` with what `sdf` (read from `path`) refers to: the OBJ files its mesh
+/// statements name, then each file it includes followed by what that refers to, as many files
+/// deep as the loader follows (deeper, it refuses the frame anyway).
+fn visit_referenced(
+    sdf: &[u8],
+    path: &Path,
+    max_input: u64,
+    visit: &mut dyn FnMut(&Path, Referenced),
+) {
+    visit_to_depth(
         sdf,
         path,
         max_input,
         anim_core::limits::MAX_INCLUDE_DEPTH,
+        visit,
     );
-    h.finish()
 }
 
-/// Adds to `h` what `sdf` (read from `path`) refers to: the OBJ files its mesh statements
-/// name, each with its name, size and modification time (a mesh may be hundreds of megabytes,
-/// which reading for every frame of a run would cost more than rendering some frames, and
-/// editing it changes its time), then the files it includes, each with its name and bytes and
-/// what it refers to, `depth` files deep at most (deeper, the loader refuses the frame anyway).
-/// A file that cannot be read adds its name alone: the frame then fails to load and is never
-/// vouched for.
-fn hash_referenced(h: &mut Fnv64, sdf: &[u8], path: &Path, max_input: u64, depth: usize) {
+fn visit_to_depth(
+    sdf: &[u8],
+    path: &Path,
+    max_input: u64,
+    depth: usize,
+    visit: &mut dyn FnMut(&Path, Referenced),
+) {
     let text = String::from_utf8_lossy(sdf);
     for mesh in anim_core::sdf::mesh_files(&text, path) {
-        h.write_part(mesh.as_os_str().as_encoded_bytes());
-        if let Ok(meta) = std::fs::metadata(&mesh) {
-            h.write_part(&meta.len().to_le_bytes());
-            let since_epoch = meta
-                .modified()
-                .ok()
-                .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
-            h.write_part(&since_epoch.map_or(0, |d| d.as_nanos()).to_le_bytes());
-        }
+        visit(&mesh, Referenced::Mesh);
     }
     let Some(depth) = depth.checked_sub(1) else {
         return;
     };
     for file in anim_core::sdf::included_files(&text, path) {
-        h.write_part(file.as_os_str().as_encoded_bytes());
-        if let Ok(bytes) = anim_core::load::read_input(&file, max_input, "file") {
-            h.write_part(&bytes);
-            hash_referenced(h, &bytes, &file, max_input, depth);
+        let bytes = anim_core::load::read_input(&file, max_input, "file").ok();
+        visit(&file, Referenced::Included(bytes.as_deref()));
+        if let Some(bytes) = bytes {
+            visit_to_depth(&bytes, &file, max_input, depth, visit);
         }
     }
 }

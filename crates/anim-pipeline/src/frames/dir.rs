@@ -413,7 +413,7 @@ impl Summary {
     /// each distinct warning once.
     fn add_outcomes(&mut self, mut results: Vec<(String, FrameOutcome)>) {
         results.sort_by(|a, b| natural_cmp(&a.0, &b.0));
-        let mut warnings: BTreeMap<String, (Diagnostic, usize)> = BTreeMap::new();
+        let mut warnings = Vec::new();
         for (name, outcome) in results {
             let frame_warnings = match outcome {
                 FrameOutcome::Rendered { rays, warnings } => {
@@ -430,18 +430,27 @@ impl Summary {
                     continue;
                 }
             };
-            for d in frame_warnings {
-                // Frames of one animation repeat the same warning: show it once, with the
-                // first frame's location and a count.
-                warnings
-                    .entry(d.message.clone())
-                    .and_modify(|e| e.1 += 1)
-                    .or_insert((d, 1));
-            }
+            warnings.extend(frame_warnings);
         }
         self.failed.sort_by(|a, b| natural_cmp(&a.0, &b.0));
-        self.warnings = warnings.into_values().collect();
+        self.warnings = distinct_warnings(warnings);
     }
+}
+
+/// Each distinct warning of `warnings` (the frames' in natural order) once, with the first
+/// one's location and how many times it came: frames of one animation repeat the same
+/// warning. In the order of their messages.
+pub fn distinct_warnings(
+    warnings: impl IntoIterator<Item = Diagnostic>,
+) -> Vec<(Diagnostic, usize)> {
+    let mut distinct: BTreeMap<String, (Diagnostic, usize)> = BTreeMap::new();
+    for d in warnings {
+        distinct
+            .entry(d.message.clone())
+            .and_modify(|e| e.1 += 1)
+            .or_insert((d, 1));
+    }
+    distinct.into_values().collect()
 }
 
 fn file_name(path: &Path) -> String {

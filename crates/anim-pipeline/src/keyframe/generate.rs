@@ -15,16 +15,15 @@
 //! after the base file's: translate −p, scale S, rotate R, translate p + T.
 
 pub use super::base::BaseScene;
-use super::keyed::{self, color};
+use super::keyed;
 use super::motion::{self, TrackPose};
 use super::orbit::{self, Pose};
 use super::placement::Placer;
 use super::ranges;
-use super::spec::{Animation, Source, TargetKind, Track};
+use super::spec::{Animation, Source, TargetKind};
 use super::split::{Split, STATIC_FILE};
 use super::tidy::tidy;
 use anim_core::diag::{Diagnostic, Loc};
-use anim_core::limits;
 use anim_core::sdf::ast::{MotionDef, NameRef, RenderDef, Statement, StatementKind, TransformOp};
 use glam::DVec3;
 use std::fmt::Write as _;
@@ -127,27 +126,10 @@ impl<'a> Generator<'a> {
             }
         }
 
-        if let Some(ch) = &anim.ambient {
-            let v = color(ch.at(t).unwrap_or(DVec3::ZERO));
-            set_or_append(
-                &mut out,
-                |k| matches!(k, StatementKind::Ambient(_)),
-                StatementKind::Ambient(v),
-                self,
-            );
-        }
-        if let Some(ch) = &anim.background {
-            let v = color(ch.at(t).unwrap_or(DVec3::ZERO));
-            set_or_append(
-                &mut out,
-                |k| matches!(k, StatementKind::Background(_)),
-                StatementKind::Background(v),
-                self,
-            );
-        }
+        keyed::set_ambient_and_background(&mut out, anim, t, &self.loc());
 
         for (k, track) in anim.tracks.iter().enumerate() {
-            self.apply_parameters(track, t, &mut out, &when)?;
+            keyed::set_parameters(&mut out, track, t, self.src, &when)?;
             keyed::set_material(&mut out, track, t);
             if self.is_aimed_camera(&track.target) {
                 continue;
@@ -187,51 +169,6 @@ impl<'a> Generator<'a> {
             samples: anim.samples,
         })));
         Ok(out)
-    }
-
-    /// Keyed light and camera parameters, set in the definitions themselves.
-    fn apply_parameters(
-        &self,
-        track: &Track,
-        t: f64,
-        out: &mut [Statement],
-        when: &dyn Fn() -> String,
-    ) -> Result<(), Vec<Diagnostic>> {
-        let brightness = track.brightness.as_ref().and_then(|c| c.at(t));
-        let rgb = track.color.as_ref().and_then(|c| c.at(t));
-        let fov = match track.fov.as_ref().and_then(|c| c.at(t).map(|v| (v, c))) {
-            Some((v, ch)) if !limits::fov_is_valid(v) => {
-                return Err(vec![self.src.error(
-                    &[&ch.path],
-                    format!(
-                        "{} the field of view of '{}' is {}°, outside 0–180° (a smooth curve overshoots here: add a key or use another interp)",
-                        when(),
-                        track.target,
-                        tidy(v)
-                    ),
-                )]);
-            }
-            other => other.map(|(v, _)| v),
-        };
-        for s in out.iter_mut() {
-            match &mut s.kind {
-                StatementKind::Light(l) if l.name == track.target => {
-                    if let Some(b) = brightness {
-                        l.brightness = tidy(b.max(0.0)) as f32;
-                    }
-                    if let Some(c) = rgb {
-                        l.color = color(c);
-                    }
-                }
-                StatementKind::Camera(c) if c.name == track.target => {
-                    if let Some(f) = fov {
-                        c.fov_x_deg = tidy(f);
-                    }
-                }
-                _ => {}
-            }
-        }
-        Ok(())
     }
 
     /// The transform operations that move track `k`'s target at time `t` (see the module
@@ -435,24 +372,5 @@ impl<'a> Generator<'a> {
             let _ = writeln!(text, "{s}");
         }
         text
-    }
-}
-
-/// Sets every statement matching `is` to `kind`, or appends `kind` if none matches.
-fn set_or_append(
-    out: &mut Vec<Statement>,
-    is: impl Fn(&StatementKind) -> bool,
-    kind: StatementKind,
-    g: &Generator,
-) {
-    let mut found = false;
-    for s in out.iter_mut() {
-        if is(&s.kind) {
-            s.kind = kind.clone();
-            found = true;
-        }
-    }
-    if !found {
-        out.push(g.statement(kind));
     }
 }

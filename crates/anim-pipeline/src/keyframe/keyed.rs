@@ -1,10 +1,12 @@
-//! Keyed values written into a frame's definitions: a camera's pose, a material's colours
-//! and coefficients, and which shapes and composites are shown.
+//! Keyed values written into a frame's definitions: a camera's pose and field of view, a
+//! light's brightness and colour, a material's colours and coefficients, the ambient and
+//! background colours, and which shapes and composites are shown.
 
 use super::base::BaseScene;
 use super::orbit::Pose;
-use super::spec::Track;
+use super::spec::{Animation, Source, Track};
 use super::tidy::{tidy, tidy3};
+use anim_core::diag::{Diagnostic, Loc};
 use anim_core::limits;
 use anim_core::sdf::ast::{Statement, StatementKind};
 use glam::{DVec3, Vec3};
@@ -30,6 +32,95 @@ pub fn place_camera(out: &mut Vec<Statement>, name: &str, pose: &Pose) {
             }
         }
     }
+}
+
+/// Sets the keyed ambient and background colours of `anim` at time `t` in the statements that
+/// set them, or in new statements (at `loc`) where the base scene sets none.
+pub fn set_ambient_and_background(out: &mut Vec<Statement>, anim: &Animation, t: f64, loc: &Loc) {
+    if let Some(ch) = &anim.ambient {
+        let v = color(ch.at(t).unwrap_or(DVec3::ZERO));
+        set_or_append(
+            out,
+            |k| matches!(k, StatementKind::Ambient(_)),
+            StatementKind::Ambient(v),
+            loc,
+        );
+    }
+    if let Some(ch) = &anim.background {
+        let v = color(ch.at(t).unwrap_or(DVec3::ZERO));
+        set_or_append(
+            out,
+            |k| matches!(k, StatementKind::Background(_)),
+            StatementKind::Background(v),
+            loc,
+        );
+    }
+}
+
+/// Sets every statement matching `is` to `kind`, or appends `kind` (at `loc`) if none matches.
+fn set_or_append(
+    out: &mut Vec<Statement>,
+    is: impl Fn(&StatementKind) -> bool,
+    kind: StatementKind,
+    loc: &Loc,
+) {
+    let mut found = false;
+    for s in out.iter_mut() {
+        if is(&s.kind) {
+            s.kind = kind.clone();
+            found = true;
+        }
+    }
+    if !found {
+        out.push(Statement::new(kind, loc.clone()));
+    }
+}
+
+/// Sets the keyed light and camera parameters of `track` at time `t` (`when` says which frame
+/// that is) in the definitions themselves; a field of view outside 0–180° is an error at the
+/// channel of spec `src`.
+pub fn set_parameters(
+    out: &mut [Statement],
+    track: &Track,
+    t: f64,
+    src: &Source,
+    when: &dyn Fn() -> String,
+) -> Result<(), Vec<Diagnostic>> {
+    let brightness = track.brightness.as_ref().and_then(|c| c.at(t));
+    let rgb = track.color.as_ref().and_then(|c| c.at(t));
+    let fov = match track.fov.as_ref().and_then(|c| c.at(t).map(|v| (v, c))) {
+        Some((v, ch)) if !limits::fov_is_valid(v) => {
+            return Err(vec![src.error(
+                &[&ch.path],
+                format!(
+                    "{} the field of view of '{}' is {}°, outside 0–180° (a smooth curve overshoots here: add a key or use another interp)",
+                    when(),
+                    track.target,
+                    tidy(v)
+                ),
+            )]);
+        }
+        other => other.map(|(v, _)| v),
+    };
+    for s in out.iter_mut() {
+        match &mut s.kind {
+            StatementKind::Light(l) if l.name == track.target => {
+                if let Some(b) = brightness {
+                    l.brightness = tidy(b.max(0.0)) as f32;
+                }
+                if let Some(c) = rgb {
+                    l.color = color(c);
+                }
+            }
+            StatementKind::Camera(c) if c.name == track.target => {
+                if let Some(f) = fov {
+                    c.fov_x_deg = tidy(f);
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 /// Sets the keyed values of material track `track` at time `t` in the material's
