@@ -44,14 +44,16 @@ fn image_files(dir: &Path) -> Vec<PathBuf> {
 /// generated frame includes. A scene of the repository takes only tracked ones, so that a
 /// scene which needs a file the repository lacks fails here, as on a fresh clone.
 fn companions(scene: &Path) -> Vec<PathBuf> {
-    let folder = scene.parent().unwrap();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let beside: Vec<PathBuf> = match folder.strip_prefix(root) {
-        Ok(dir) => common::repository_files(&dir.to_string_lossy())
+    // Canonical paths: the corpus is reached as `../shared` from the repository's root.
+    let canonical = |p: &Path| p.canonicalize().unwrap();
+    let folder = canonical(scene.parent().unwrap());
+    let root = canonical(Path::new(env!("CARGO_MANIFEST_DIR")));
+    let beside: Vec<PathBuf> = match folder.strip_prefix(&root) {
+        Ok(dir) => common::tracked_files(&root, &dir.to_string_lossy())
             .into_iter()
-            .filter(|f| f.parent() == Some(folder))
+            .filter(|f| f.parent() == Some(folder.as_path()))
             .collect(),
-        Err(_) => std::fs::read_dir(folder)
+        Err(_) => std::fs::read_dir(&folder)
             .unwrap()
             .flatten()
             .map(|e| e.path())
