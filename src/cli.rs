@@ -232,8 +232,7 @@ pub struct BenchArgs {
     /// --error, the settings measured are those given instead of the preset's.
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_samples)]
     pub spp: Vec<u32>,
-    /// Adaptive settings to measure, as error targets in 8-bit levels (e.g. `--error 2,3,4`;
-    /// 2 is `anim render`'s default).
+    /// Adaptive settings to measure, as error targets in 8-bit levels (e.g. `--error 2,3,4`).
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_error_target)]
     pub error: Vec<f32>,
     /// A POV-Ray anti-aliasing setting to time instead of the preset's (repeat for several),
