@@ -1,7 +1,8 @@
 //! Command-line definitions (clap derive), resolved into configuration before any work starts.
 
 use crate::app::{CheckConfig, GenerateConfig, PreviewConfig, RenderConfig};
-use anim_bench::{BenchConfig, PovMode, Preset};
+use anim_bench::pov::PovSetting;
+use anim_bench::{BenchConfig, Clock, PovMode, Preset, Setting};
 use anim_core::limits;
 use anim_core::render::RenderSettings;
 use anim_core::sdf::{LoadOptions, MaterialField, MaterialLayout, TransformOrder};
@@ -227,6 +228,25 @@ pub struct BenchArgs {
     /// Samples per pixel of the converged anim reference.
     #[arg(long, value_name = "N", default_value_t = 1024, value_parser = parse_reference_samples)]
     pub reference_spp: u32,
+    /// Uniform settings to measure, in samples per pixel (e.g. `--spp 1,16`). With --spp or
+    /// --error, the settings measured are those given instead of the preset's.
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_samples)]
+    pub spp: Vec<u32>,
+    /// Adaptive settings to measure, as error targets in 8-bit levels (e.g. `--error 2,3,4`).
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_error_target)]
+    pub error: Vec<f32>,
+    /// A POV-Ray anti-aliasing setting to time instead of the preset's (repeat for several),
+    /// e.g. `--pov-setting "+A0.1 +AM2 +R3"`.
+    #[arg(long = "pov-setting", value_name = "FLAGS")]
+    pub pov_settings: Vec<String>,
+    /// Time every run N times, all runs of a scene in turn (A B A B), and keep each run's
+    /// median.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
+    pub turns: u32,
+    /// Time anim as a whole `anim render` process (reading, building, tracing, writing; GNU
+    /// time), as POV-Ray is timed, instead of around its render call.
+    #[arg(long)]
+    pub whole_process: bool,
     /// Worker threads (default: one per core).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
@@ -280,6 +300,26 @@ impl BenchArgs {
         c.height = self.height.unwrap_or(c.height);
         c.reference_spp = self.reference_spp;
         c.threads = threads;
+        if !self.spp.is_empty() || !self.error.is_empty() {
+            let uniform = self.spp.iter().map(|&spp| Setting::Uniform(spp));
+            let adaptive = self.error.iter().map(|&error| Setting::Adaptive { error });
+            c.settings = uniform.chain(adaptive).collect();
+        }
+        if !self.pov_settings.is_empty() {
+            c.pov_settings = self
+                .pov_settings
+                .iter()
+                .map(|f| PovSetting::new(f))
+                .collect();
+        }
+        c.turns = self.turns as usize;
+        if self.whole_process {
+            // This very executable renders: the build measured is the build timed. Without a
+            // path to it (no /proc), the `anim` on PATH, which the image check holds to this
+            // one's images.
+            let exe = std::env::current_exe().unwrap_or_else(|_| PathBuf::from("anim"));
+            c.clock = Clock::Process(exe);
+        }
         c
     }
 }

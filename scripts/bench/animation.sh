@@ -75,7 +75,8 @@ for c in "${cases[@]}"; do
         for bin in "${bins[@]}"; do
             dir="frames-$c-$(basename "$bin")"
             n=$(ls "$dir"/*.sdf | wc -l)
-            first=$(ls "$dir"/*.sdf | sort | head -1)
+            # Not `head`: leaving early would kill sort with SIGPIPE (pipefail).
+            first=$(ls "$dir"/*.sdf | sort | sed -n 1p)
             # A frame alone, with the static part it includes (if any) beside it.
             rm -rf "$dir"/*.png "$dir/.anim-cache" alone && mkdir alone && cp "$first" alone/
             if [ -f "$dir/static.sdfi" ]; then cp "$dir/static.sdfi" alone/; fi

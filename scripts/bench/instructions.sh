@@ -15,8 +15,8 @@
 #   deep grid (camera packets), a mesh, instanced composites and a motion-blurred frame; at
 #   one sample per pixel and at the default adaptive settings;
 # - `pov`: the scenes and settings of scripts/bench/pov.sh (speed against POV-Ray);
-# - `adaptive`: the default and `--spp 1` runs of scripts/bench/adaptive.sh (time against
-#   error) on its three scenes at 640×360.
+# - `adaptive`: the default and `--spp 1` runs of BENCHMARKS.md's "Time against error"
+#   (`anim bench --whole-process`) on its three scenes at 640×360.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 new=${1:?usage: scripts/bench/instructions.sh NEW [BASE]}

@@ -138,6 +138,58 @@ pub fn shared_dir(test: &str) -> Option<PathBuf> {
     None
 }
 
+/// The repository's own files below `dir` (a folder of the repository, e.g. `"scenes"`), in
+/// order: what git tracks there (`git ls-files`), never what a run of anim left in the tree
+/// (the frames, video and caches of the README's main job). Every test that judges "the files
+/// we ship" takes them from here; folders outside the repository (the shared corpus, a test's
+/// own temporary folder) are read with [`files_below`].
+pub fn repository_files(dir: &str) -> Vec<PathBuf> {
+    tracked_files(Path::new(env!("CARGO_MANIFEST_DIR")), dir)
+}
+
+/// The files git tracks below `dir` of the checkout at `root`, that exist, in order.
+///
+/// Panics, saying why, when `root` is not the top of a git checkout (git missing, a copy
+/// without `.git`, a checkout git refuses to read) or git tracks nothing there: the tests
+/// cannot tell the repository's files from the rest without it, and an empty list would
+/// pass by testing nothing.
+pub fn tracked_files(root: &Path, dir: &str) -> Vec<PathBuf> {
+    let run = std::process::Command::new("git")
+        .arg("-C")
+        .arg(root)
+        .args(["ls-files", "-z", "--", dir])
+        // Only `root` itself may be the checkout: a repository around a copy without `.git`
+        // would list nothing of it.
+        .env("GIT_CEILING_DIRECTORIES", root.parent().unwrap_or(root))
+        .output();
+    let why = match &run {
+        Err(e) => format!("git cannot be run ({e})"),
+        Ok(out) if !out.status.success() => String::from_utf8_lossy(&out.stderr).trim().into(),
+        Ok(_) => String::new(),
+    };
+    assert!(
+        why.is_empty(),
+        "the repository's files under {dir}/ are what `git ls-files` lists, and it failed in {}: \
+         {why}\nrun the tests in a git checkout of anim",
+        root.display()
+    );
+    let listed = run.map(|out| out.stdout).unwrap_or_default();
+    let mut files: Vec<PathBuf> = listed
+        .split(|&b| b == 0)
+        .filter(|name| !name.is_empty())
+        .map(|name| root.join(String::from_utf8_lossy(name).as_ref()))
+        // Deleted but not yet committed: no longer part of the tree being tested.
+        .filter(|path| path.is_file())
+        .collect();
+    assert!(
+        !files.is_empty(),
+        "git tracks no file under {dir}/ in {}: is this a checkout of anim?",
+        root.display()
+    );
+    files.sort();
+    files
+}
+
 /// Every file below `dir`, recursively (nothing when it cannot be read).
 pub fn files_below(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else {

@@ -4,16 +4,19 @@
 //! `tobj`, the mesh and its hierarchy) and `include` (a scene cut in two files, the second
 //! including the first, sometimes round a loop). See FUZZING.md; `scripts/fuzz.sh` runs it.
 //!
-//! Deterministic: the inputs are mutations of seed files (the shared corpus, `scenes/`,
-//! `animations/`) drawn from the seeded `SplitMix64` of `anim_core::util`, so a run is reproduced by its seed
-//! and execution count. Each input runs on a worker thread under `catch_unwind`; the main
-//! thread waits for it at most the per-input time limit and otherwise records a hang (and
-//! carries on with a fresh worker). Crashing and hanging inputs are saved to the findings
-//! directory, to become regression tests in tests/hostile/files.rs.
+//! Deterministic: the inputs are mutations of seed files (the shared corpus, and what git
+//! tracks in `scenes/` and `animations/`) drawn from the seeded `SplitMix64` of
+//! `anim_core::util`, so a run is reproduced by its seed and execution count. Each input runs
+//! on a worker thread under `catch_unwind`; the main thread waits for it at most the
+//! per-input time limit and otherwise records a hang (and carries on with a fresh worker).
+//! Crashing and hanging inputs are saved to the findings directory, to become regression
+//! tests in tests/hostile/files.rs.
 //!
 //! Settings come from the environment (the test harness owns the command line):
 //! `FUZZ_EXECS` (default 100 000), `FUZZ_SEED` (1), `FUZZ_CORPUS` (`../shared/corpus`),
 //! `FUZZ_TIMEOUT_MS` (2000), `FUZZ_OUT` (`target/fuzz-findings`).
+
+use crate::common;
 
 use anim_core::load::load_str;
 use anim_core::sdf::{LoadOptions, MaterialField, TransformOrder};
@@ -177,10 +180,17 @@ struct Seeds {
     files: Vec<Vec<u8>>,
 }
 
-fn read_seeds(dirs: &[PathBuf], wanted: &dyn Fn(&Path) -> bool) -> Seeds {
+/// The seed files `wanted` takes: those below `corpus` (outside the repository) and those git
+/// tracks in the repository's `folders` (never what a run of anim left there).
+fn read_seeds(corpus: &Path, folders: &[&str], wanted: &dyn Fn(&Path) -> bool) -> Seeds {
     let mut paths = Vec::new();
-    for dir in dirs {
-        collect(dir, wanted, &mut paths);
+    collect(corpus, wanted, &mut paths);
+    for folder in folders {
+        paths.extend(
+            common::repository_files(folder)
+                .into_iter()
+                .filter(|p| wanted(p)),
+        );
     }
     paths.sort();
     let files = paths
@@ -564,24 +574,18 @@ struct AllSeeds {
     obj: Seeds,
 }
 
-fn seeds(settings: &Settings, repo: &Path) -> AllSeeds {
-    let mut sdf = read_seeds(
-        &[
-            settings.corpus.clone(),
-            repo.join("scenes"),
-            repo.join("animations"),
-        ],
-        &|p| {
-            let name = p.to_string_lossy();
-            name.ends_with(".sdf") || name.ends_with(".txt")
-        },
-    );
+fn seeds(settings: &Settings) -> AllSeeds {
+    let corpus = &settings.corpus;
+    let mut sdf = read_seeds(corpus, &["scenes", "animations"], &|p| {
+        let name = p.to_string_lossy();
+        name.ends_with(".sdf") || name.ends_with(".txt")
+    });
     sdf.files
         .extend(FRAME_SEEDS.iter().map(|s| s.as_bytes().to_vec()));
-    let spec = read_seeds(&[repo.join("animations"), settings.corpus.clone()], &|p| {
+    let spec = read_seeds(corpus, &["animations"], &|p| {
         p.extension().is_some_and(|e| e == "ron")
     });
-    let mut obj = read_seeds(&[repo.join("scenes"), settings.corpus.clone()], &|p| {
+    let mut obj = read_seeds(corpus, &["scenes"], &|p| {
         p.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"))
     });
     obj.files
@@ -638,7 +642,7 @@ fn next_input(rng: &mut SplitMix64, seeds: &AllSeeds) -> (Target, Vec<u8>) {
 
 fn run(settings: &Settings) -> Report {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let seeds = seeds(settings, repo);
+    let seeds = seeds(settings);
     let base = Arc::new(base_scene(repo));
     let last_panic = record_panics();
     let mut worker = spawn_worker(base.clone(), last_panic.clone());

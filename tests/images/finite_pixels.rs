@@ -1,19 +1,17 @@
-//! No scene we ship or our users have may produce a NaN or infinite pixel: every file in
-//! scenes/, animations/ and the shared corpus that loads is rendered small, and its HDR
-//! buffer (before tone mapping could hide a NaN as 0) is checked.
+//! No scene we ship or our users have may produce a NaN or infinite pixel: every file of
+//! scenes/ and animations/ (as git tracks them) and of the shared corpus that loads is
+//! rendered small, and its HDR buffer (before tone mapping could hide a NaN as 0) is checked.
 
 use crate::common;
 
 use anim_core::load::load_file;
 use anim_core::render::{render_job, RenderSettings};
 use anim_core::sdf::LoadOptions;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-/// Scene files below `dir`: `.sdf`, `.txt` and files without an extension (as the corpus
+/// Scene files among `all`: `.sdf`, `.txt` and files without an extension (as the corpus
 /// names them).
-fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut all = Vec::new();
-    common::files_below(dir, &mut all);
+fn scene_files(all: Vec<PathBuf>, out: &mut Vec<PathBuf>) {
     out.extend(
         all.into_iter()
             .filter(|p| p.extension().is_none_or(|e| e == "sdf" || e == "txt")),
@@ -22,13 +20,16 @@ fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
 
 #[test]
 fn every_loadable_scene_renders_finite_pixels() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut files = Vec::new();
-    scene_files(&root.join("scenes"), &mut files);
-    scene_files(&root.join("animations"), &mut files);
+    for folder in ["scenes", "animations"] {
+        scene_files(common::repository_files(folder), &mut files);
+    }
     if let Some(shared) = common::shared_dir("finite pixels (corpus part)") {
-        scene_files(&shared.join("corpus/wild"), &mut files);
-        scene_files(&shared.join("corpus/wild2"), &mut files);
+        for set in ["corpus/wild", "corpus/wild2"] {
+            let mut all = Vec::new();
+            common::files_below(&shared.join(set), &mut all);
+            scene_files(all, &mut files);
+        }
     }
     files.sort();
     let settings = RenderSettings {

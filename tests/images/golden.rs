@@ -1,10 +1,11 @@
-//! The golden image manifest: every scene we ship (scenes/, animations/ and frames generated
-//! from every spec in animations/) and every file of the shared corpus, rendered small by the
-//! real binary, with a fingerprint of each image's decoded pixels. Refactoring must not change
-//! a single pixel: the manifest is compared line by line, and it is rewritten only on purpose,
-//! with `ANIM_UPDATE_GOLDEN=1 cargo test --test images golden` after a deliberate change of output.
-//! That run also renders each scene whose lines changed converged and prints each changed
-//! image's RMSE against it.
+//! The golden image manifest: every scene we ship (the files git tracks in scenes/ and
+//! animations/: a new scene counts once it is added, frames a run left there never do; and
+//! frames generated here from every tracked spec) and every file of the shared corpus,
+//! rendered small by the real binary, with a fingerprint of each image's decoded pixels.
+//! Refactoring must not change a single pixel: the manifest is compared line by line, and it
+//! is rewritten only on purpose, with `ANIM_UPDATE_GOLDEN=1 cargo test --test images golden`
+//! after a deliberate change of output. That run also renders each scene whose lines changed
+//! converged and prints each changed image's RMSE against it.
 
 use crate::common;
 
@@ -39,6 +40,31 @@ fn image_files(dir: &Path) -> Vec<PathBuf> {
     images
 }
 
+/// The files a scene reads that sit beside it: meshes (`define shape obj`) and the static part a
+/// generated frame includes. A scene of the repository takes only tracked ones, so that a
+/// scene which needs a file the repository lacks fails here, as on a fresh clone.
+fn companions(scene: &Path) -> Vec<PathBuf> {
+    // Canonical paths: the corpus is reached as `../shared` from the repository's root.
+    let canonical = |p: &Path| p.canonicalize().unwrap();
+    let folder = canonical(scene.parent().unwrap());
+    let root = canonical(Path::new(env!("CARGO_MANIFEST_DIR")));
+    let beside: Vec<PathBuf> = match folder.strip_prefix(&root) {
+        Ok(dir) => common::tracked_files(&root, &dir.to_string_lossy())
+            .into_iter()
+            .filter(|f| f.parent() == Some(folder.as_path()))
+            .collect(),
+        Err(_) => std::fs::read_dir(&folder)
+            .unwrap()
+            .flatten()
+            .map(|e| e.path())
+            .collect(),
+    };
+    beside
+        .into_iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "obj" || e == "sdfi"))
+        .collect()
+}
+
 /// Renders one scene file in a sandbox of its own (deep enough that render lines with `../..`
 /// stay inside it) with `args` added; the images it wrote, by file name, or `None` if it was
 /// rejected.
@@ -49,19 +75,8 @@ fn render_images(label: &str, scene: &Path, args: &[&str]) -> Rendered {
     let name = scene.file_name().unwrap();
     let copy = dir.join(name);
     std::fs::copy(scene, &copy).unwrap();
-    // Meshes a scene reads (`define shape obj`) and the static part a generated frame
-    // includes sit beside it.
-    for entry in std::fs::read_dir(scene.parent().unwrap())
-        .unwrap()
-        .flatten()
-    {
-        if entry
-            .path()
-            .extension()
-            .is_some_and(|e| e == "obj" || e == "sdfi")
-        {
-            std::fs::copy(entry.path(), dir.join(entry.file_name())).unwrap();
-        }
+    for companion in companions(scene) {
+        std::fs::copy(&companion, dir.join(companion.file_name().unwrap())).unwrap();
     }
     let output = anim()
         .arg("render")
@@ -141,22 +156,33 @@ fn changed_against_converged(scenes: &[(String, PathBuf)], rendered: &[Rendered]
     }
 }
 
+/// The scene files the repository ships (`scenes/`, `animations/`), labelled by their path in
+/// it, and its keyframe specs: what git tracks at `root`, not what a run left beside them.
+fn shipped(root: &Path) -> (Vec<(String, PathBuf)>, Vec<PathBuf>) {
+    let has = |f: &PathBuf, ext: &str| f.extension().is_some_and(|e| e == ext);
+    let mut scenes = Vec::new();
+    for folder in ["scenes", "animations"] {
+        for f in common::tracked_files(root, folder) {
+            if has(&f, "sdf") {
+                let label = f.strip_prefix(root).unwrap().display().to_string();
+                scenes.push((label, f));
+            }
+        }
+    }
+    let mut specs = common::tracked_files(root, "animations");
+    specs.retain(|f| has(f, "ron"));
+    (scenes, specs)
+}
+
 /// Frames 0, a third and two thirds of the way through each spec's animation.
-fn generated_frames(root: &Path, frames_root: &Path) -> Vec<(String, PathBuf)> {
-    let mut specs: Vec<PathBuf> = std::fs::read_dir(root.join("animations"))
-        .unwrap()
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
-        .collect();
-    specs.sort();
+fn generated_frames(specs: &[PathBuf], frames_root: &Path) -> Vec<(String, PathBuf)> {
     let mut frames = Vec::new();
     for spec in specs {
         let stem = spec.file_stem().unwrap().to_string_lossy().into_owned();
         let out = frames_root.join(&stem);
         let status = anim()
             .arg("generate")
-            .arg(&spec)
+            .arg(spec)
             .arg("-o")
             .arg(&out)
             .arg("--quiet")
@@ -186,21 +212,9 @@ fn generated_frames(root: &Path, frames_root: &Path) -> Vec<(String, PathBuf)> {
 
 #[test]
 fn every_scene_renders_the_pixels_of_the_golden_manifest() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut scenes: Vec<(String, PathBuf)> = Vec::new();
-    for folder in ["scenes", "animations"] {
-        let mut files = Vec::new();
-        common::files_below(&root.join(folder), &mut files);
-        for f in files
-            .into_iter()
-            .filter(|f| f.extension().is_some_and(|e| e == "sdf"))
-        {
-            let label = f.strip_prefix(root).unwrap().display().to_string();
-            scenes.push((label, f));
-        }
-    }
+    let (mut scenes, specs) = shipped(Path::new(env!("CARGO_MANIFEST_DIR")));
     let frames_root = tempfile::tempdir().unwrap();
-    scenes.extend(generated_frames(root, frames_root.path()));
+    scenes.extend(generated_frames(&specs, frames_root.path()));
     let shared = shared_dir("golden manifest (corpus part)");
     if let Some(shared) = &shared {
         // The first public set is labelled `corpus/`, the second `corpus-wild2/`.
@@ -255,4 +269,67 @@ fn every_scene_renders_the_pixels_of_the_golden_manifest() {
         extra.iter().map(|l| format!("  {l}")).collect::<Vec<_>>().join("\n"),
     );
     eprintln!("{} manifest lines match", actual.len());
+}
+
+/// `git` in `dir`, which must succeed.
+fn git(dir: &Path, args: &[&str]) {
+    let out = std::process::Command::new("git")
+        .arg("-C")
+        .arg(dir)
+        .args(args)
+        .output()
+        .expect("git runs");
+    assert!(
+        out.status.success(),
+        "git {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The README's main job, then its tests: what `scripts/animate.sh animations/orbit.ron
+/// animation.mp4` leaves in the tree (frames, their static part and cache, the video) is no
+/// scene of the manifest, nor is a scene nobody added to the repository.
+#[test]
+fn the_manifest_takes_what_git_tracks_not_what_a_run_left() {
+    let checkout = tempfile::tempdir().unwrap();
+    let root = checkout.path();
+    let write = |name: &str| {
+        let path = root.join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, "# a file\n").unwrap();
+    };
+    for tracked in [
+        "scenes/a.sdf",
+        "scenes/meshes/m.obj",
+        "animations/orbit.ron",
+    ] {
+        write(tracked);
+    }
+    write("animations/showcase.sdf");
+    git(root, &["init", "-q"]);
+    git(root, &["add", "."]);
+    for left in [
+        "animations/frames/orbit/frame_0000.sdf",
+        "animations/frames/orbit/static.sdfi",
+        "animations/frames/orbit/.anim-cache/frame_0000.sdf.record",
+        "animations/frames/orbit/frame_0000.png",
+        "animations/scratch.sdf",
+        "animations/scratch.ron",
+        "animation.mp4",
+    ] {
+        write(left);
+    }
+    let (scenes, specs) = shipped(root);
+    let labels: Vec<&str> = scenes.iter().map(|(label, _)| label.as_str()).collect();
+    assert_eq!(labels, ["scenes/a.sdf", "animations/showcase.sdf"]);
+    assert_eq!(specs, [root.join("animations/orbit.ron")]);
+}
+
+#[test]
+#[should_panic(expected = "run the tests in a git checkout")]
+fn outside_a_git_checkout_the_shipped_files_are_an_error_not_a_guess() {
+    let copy = tempfile::tempdir().unwrap();
+    std::fs::create_dir(copy.path().join("scenes")).unwrap();
+    std::fs::write(copy.path().join("scenes/a.sdf"), "# a file\n").unwrap();
+    shipped(copy.path());
 }

@@ -73,6 +73,13 @@ const TODAY: [(&str, usize, u64); 3] = [
     ("lights", 120, 0x2b0e_b433_96ac_6f12),
 ];
 
+/// The file a spec's `scene: File("...")` names.
+fn base_scene_file(spec: &str) -> &str {
+    let start = spec.find("scene: File(\"").expect("a base scene file") + "scene: File(\"".len();
+    let len = spec[start..].find('"').expect("its closing quote");
+    &spec[start..start + len]
+}
+
 #[test]
 fn without_a_shutter_or_with_shutter_0_frames_are_unchanged() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("animations");
@@ -82,19 +89,22 @@ fn without_a_shutter_or_with_shutter_0_frames_are_unchanged() {
         let run = generate(&root.join(format!("{name}.ron")), &out);
         assert!(run.status.success(), "{name}");
         assert_eq!(frames_hash(&out), (count, hash), "{name}");
-        // The same spec with an explicit `shutter: 0`, beside the original so that its base
-        // scene is found.
+        // The same spec with an explicit `shutter: 0`, beside a copy of its base scene (the
+        // repository's tree is not written to).
         let text = std::fs::read_to_string(root.join(format!("{name}.ron"))).expect("spec");
         let with_zero = text.replacen("    fps: 24,", "    fps: 24,\n    shutter: 0,", 1);
         assert_ne!(
             with_zero, text,
             "{name}: no fps line to put the shutter after"
         );
-        let spec = root.join(format!(".shutter-zero-{name}-{}.ron", std::process::id()));
+        let copy = tmp.path().join(format!("{name}-spec"));
+        std::fs::create_dir(&copy).expect("dir");
+        let base = base_scene_file(&text);
+        std::fs::copy(root.join(base), copy.join(base)).expect("base scene");
+        let spec = copy.join(format!("{name}.ron"));
         std::fs::write(&spec, with_zero).expect("spec");
         let out0 = tmp.path().join(format!("{name}-0"));
         let run = generate(&spec, &out0);
-        let _ = std::fs::remove_file(&spec);
         assert!(run.status.success(), "{name}");
         // Only the header names the spec file.
         let rename = |dir: &Path| -> Vec<String> {

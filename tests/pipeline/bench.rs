@@ -1,6 +1,7 @@
-//! `anim bench` end to end: the real binary at its hidden `--tiny` size on two of the bench
-//! scenes, checking the files it writes. POV-Ray rows are checked when POV-Ray and the shared
-//! converter scripts are there, and the skip note otherwise.
+//! `anim bench` end to end: the real binary at its hidden `--tiny` size on bench scenes,
+//! checking the files it writes, the settings, turns and clock a run names. POV-Ray rows are
+//! checked when POV-Ray and the shared converter scripts are there, and the skip note
+//! otherwise.
 
 use assert_cmd::Command;
 use std::path::Path;
@@ -75,6 +76,103 @@ fn quick_bench_writes_csv_markdown_and_plots() {
         .unwrap();
     assert!(again.status.success());
     assert!(String::from_utf8_lossy(&again.stderr).contains("anim reference from cache"));
+}
+
+/// `anim bench ARGS --tiny --scene assignment`, files in `dir`: (success, stderr).
+fn bench_in(dir: &Path, args: &[&str]) -> (bool, String) {
+    let output = Command::cargo_bin("anim")
+        .unwrap()
+        .args(["bench", "--tiny", "--scene", "assignment", "--out"])
+        .arg(dir.join("out"))
+        .arg("--cache")
+        .arg(dir.join("cache"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        output.status.success(),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    )
+}
+
+/// The settings a run names are the ones measured, each timed in every turn, and a timed
+/// `anim render` process must draw the image measured in the bench's own process (the bench
+/// fails otherwise), so its flags ask for what the setting asks.
+#[test]
+fn named_settings_are_timed_in_turns_as_whole_processes() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, stderr) = bench_in(
+        dir.path(),
+        &[
+            "--spp",
+            "1,16",
+            "--error",
+            "2",
+            "--pov-setting",
+            "+A0.1 +AM2 +R3",
+            "--turns",
+            "3",
+            "--whole-process",
+        ],
+    );
+    assert!(ok, "bench failed:\n{stderr}");
+    let csv = std::fs::read_to_string(dir.path().join("out/bench.csv")).unwrap();
+    let rows: Vec<(&str, &str)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let cols: Vec<&str> = l.split(',').collect();
+            (cols[1], cols[3])
+        })
+        .collect();
+    let mut expected = vec![("anim", "1 spp"), ("anim", "16 spp"), ("anim", "error 2")];
+    if pov_available() {
+        expected.push(("povray", "+A0.1 +AM2 +R3"));
+    }
+    assert_eq!(rows, expected, "{csv}");
+    assert!(rmse(&csv, "assignment", "16 spp") < rmse(&csv, "assignment", "1 spp"));
+    for turn in 1..=3 {
+        assert!(
+            stderr.contains(&format!("assignment: turn {turn} of 3")),
+            "{stderr}"
+        );
+    }
+    let md = std::fs::read_to_string(dir.path().join("out/bench.md")).unwrap();
+    assert!(
+        md.contains("whole process") && md.contains("median of 3 turns"),
+        "{md}"
+    );
+    // The timed processes' images went to a work folder, gone afterwards.
+    let left: Vec<_> = std::fs::read_dir(dir.path().join("cache"))
+        .unwrap()
+        .flatten()
+        .filter(|e| e.path().is_dir())
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
+/// A process renders every render line of its file, so it cannot be timed for one of them.
+#[test]
+fn whole_process_timing_refuses_a_scene_of_two_render_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenes = dir.path().join("scenes");
+    std::fs::create_dir(&scenes).unwrap();
+    let scene = std::fs::read_to_string("scenes/bench/assignment.sdf").unwrap();
+    std::fs::write(
+        scenes.join("assignment.sdf"),
+        format!("{scene}\nrender eye second.ppm 48 27\n"),
+    )
+    .unwrap();
+    let scenes_dir = scenes.to_str().unwrap();
+    let args = ["--no-pov", "--spp", "1", "--scenes", scenes_dir];
+    let (ok, stderr) = bench_in(dir.path(), &[&args[..], &["--whole-process"]].concat());
+    assert!(!ok);
+    assert!(stderr.contains("has 2 render lines"), "{stderr}");
+    let (ok, stderr) = bench_in(dir.path(), &args);
+    assert!(
+        ok,
+        "around the render call, the first render line is measured:\n{stderr}"
+    );
 }
 
 #[test]

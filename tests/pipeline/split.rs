@@ -2,7 +2,7 @@
 //! includes `static.sdfi`) and whole (`--standalone`), render to the same bytes; a split frame
 //! renders on its own; and the split takes the static part out of every frame.
 
-use crate::common::anim;
+use crate::common::{self, anim};
 use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {
@@ -67,7 +67,10 @@ fn size(paths: &[PathBuf]) -> u64 {
 
 #[test]
 fn split_frames_render_to_the_bytes_of_whole_frames() {
-    let specs = files(&repo().join("animations"), "ron");
+    let specs: Vec<PathBuf> = common::repository_files("animations")
+        .into_iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
     assert!(specs.len() >= 8, "{specs:?}");
     for spec in &specs {
         let name = spec.file_stem().unwrap().to_string_lossy().into_owned();

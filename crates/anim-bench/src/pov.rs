@@ -7,7 +7,10 @@
 //! setting, merged with `c/(c+1)` by `povtonemap.py`, compared with the same merge of POV's
 //! own converged render (`+A0.0 +AM2 +R5`).
 
-use super::{cache_key, metrics, read_rgb8, BenchConfig, BenchScene, Reference, Renderer, Row};
+use super::{
+    cache_key, last_lines, metrics, read_rgb8, run_child, timed_process, BenchConfig, BenchScene,
+    Reference, Renderer, Row, Timing, WorkDir, TIME,
+};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Instant;
@@ -16,33 +19,53 @@ use std::time::Instant;
 #[derive(Clone, Debug, PartialEq)]
 pub struct PovSetting {
     /// Its command-line flags, as written in the report.
-    pub flags: &'static str,
-    /// The plot line it belongs to: no anti-aliasing, or adaptive method 1 or 2.
-    pub mode: &'static str,
+    pub flags: String,
+    /// The plot line it belongs to: no anti-aliasing (`no AA`), or adaptive method N (`AMN`).
+    pub mode: String,
 }
 
-const fn setting(flags: &'static str, mode: &'static str) -> PovSetting {
-    PovSetting { flags, mode }
+impl PovSetting {
+    /// The setting of `flags`, in the plot line of its anti-aliasing: on with the last `+A` or
+    /// `+A<threshold>` that no `-A` follows, by method 1 unless a `+AM<n>` says otherwise.
+    pub fn new(flags: &str) -> PovSetting {
+        let words: Vec<&str> = flags.split_whitespace().collect();
+        let switch = |w: &&str| {
+            let threshold = |rest: &str| rest.chars().all(|c| c.is_ascii_digit() || c == '.');
+            match (w.strip_prefix("+A"), w.strip_prefix("-A")) {
+                (Some(rest), _) if threshold(rest) => Some(true),
+                (_, Some(rest)) if threshold(rest) => Some(false),
+                _ => None,
+            }
+        };
+        let on = words.iter().rev().find_map(switch).unwrap_or(false);
+        let method = words
+            .iter()
+            .rev()
+            .find_map(|w| w.strip_prefix("+AM"))
+            .unwrap_or("1");
+        PovSetting {
+            flags: flags.to_string(),
+            mode: if on {
+                format!("AM{method}")
+            } else {
+                "no AA".to_string()
+            },
+        }
+    }
 }
 
 /// Every setting of a full run.
 pub fn standard_settings() -> Vec<PovSetting> {
-    vec![
-        setting("-A", "no AA"),
-        setting("+A0.3", "AM1"),
-        setting("+A0.1", "AM1"),
-        setting("+A0.3 +AM2 +R3", "AM2"),
-        setting("+A0.1 +AM2 +R3", "AM2"),
-    ]
+    ["-A", "+A0.3", "+A0.1", "+A0.3 +AM2 +R3", "+A0.1 +AM2 +R3"]
+        .map(PovSetting::new)
+        .to_vec()
 }
 
 /// The quick run's: no anti-aliasing and the finest of each method.
 pub fn quick_settings() -> Vec<PovSetting> {
-    vec![
-        setting("-A", "no AA"),
-        setting("+A0.1", "AM1"),
-        setting("+A0.1 +AM2 +R3", "AM2"),
-    ]
+    ["-A", "+A0.1", "+A0.1 +AM2 +R3"]
+        .map(PovSetting::new)
+        .to_vec()
 }
 
 /// POV-Ray's converged image.
@@ -93,30 +116,6 @@ impl Tools {
     }
 }
 
-const TIME: &str = "/usr/bin/time";
-
-/// The end of a failed program's messages, where the reason is.
-fn last_lines(text: &str) -> String {
-    let lines: Vec<&str> = text.lines().collect();
-    lines[lines.len().saturating_sub(8)..].join(" | ")
-}
-
-fn run(cmd: &mut Command) -> Result<String, String> {
-    let out = cmd
-        .output()
-        .map_err(|e| format!("cannot run {cmd:?}: {e}"))?;
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    if !out.status.success() {
-        return Err(format!(
-            "{:?} failed ({}): {}",
-            cmd.get_program(),
-            out.status,
-            last_lines(&stderr)
-        ));
-    }
-    Ok(stderr)
-}
-
 /// The POV-Ray command for one render of `pov` into `out`.
 fn povray(config: &BenchConfig, flags: &str, pov: &Path, out: &Path, hdr: bool) -> Command {
     let mut cmd = Command::new("povray");
@@ -151,21 +150,25 @@ fn convert(
         config.height.to_string(),
     ];
     let phong = work.join("scene.pov");
-    run(Command::new("python3")
-        .arg(&tools.sdf2pov)
-        .arg(&scene.file)
-        .args(&size)
-        .arg("-o")
-        .arg(&phong))?;
-    let channels = ["r", "g", "b"].map(|c| work.join(format!("scene_{c}.pov")));
-    for (c, path) in ["r", "g", "b"].iter().zip(&channels) {
-        run(Command::new("python3")
+    run_child(
+        Command::new("python3")
             .arg(&tools.sdf2pov)
             .arg(&scene.file)
             .args(&size)
-            .args(["--channel", c])
             .arg("-o")
-            .arg(path))?;
+            .arg(&phong),
+    )?;
+    let channels = ["r", "g", "b"].map(|c| work.join(format!("scene_{c}.pov")));
+    for (c, path) in ["r", "g", "b"].iter().zip(&channels) {
+        run_child(
+            Command::new("python3")
+                .arg(&tools.sdf2pov)
+                .arg(&scene.file)
+                .args(&size)
+                .args(["--channel", c])
+                .arg("-o")
+                .arg(path),
+        )?;
     }
     Ok(Converted { phong, channels })
 }
@@ -215,11 +218,13 @@ fn tone_mapped(
     if let Some(problem) = failure {
         return Err(problem);
     }
-    run(Command::new("python3")
-        .arg(&tools.tonemap)
-        .args(&hdrs)
-        .arg("-o")
-        .arg(png))?;
+    run_child(
+        Command::new("python3")
+            .arg(&tools.tonemap)
+            .args(&hdrs)
+            .arg("-o")
+            .arg(png),
+    )?;
     read_rgb8(png, config.width, config.height)
         .ok_or_else(|| format!("cannot read POV-Ray's merged image {}", png.display()))
 }
@@ -232,131 +237,129 @@ fn stat(text: &str, label: &str) -> Option<u64> {
     })
 }
 
-/// Times POV-Ray at every setting on one scene and measures each against its converged image.
-pub fn measure_scene(
-    tools: &Tools,
-    scene: &BenchScene,
-    config: &BenchConfig,
-    progress: &mut dyn FnMut(&str),
-) -> Result<(Reference, Vec<Row>), String> {
-    let work = config
-        .cache_dir
-        .join(format!("pov-work-{}-{}", std::process::id(), scene.name));
-    std::fs::create_dir_all(&work).map_err(|e| format!("cannot create {}: {e}", work.display()))?;
-    let result = measure_in(tools, scene, config, &work, progress);
-    // The work folder holds only intermediate files; the reference is cached outside it.
-    let _ = std::fs::remove_dir_all(&work);
-    result
+/// POV-Ray ready to time one scene: the converted scenes and the converged reference, in a
+/// work folder of intermediate files removed with the session (the reference is cached
+/// outside it).
+pub struct Session<'a> {
+    tools: &'a Tools,
+    scene: &'a BenchScene,
+    config: &'a BenchConfig,
+    conv: Converted,
+    ref_rgb: Vec<u8>,
+    pub reference: Reference,
+    work: WorkDir,
 }
 
-fn measure_in(
-    tools: &Tools,
-    scene: &BenchScene,
-    config: &BenchConfig,
-    work: &Path,
-    progress: &mut dyn FnMut(&str),
-) -> Result<(Reference, Vec<Row>), String> {
-    let conv = convert(tools, scene, config, work)?;
-    let script = std::fs::read(&tools.sdf2pov).unwrap_or_default();
-    let key = cache_key(&[
-        &scene.bytes,
-        &script,
-        tools.version.as_bytes(),
-        REFERENCE_FLAGS.as_bytes(),
-        &config.width.to_le_bytes(),
-        &config.height.to_le_bytes(),
-    ]);
-    let ref_path = config
-        .cache_dir
-        .join(format!("{}-pov-{key:016x}.png", scene.name));
-    let mut reference = Reference {
-        renderer: Renderer::PovRay,
-        setting: REFERENCE_FLAGS.to_string(),
-        wall_s: None,
-        path: ref_path.clone(),
-    };
-    let ref_rgb = match read_rgb8(&ref_path, config.width, config.height) {
-        Some(rgb) => {
-            progress(&format!(
-                "{}: POV-Ray reference from cache {}",
-                scene.name,
-                ref_path.display()
-            ));
-            rgb
-        }
-        None => {
-            progress(&format!(
-                "{}: rendering the POV-Ray reference ({REFERENCE_FLAGS}, 3 channel passes)",
-                scene.name
-            ));
-            let start = Instant::now();
-            let rgb = tone_mapped(tools, &conv, config, REFERENCE_FLAGS, work, &ref_path)?;
-            reference.wall_s = Some(start.elapsed().as_secs_f64());
-            rgb
-        }
-    };
-    let mut rows = Vec::new();
-    for s in &config.pov_settings {
-        let out = work.join("timed.png");
-        let times = work.join("time.txt");
-        let wall = Instant::now();
-        let stderr = run(Command::new(TIME)
-            .arg("-o")
-            .arg(&times)
-            .args(["-f", "%U+%S"])
-            .arg("povray")
-            .args(povray(config, s.flags, &conv.phong, &out, false).get_args()))?;
-        let wall_s = wall.elapsed().as_secs_f64();
-        let cpu_s = read_time(&times)?;
-        let rgb = tone_mapped(
-            tools,
-            &conv,
-            config,
-            s.flags,
-            work,
-            &work.join("setting.png"),
-        )?;
-        let pixels = f64::from(config.width) * f64::from(config.height);
-        let row = Row {
-            scene: scene.name.clone(),
+impl<'a> Session<'a> {
+    /// Converts the scene and finds POV-Ray's converged image in the cache, or renders it.
+    pub fn start(
+        tools: &'a Tools,
+        scene: &'a BenchScene,
+        config: &'a BenchConfig,
+        progress: &mut dyn FnMut(&str),
+    ) -> Result<Session<'a>, String> {
+        let work = WorkDir::new(config, "pov", scene)?;
+        let conv = convert(tools, scene, config, &work.0)?;
+        let script = std::fs::read(&tools.sdf2pov).unwrap_or_default();
+        let key = cache_key(&[
+            &scene.bytes,
+            &script,
+            tools.version.as_bytes(),
+            REFERENCE_FLAGS.as_bytes(),
+            &config.width.to_le_bytes(),
+            &config.height.to_le_bytes(),
+        ]);
+        let ref_path = config
+            .cache_dir
+            .join(format!("{}-pov-{key:016x}.png", scene.name));
+        let mut reference = Reference {
             renderer: Renderer::PovRay,
-            mode: s.mode.to_string(),
-            setting: s.flags.to_string(),
-            width: config.width,
-            height: config.height,
-            cpu_s,
-            wall_s,
-            // POV-Ray's "Rays" leave out shadow rays, so they are not comparable with anim's.
-            rays: None,
-            // POV-Ray counts the samples of anti-aliasing only; without it, one per pixel.
-            mean_spp: match stat(&stderr, "Samples:") {
-                Some(n) if n > 0 => Some(n as f64 / pixels),
-                _ => Some(1.0),
-            },
-            error: metrics::compare_rgb8(&rgb, &ref_rgb),
+            setting: REFERENCE_FLAGS.to_string(),
+            wall_s: None,
+            path: ref_path.clone(),
         };
-        progress(&super::row_line(&row));
-        rows.push(row);
+        let ref_rgb = match read_rgb8(&ref_path, config.width, config.height) {
+            Some(rgb) => {
+                progress(&format!(
+                    "{}: POV-Ray reference from cache {}",
+                    scene.name,
+                    ref_path.display()
+                ));
+                rgb
+            }
+            None => {
+                progress(&format!(
+                    "{}: rendering the POV-Ray reference ({REFERENCE_FLAGS}, 3 channel passes)",
+                    scene.name
+                ));
+                let start = Instant::now();
+                let rgb = tone_mapped(tools, &conv, config, REFERENCE_FLAGS, &work.0, &ref_path)?;
+                reference.wall_s = Some(start.elapsed().as_secs_f64());
+                rgb
+            }
+        };
+        Ok(Session {
+            tools,
+            scene,
+            config,
+            conv,
+            ref_rgb,
+            reference,
+            work,
+        })
     }
-    Ok((reference, rows))
-}
 
-/// Reads GNU time's `%U+%S` output (user + system seconds of the child).
-fn read_time(path: &Path) -> Result<f64, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-    let line = text
-        .lines()
-        .rev()
-        .find(|l| l.contains('+'))
-        .ok_or_else(|| format!("no time in {}", path.display()))?;
-    let (u, s) = line.trim().split_once('+').unwrap_or((line, "0"));
-    let parse = |x: &str| {
-        x.trim()
-            .parse::<f64>()
-            .map_err(|_| format!("bad time '{line}' in {}", path.display()))
-    };
-    Ok(parse(u)? + parse(s)?)
+    /// One turn: POV-Ray's normal render at every setting, each timed as a whole process
+    /// (GNU time), with its mean samples per pixel.
+    pub fn time_all(&self) -> Result<Vec<(Timing, f64)>, String> {
+        let pixels = f64::from(self.config.width) * f64::from(self.config.height);
+        let out = self.work.0.join("timed.png");
+        let report = self.work.0.join("time.txt");
+        let mut timed = Vec::new();
+        for s in &self.config.pov_settings {
+            let cmd = povray(self.config, &s.flags, &self.conv.phong, &out, false);
+            let (stderr, timing) = timed_process(&cmd, &report)?;
+            // POV-Ray counts the samples of anti-aliasing only; without it, one per pixel.
+            let spp = match stat(&stderr, "Samples:") {
+                Some(n) if n > 0 => n as f64 / pixels,
+                _ => 1.0,
+            };
+            timed.push((timing, spp));
+        }
+        Ok(timed)
+    }
+
+    /// The rows of every setting, given its time and mean samples per pixel (in the order of
+    /// the settings), each with its error against the converged image.
+    pub fn rows(&self, timed: impl Iterator<Item = (Timing, f64)>) -> Result<Vec<Row>, String> {
+        let mut rows = Vec::new();
+        for (s, (timing, spp)) in self.config.pov_settings.iter().zip(timed) {
+            let png = self.work.0.join("setting.png");
+            let rgb = tone_mapped(
+                self.tools,
+                &self.conv,
+                self.config,
+                &s.flags,
+                &self.work.0,
+                &png,
+            )?;
+            rows.push(Row {
+                scene: self.scene.name.clone(),
+                renderer: Renderer::PovRay,
+                mode: s.mode.clone(),
+                setting: s.flags.clone(),
+                width: self.config.width,
+                height: self.config.height,
+                cpu_s: timing.cpu_s,
+                wall_s: timing.wall_s,
+                // POV-Ray's "Rays" leave out shadow rays, so they are not comparable with anim's.
+                rays: None,
+                mean_spp: Some(spp),
+                error: metrics::compare_rgb8(&rgb, &self.ref_rgb),
+            });
+        }
+        Ok(rows)
+    }
 }
 
 #[cfg(test)]
@@ -369,5 +372,19 @@ mod tests {
         assert_eq!(stat(text, "Samples:"), Some(13086));
         assert_eq!(stat(text, "Pixels:"), Some(5538));
         assert_eq!(stat(text, "Rays:"), None);
+    }
+
+    #[test]
+    fn a_setting_is_drawn_in_the_line_of_its_method() {
+        let mode = |flags: &str| PovSetting::new(flags).mode;
+        assert_eq!(mode("-A"), "no AA");
+        assert_eq!(mode(""), "no AA");
+        assert_eq!(mode("+A0.3"), "AM1");
+        assert_eq!(mode("+A"), "AM1");
+        assert_eq!(mode("+A0.1 +AM2 +R3"), "AM2");
+        // The last switch counts; a method alone does not turn anti-aliasing on.
+        assert_eq!(mode("+A0.1 -A"), "no AA");
+        assert_eq!(mode("+AM2 +R3"), "no AA");
+        assert_eq!(PovSetting::new("+A0.1 +AM2 +R3").flags, "+A0.1 +AM2 +R3");
     }
 }

@@ -76,9 +76,18 @@ fn table_row(out: &mut String, r: &Row) {
 /// The tables, one per scene.
 pub fn markdown(report: &BenchReport) -> String {
     let mut out = String::new();
+    let clock = if report.whole_process {
+        "CPU s: each renderer's whole process (user + system, GNU time): `anim render` reading, building, tracing and writing the image, and POV-Ray's render"
+    } else {
+        "CPU s: anim's process CPU time around the render call; POV-Ray's child process (user + system, whole process)"
+    };
+    let turns = match report.turns {
+        1 => String::new(),
+        n => format!(" Times are the median of {n} turns, all runs of a scene in turn."),
+    };
     let _ = writeln!(
         out,
-        "# anim bench: time against error\n\n{}×{}, {} threads. Error in 8-bit levels (after `c/(c+1)` and rounding) against each renderer's own converged image: anim uniform {} spp, POV-Ray `{}` (three HDR channel passes, tone-mapped alike). CPU s: anim's process CPU time around the render call; POV-Ray's child process (user + system, whole process).\n",
+        "# anim bench: time against error\n\n{}×{}, {} threads. Error in 8-bit levels (after `c/(c+1)` and rounding) against each renderer's own converged image: anim uniform {} spp, POV-Ray `{}` (three HDR channel passes, tone-mapped alike). {clock}.{turns}\n",
         report.width,
         report.height,
         report.threads,

@@ -139,6 +139,7 @@ fn anisotropic_scene() -> Result<BenchScene, String> {
         file,
         bytes: ANISOTROPIC_SDF.as_bytes().to_vec(),
         job,
+        render_lines: 1,
     })
 }
 

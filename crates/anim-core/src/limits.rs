@@ -12,8 +12,7 @@ pub const SAMPLES: RangeInclusive<u32> = 1..=4096;
 
 /// Adaptive sampling (the default when neither `--spp` nor the render line gives a count):
 /// target error per refined pixel, in 8-bit levels, when `--error` is not given, chosen by
-/// measuring error against time (`scripts/bench/adaptive.sh`; BENCHMARKS.md, "Time against
-/// error"). The per-pixel target is far above the image's RMSE because only pixels on edges
+/// measuring error against time (`anim bench`; BENCHMARKS.md, "Time against error"). The per-pixel target is far above the image's RMSE because only pixels on edges
 /// carry any error at all. Lower it for cleaner edges.
 pub const DEFAULT_ERROR: f32 = 2.0;
 
