@@ -162,7 +162,7 @@ fn light_through_glass_is_what_brute_force_finds() {
 
 /// Instanced composites of glass: the walk offers the shapes inside each use, and answers
 /// as brute force over the flattened tree's shapes does. (A file that draws glass is never
-/// instanced, `scene::build::instancing`; the materials are made glass once the scene is
+/// instanced, `scene::builder::instancing`; the materials are made glass once the scene is
 /// loaded, for the facade must answer any compiled scene right.)
 #[test]
 fn light_through_instanced_glass_is_what_brute_force_finds() {

@@ -22,7 +22,7 @@ use anim_core::load::load_str;
 use anim_core::sdf::{LoadOptions, MaterialField, TransformOrder};
 use anim_core::util::SplitMix64;
 use anim_pipeline::keyframe::generate::{BaseScene, Generator};
-use anim_pipeline::keyframe::spec::{self, Source};
+use anim_pipeline::keyframe::spec_file::{self, Source};
 use std::panic::{self, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -419,9 +419,9 @@ fn execute(target: Target, input: &[u8], variant: u64, base: &BaseScene) {
         Target::Include => included(input, variant),
         Target::Spec => {
             let src = Source::new(Path::new("fuzz.ron"), text.into_owned());
-            if let Ok(file) = spec::parse(&src) {
+            if let Ok(file) = spec_file::parse(&src) {
                 let names = match &file.scene {
-                    spec::SceneSource::Inline(scene) => {
+                    spec_file::SceneSource::Inline(scene) => {
                         let (statements, _) = anim_core::sdf::parse(
                             scene,
                             Path::new("fuzz.ron"),
@@ -429,10 +429,10 @@ fn execute(target: Target, input: &[u8], variant: u64, base: &BaseScene) {
                         );
                         Some(BaseScene::new(statements))
                     }
-                    spec::SceneSource::File(_) => None,
+                    spec_file::SceneSource::File(_) => None,
                 };
                 let scene = names.as_ref().unwrap_or(base);
-                if let Ok(anim) = spec::validate(&file, scene, &src) {
+                if let Ok(anim) = spec_file::validate(&file, scene, &src) {
                     // A valid spec's first and last frames are made as `anim generate` makes
                     // them (aims, orientations, ranges, visibility), in memory.
                     let generator = Generator::new(scene, &anim, &src);

@@ -8,7 +8,7 @@ use anim_core::sdf::LoadOptions;
 use anim_pipeline::keyframe::generate::{BaseScene, Generator};
 use anim_pipeline::keyframe::interp::{sample, Interp, Key};
 use anim_pipeline::keyframe::orbit::pose_at;
-use anim_pipeline::keyframe::spec::{self, Animation, Orbit, Source};
+use anim_pipeline::keyframe::spec_file::{self, Animation, Orbit, Source};
 use glam::{DVec3, Vec3};
 use std::path::Path;
 
@@ -41,9 +41,9 @@ const HEADER: &str =
 /// Parses and validates `text` against [`base`]; errors rendered as text.
 fn check(text: &str) -> Result<Animation, Vec<String>> {
     let src = Source::new(Path::new("spec.ron"), text.to_string());
-    let parsed =
-        spec::parse(&src).map_err(|ds| ds.iter().map(Diagnostic::to_string).collect::<Vec<_>>())?;
-    spec::validate(&parsed, &base(), &src)
+    let parsed = spec_file::parse(&src)
+        .map_err(|ds| ds.iter().map(Diagnostic::to_string).collect::<Vec<_>>())?;
+    spec_file::validate(&parsed, &base(), &src)
         .map_err(|ds| ds.iter().map(Diagnostic::to_string).collect())
 }
 

@@ -7,7 +7,7 @@ use anim_core::diag::Diagnostic;
 use anim_core::render::RenderSettings;
 use anim_core::sdf::LoadOptions;
 use anim_pipeline::frames::{frame_hash, list_frames, referenced_files, settings_fingerprint};
-use anim_pipeline::keyframe::spec::{self, SceneSource, Source, SpecFile};
+use anim_pipeline::keyframe::spec_file::{self, SceneSource, Source, SpecFile};
 use anim_pipeline::keyframe::{run_generate, GenerateConfig};
 use std::path::{Path, PathBuf};
 
@@ -115,7 +115,7 @@ impl Project {
 
 fn read_spec(path: &Path) -> Option<SpecFile> {
     let src = Source::read(path, Source::MAX_BYTES).ok()?;
-    spec::parse(&src).ok()
+    spec_file::parse(&src).ok()
 }
 
 /// The base scene file a spec names, if it names one.

@@ -12,7 +12,7 @@
 //! hits resolve the same way.
 //!
 //! Instancing, one home per layer: `crate::scene::instancing` (what a composite drawn in
-//! several places expands to), `crate::scene::build::instancing` (which composites are kept
+//! several places expands to), `crate::scene::builder::instancing` (which composites are kept
 //! once) and `crate::render::geometry::instancing` (their hierarchies, entered by a use's
 //! transform).
 

@@ -3,12 +3,12 @@
 //! `crate::sdf` (or directly in tests) and compiled by `crate::render::compile` into the
 //! render scene.
 
-mod build;
+mod builder;
 mod instancing;
 pub mod motion;
 
 pub use crate::shape::Geometry;
-pub use build::build_jobs;
+pub use builder::build_jobs;
 pub use instancing::{Instanced, Placed, Prototype, Use};
 
 use crate::diag::Loc;

@@ -9,7 +9,7 @@
 //!
 //! Motion, one home per layer: `crate::math::motion` (keys and their interpolation),
 //! `crate::sdf::parse::motion` (the `motion` lines), `crate::scene::motion` (what moves in a
-//! scene) with `crate::scene::build::motion` (made from the lines),
+//! scene) with `crate::scene::builder::motion` (made from the lines),
 //! `crate::render::geometry::motion` (moving shapes as primitives), `crate::render::motion`
 //! (the exposure, as the samplers see it), and the animation pipeline's `keyframe::motion`
 //! (the lines a spec with a `shutter` writes).

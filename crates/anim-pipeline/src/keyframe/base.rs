@@ -1,7 +1,7 @@
 //! The base scene of an animation: its statements, what each name is, and where each thing
 //! sits (the default pivots and the centres that `look_at` follows).
 
-use super::spec::{SceneNames, TargetKind};
+use super::spec_file::{SceneNames, TargetKind};
 use anim_core::limits;
 use anim_core::math::Transform;
 use anim_core::scene::Geometry;

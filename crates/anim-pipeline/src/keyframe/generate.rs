@@ -20,7 +20,7 @@ use super::motion::{self, TrackPose};
 use super::orbit::{self, Pose};
 use super::placement::Placer;
 use super::ranges;
-use super::spec::{Animation, Source, TargetKind};
+use super::spec_file::{Animation, Source, TargetKind};
 use super::split::{Split, STATIC_FILE};
 use super::tidy::tidy;
 use anim_core::diag::{Diagnostic, Loc};

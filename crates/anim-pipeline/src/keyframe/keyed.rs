@@ -4,7 +4,7 @@
 
 use super::base::BaseScene;
 use super::orbit::Pose;
-use super::spec::{Animation, Source, Track};
+use super::spec_file::{Animation, Source, Track};
 use super::tidy::{tidy, tidy3};
 use anim_core::diag::{Diagnostic, Loc};
 use anim_core::limits;
@@ -127,8 +127,8 @@ pub fn set_parameters(
 /// definitions.
 pub fn set_material(out: &mut [Statement], track: &Track, t: f64) {
     let m = &track.material;
-    let colour = |c: &Option<super::spec::Channel<DVec3>>| c.as_ref().and_then(|c| c.at(t));
-    let number = |c: &Option<super::spec::Channel<f64>>| {
+    let colour = |c: &Option<super::spec_file::Channel<DVec3>>| c.as_ref().and_then(|c| c.at(t));
+    let number = |c: &Option<super::spec_file::Channel<f64>>| {
         c.as_ref().and_then(|c| c.at(t)).map(|v| tidy(v) as f32)
     };
     let (ka, kd, ks) = (colour(&m.ka), colour(&m.kd), colour(&m.ks));

@@ -18,7 +18,7 @@ pub mod orbit;
 pub mod placement;
 pub mod ranges;
 pub mod rotation;
-pub mod spec;
+pub mod spec_file;
 pub mod split;
 pub mod tidy;
 
@@ -28,7 +28,7 @@ use anim_core::sdf::LoadOptions;
 use anim_core::util::write_atomically;
 use generate::{BaseScene, Generator};
 use rayon::prelude::*;
-use spec::{Animation, SceneSource, Source};
+use spec_file::{Animation, SceneSource, Source};
 use split::{Split, STATIC_FILE};
 use std::collections::{HashMap, HashSet};
 use std::io::Write as _;
@@ -81,7 +81,7 @@ pub fn run_generate_reporting(
 ) -> Result<GenerateReport, Vec<Diagnostic>> {
     let spec_path = config.spec.as_path();
     let src = Source::read(spec_path, Source::MAX_BYTES)?;
-    let spec_file = spec::parse(&src)?;
+    let spec_file = spec_file::parse(&src)?;
     let spec_dir = spec_path
         .parent()
         .map(Path::to_path_buf)
@@ -89,7 +89,7 @@ pub fn run_generate_reporting(
 
     let (statements, mut warnings) = load_base(&spec_file.scene, &spec_dir, &src)?;
     let mut base = BaseScene::new(statements);
-    let anim = spec::validate(&spec_file, &base, &src)?;
+    let anim = spec_file::validate(&spec_file, &base, &src)?;
     warnings.extend(anim.warnings.iter().cloned());
     for w in first_frame_warnings(&base, &anim, &src, &spec_file.scene, &spec_dir) {
         if !warnings.iter().any(|d| d.to_string() == w.to_string()) {

@@ -13,7 +13,7 @@
 
 use super::orbit::{self, Pose};
 use super::rotation::axis_degrees;
-use super::spec::{Animation, Track};
+use super::spec_file::{Animation, Track};
 use super::tidy::{tidy, tidy3};
 use anim_core::limits;
 use anim_core::sdf::ast::TransformOp;

@@ -1,7 +1,7 @@
 //! The orbit helper: a camera circling a point at a fixed radius and height, always looking
 //! at its target — the classic turntable shot.
 
-use super::spec::Orbit;
+use super::spec_file::Orbit;
 use glam::DVec3;
 
 /// Where a camera is and where it looks.

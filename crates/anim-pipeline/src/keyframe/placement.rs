@@ -6,7 +6,7 @@ use super::base::{ops_transform, BaseScene};
 use super::motion::TrackPose;
 use super::orbit::Pose;
 use super::rotation::{can_look, facing, rolled_up};
-use super::spec::{Aim, AimTarget, Animation, TargetKind};
+use super::spec_file::{Aim, AimTarget, Animation, TargetKind};
 use super::tidy::tidy3;
 use anim_core::limits;
 use anim_core::math::Transform;

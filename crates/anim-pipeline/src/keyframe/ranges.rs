@@ -4,7 +4,7 @@
 //! they are written; curves that overshoot (Catmull-Rom, Back, Elastic) can leave the range
 //! between them, so every frame's span of time is checked too, not only its instant.
 
-use super::spec::{Animation, Channel, Track};
+use super::spec_file::{Animation, Channel, Track};
 use super::tidy::tidy;
 use anim_core::limits;
 use glam::DVec3;

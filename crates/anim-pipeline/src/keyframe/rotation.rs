@@ -1,6 +1,6 @@
 //! Orientations: Euler angles in a stated order, the turn that makes one direction face
 //! another, and the axis and angle a frame file writes. Quaternions throughout, so that keyed
-//! orientations interpolate by slerp (`spec::model::OrientChannel`).
+//! orientations interpolate by slerp (`spec_file::model::OrientChannel`).
 
 use glam::{DMat3, DQuat, DVec3};
 use serde::Deserialize;

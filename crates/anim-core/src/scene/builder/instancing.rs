@@ -3,7 +3,7 @@
 //! worth it, becomes a prototype the first time it is met, and a use wherever it is listed.
 //!
 //! Instancing, one home per layer: `crate::scene::instancing` (what a composite drawn in
-//! several places expands to), `crate::scene::build::instancing` (which composites are kept
+//! several places expands to), `crate::scene::builder::instancing` (which composites are kept
 //! once) and `crate::render::geometry::instancing` (their hierarchies, entered by a use's
 //! transform).
 
