@@ -5,9 +5,11 @@
 use super::packet::{self, BLOCK, BLOCK_H, BLOCK_W};
 use super::pattern::uniform_time;
 use super::{coverage, Frame, Sampled};
+use crate::math::Ray;
 use crate::render::compile::NO_HIT;
 use crate::render::counts::RayCounts;
 use crate::render::integrator::{PixelPrior, TraceState};
+use crate::render::motion::Shutter;
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 
@@ -86,15 +88,18 @@ fn render_band(
                     frame.camera.ray(x as f32 + dx, y as f32 + dy)
                 });
                 let traced = packet::trace_primaries(frame, &rays, st, &mut [0; BLOCK]);
-                for ((sum, hit), (c, prim)) in sums.iter_mut().zip(&mut hits).zip(&traced) {
+                for (sum, (c, _)) in sums.iter_mut().zip(&traced) {
                     *sum += *c;
+                }
+                for (hit, (_, prim)) in hits.iter_mut().zip(&traced) {
                     *hit += u32::from(*prim != NO_HIT);
                 }
             }
-            for (k, (sum, hit)) in sums.iter().zip(hits).enumerate() {
-                let i = index(at(k));
-                band[i] = Vec3::from(*sum * inv_spp);
-                covered[i] = coverage(hit, offsets.len() as u32);
+            for (k, sum) in sums.iter().enumerate() {
+                band[index(at(k))] = Vec3::from(*sum * inv_spp);
+            }
+            for (k, hit) in hits.into_iter().enumerate() {
+                covered[index(at(k))] = coverage(hit, offsets.len() as u32);
             }
         }
     }
@@ -111,15 +116,14 @@ pub(super) fn uniform_pixel(
     offsets: &[(f32, f32)],
     st: &mut TraceState,
 ) -> (Vec3, f32) {
-    let mut sum = Vec3A::ZERO;
-    let mut hits = 0u32;
+    let (mut sum, mut hits) = (Vec3A::ZERO, 0u32);
     for (i, &(dx, dy)) in offsets.iter().enumerate() {
         let (px, py) = (x as f32 + dx, y as f32 + dy);
         let ray = match frame.shutter {
             None => frame.camera.ray(px, py),
             Some(s) => {
-                let n = offsets.len() as u32;
-                s.ray(frame.camera, px, py, uniform_time(x, y, i as u32, n))
+                let sample = (i as u32, offsets.len() as u32);
+                exposure_ray(frame, s, ((x, y), (px, py)), sample)
             }
         };
         let sample = frame.integrator.camera_sample(&ray, &PixelPrior::NONE, st);
@@ -131,6 +135,19 @@ pub(super) fn uniform_pixel(
         Vec3::from(sum * inv_spp),
         coverage(hits, offsets.len() as u32),
     )
+}
+
+/// The camera ray of sample `i` of `n` of pixel (`x`, `y`), through (`px`, `py`), at its
+/// instant of the exposure. Out of line: inlined, the compiler works out the hash of each
+/// pixel's instants ahead of its loop of samples, for still frames too.
+#[inline(never)]
+fn exposure_ray(
+    frame: &Frame,
+    shutter: &Shutter,
+    ((x, y), (px, py)): ((u32, u32), (f32, f32)),
+    (i, n): (u32, u32),
+) -> Ray {
+    shutter.ray(frame.camera, px, py, uniform_time(x, y, i, n))
 }
 
 /// Sub-pixel sample positions in [0,1)²: a k×k stratified grid when `n = k²`, otherwise a
