@@ -190,7 +190,8 @@ pub struct PreviewArgs {
     #[arg(long)]
     pub open: bool,
     /// Render every frame at full quality, encode them into this MP4 with ffmpeg and stop
-    /// (no server).
+    /// (no server). Checked first: its folder must exist, and it must not be a file the
+    /// preview reads (the spec, its scene, includes, meshes).
     #[arg(long, value_name = "OUT.mp4")]
     pub export: Option<PathBuf>,
     /// Worker threads (default: one per core).

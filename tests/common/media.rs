@@ -94,3 +94,43 @@ pub fn planar_floats(raw: &[u8], pixels: usize, planes: usize) -> Vec<[f32; 4]> 
         })
         .collect()
 }
+
+/// Each frame's PSNR (dB, the mean over Y, U and V) of `video` against the images
+/// `reference` (an ffmpeg pattern such as `dir/ref_%04d.png`), as ffmpeg's `psnr` filter
+/// measures it: the reference converted to the video's own pixel format first, the way
+/// a codec's fidelity is usually stated.
+pub fn psnr_per_frame(video: &Path, reference: &Path) -> Vec<f64> {
+    let stats = tempfile::NamedTempFile::new().expect("a stats file");
+    let filter = format!(
+        // Frame n of each at second n: they pair by their order, whatever their rates.
+        "[0:v]setpts=N/TB[v];[1:v]setpts=N/TB[r];[v][r]psnr=stats_file='{}'",
+        stats.path().display().to_string().replace('\'', "\\'")
+    );
+    let out = Command::new("ffmpeg")
+        .args(["-v", "error", "-nostdin", "-i"])
+        .arg(video)
+        .arg("-i")
+        .arg(reference)
+        .args(["-lavfi", &filter, "-f", "null", "-"])
+        .output()
+        .expect("ffmpeg runs");
+    assert!(
+        out.status.success(),
+        "ffmpeg psnr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(stats.path()).expect("the stats");
+    text.lines()
+        .filter_map(|l| {
+            l.split_whitespace()
+                .find_map(|f| f.strip_prefix("psnr_avg:"))
+        })
+        .map(|v| {
+            if v == "inf" {
+                f64::INFINITY
+            } else {
+                v.parse().expect("a PSNR")
+            }
+        })
+        .collect()
+}
