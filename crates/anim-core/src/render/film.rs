@@ -3,7 +3,7 @@
 //! each pixel's coverage, the linear radiance itself as PFM (`--hdr`), and atomic writes (a
 //! reader never sees a half-written image).
 //!
-//! The alpha model (README, "Image formats and alpha"): a camera sample that hits no surface
+//! The alpha model (README, "Image formats, alpha and video codecs"): a camera sample that hits no surface
 //! is transparent, so a pixel's alpha is its coverage, the fraction of its samples that hit
 //! one. The background colour is not in an image with alpha: the samplers' mean counts what
 //! the missed samples saw, the background, which is one colour, and the film takes it out
