@@ -264,7 +264,7 @@ keeps_alpha=0
 if [ "$alpha" = 1 ]; then
   case $codec in
     prores | webm | ffv1) keeps_alpha=1 ;;
-    *) filters+=("premultiply=inplace=1") ;;
+    *) filters+=("premultiply=inplace=1,format=rgb24") ;;
   esac
 fi
 codec_args=()

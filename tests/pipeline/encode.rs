@@ -208,6 +208,13 @@ fn each_codec_names_itself_and_keeps_alpha_where_it_can() {
     let rgba = decode(&dir.path().join("a.mkv"), "rgba");
     let alpha = |x: usize, y: usize| rgba[(y * 32 + x) * 4 + 3];
     assert_eq!((alpha(0, 0), alpha(16, 12)), (0, 255));
+    // A GIF has no partial alpha: the frames are put over black, every pixel opaque.
+    let gif = decode(&dir.path().join("a.gif"), "rgba");
+    assert!(
+        gif.chunks_exact(4).all(|p| p[3] == 255),
+        "a transparent pixel"
+    );
+    assert_eq!(gif[..4], [0, 0, 0, 255], "the empty corner");
 }
 
 /// The first frame of `video` decoded to 8-bit RGBA.
