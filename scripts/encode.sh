@@ -298,17 +298,36 @@ case $codec in
 esac
 case $out_ext in mp4 | mov) codec_args+=(-movflags +faststart) ;; esac
 
-# The images under the numbers ffmpeg counts, whatever anim named them: links in a
-# temporary folder.
-links=$(mktemp -d)
+# The images as ffmpeg counts them: their own names where those are one numbered pattern
+# from 0 (as anim's `{frame}` names them), else links under numbers in a temporary folder (a
+# process per link: only for names that need it).
 tmp=
-trap 'rm -rf -- "$links"; if [ -n "$tmp" ]; then rm -f -- "$tmp"; fi' EXIT
-for ((i = 0; i < count; i++)); do
-  f=${files[$i]}
-  case $f in /*) ;; *) f=$PWD/$f ;; esac
-  printf -v link '%s/%06d.%s' "$links" "$i" "$ext"
-  ln -s -- "$f" "$link"
-done
+links=
+trap 'if [ -n "$links" ]; then rm -rf -- "$links"; fi; if [ -n "$tmp" ]; then rm -f -- "$tmp"; fi' EXIT
+pattern=
+if [[ ${files[0]} =~ ^(.*[^0-9])?(0+)(\.[^./]*)$ ]]; then
+  # printf's pattern: the name with its % doubled, the zeros as %0Nd.
+  pre=${BASH_REMATCH[1]}
+  post=${BASH_REMATCH[3]}
+  pattern="${pre//%/%%}%0${#BASH_REMATCH[2]}d${post//%/%%}"
+  for ((i = 0; i < count; i++)); do
+    printf -v expected "$pattern" "$i"
+    if [ "$expected" != "${files[$i]}" ]; then
+      pattern=
+      break
+    fi
+  done
+fi
+if [ -z "$pattern" ]; then
+  links=$(mktemp -d)
+  for ((i = 0; i < count; i++)); do
+    f=${files[$i]}
+    case $f in /*) ;; *) f=$PWD/$f ;; esac
+    printf -v link '%s/%06d.%s' "$links" "$i" "$ext"
+    ln -s -- "$f" "$link"
+  done
+  pattern=$links/%06d.$ext
+fi
 
 tmp=$(mktemp "$out_dir/.$(basename -- "$output").XXXXXX")
 filter_args=()
@@ -317,7 +336,7 @@ if [ ${#filters[@]} -gt 0 ]; then
   filter_args=(-filter_complex "$chain")
 fi
 ffmpeg -hide_banner -loglevel error -nostdin -y \
-  -framerate "$fps" -start_number 0 -i "$links/%06d.$ext" \
+  -framerate "$fps" -start_number 0 -i "$pattern" \
   -frames:v "$count" "${filter_args[@]}" "${codec_args[@]}" -r "$fps" \
   -f "$(case $out_ext in mkv) echo matroska ;; *) echo "$out_ext" ;; esac)" "$tmp"
 # mktemp makes the file private (0600); a video is a new file like any other.

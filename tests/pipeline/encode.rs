@@ -115,30 +115,48 @@ fn a_12_fps_spec_lasts_1_s_for_12_frames_without_being_told_its_rate() {
 }
 
 #[test]
-fn a_ratio_in_the_frame_header_is_the_video_s_rate() {
-    if !ffmpeg_for("a_ratio_in_the_frame_header_is_the_video_s_rate") {
+fn a_ratio_in_the_header_and_images_of_any_name_are_read_from_the_frames() {
+    if !ffmpeg_for("a_ratio_in_the_header_and_images_of_any_name_are_read_from_the_frames") {
         return;
     }
     let dir = project("24", 3, "frame_{frame}.png");
     let frames = frames(dir.path(), "f", &[]);
-    // The header of a fractional rate, as the contract of the frame files spells it.
-    for i in 0..3 {
+    // The header of a fractional rate, as the contract of the frame files spells it; and
+    // images named by no number (each frame's own render line says which is its image).
+    let names = ["first", "second", "third"];
+    for (i, name) in names.iter().enumerate() {
         let file = frames.join(format!("frame_{i:04}.sdf"));
         let text = std::fs::read_to_string(&file).expect("frame");
         assert!(text.starts_with(&format!("# Frame {i} of 3 (")), "{text}");
-        std::fs::write(
-            &file,
-            text.replacen(" at 24 fps)", " at 24000/1001 fps)", 1),
-        )
-        .unwrap();
+        let text = text
+            .replacen(" at 24 fps)", " at 24000/1001 fps)", 1)
+            .replacen(&format!("frame_{i:04}.png"), &format!("{name}.png"), 1);
+        std::fs::write(&file, text).unwrap();
     }
+    let render = Command::new(env!("CARGO_BIN_EXE_anim"))
+        .arg("render")
+        .arg(&frames)
+        .output()
+        .expect("render");
+    assert_ran(&render, "render");
+    assert!(frames.join("second.png").is_file());
     let video = dir.path().join("out.mkv");
-    assert_ran(&encode(&[&frames, &video], None), "encode.sh");
+    // Lossless, so that the frames can be told apart by their pixels.
+    let out = encode(&[&frames, &video, &"--codec", &"ffv1"], None);
+    assert_ran(&out, "encode.sh");
     assert_eq!(stream_field(&video, "r_frame_rate"), "24000/1001");
     let (count, duration) = frames_and_duration(&video);
     assert_eq!(count, 3);
     // Matroska keeps milliseconds: 3 · 1001/24000 s = 0.125125 s.
     assert!((duration - 0.125125).abs() < 0.0011, "duration {duration}");
+    // In the frames' order: the video's second frame is second.png.
+    let second = &decode(&video, "rgb24")[32 * 24 * 3..2 * 32 * 24 * 3];
+    let png = decode(&frames.join("second.png"), "rgb24");
+    let worst = second.iter().zip(&png).map(|(a, b)| a.abs_diff(*b)).max();
+    assert!(
+        worst < Some(40),
+        "frame 1 is not second.png: off by {worst:?}"
+    );
 }
 
 #[test]
