@@ -8,6 +8,8 @@
 //!   scene including its materials file), and plain HTTP requests to it.
 //! - `http`: the routes, refusals (traversal, encoded traversal, foreign `Host`), pixels, edits
 //!   and warnings, through plain HTTP requests.
+//! - `lifecycle`: `--export` (full-quality frames only, wrong outputs refused before any
+//!   render), SIGTERM and SIGHUP, the diagnostics the terminal prints.
 //! - `browser`: the page in headless Chromium, driven by `scripts/preview-browser.py`.
 
 #[path = "../common/mod.rs"]
@@ -15,4 +17,5 @@ mod common;
 
 mod browser;
 mod http;
+mod lifecycle;
 mod session;
