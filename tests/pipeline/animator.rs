@@ -443,27 +443,51 @@ fn a_bracket_left_open_is_shown_where_it_opens() {
 #[test]
 fn every_example_spec_generates_the_frames_it_always_has() {
     // Each line: spec, frame count, and the 64-bit FNV-1a of every frame file's name and
-    // bytes in name order (each followed by a 0xff byte), as generated before the animator's
-    // fields existed. New fields are opt-in: the frames of these specs must not change.
+    // bytes in name order (each followed by a 0xff byte), whole (`--standalone`) and split
+    // (the frames with `static.sdfi`), as anim 4a69291 generated them. New fields and
+    // defaults are opt-in: the frames of these specs must not change.
     let manifest = include_str!("animations.tsv");
     let out = tempfile::tempdir().unwrap();
+    let fingerprint = |dir: &Path, extensions: &[&str]| {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .expect("frame dir")
+            .filter_map(Result::ok)
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| extensions.iter().any(|x| n.ends_with(x)))
+            .collect();
+        names.sort();
+        let mut h = anim_core::util::Fnv64::default();
+        for name in &names {
+            h.write_part(name.as_bytes());
+            h.write_part(&std::fs::read(dir.join(name)).expect("frame"));
+        }
+        format!("{:016x}", h.finish())
+    };
     for line in manifest.lines().filter(|l| !l.starts_with('#')) {
         let cols: Vec<&str> = line.split('\t').collect();
-        let (spec, count, hash) = (cols[0], cols[1].parse::<usize>().unwrap(), cols[2]);
-        let dir = out.path().join(spec);
-        let (ok, stderr) = generate(&repo().join("animations").join(spec), &dir);
+        let (spec, count) = (cols[0], cols[1].parse::<usize>().unwrap());
+        let whole = out.path().join(spec);
+        let (ok, stderr) = generate(&repo().join("animations").join(spec), &whole);
         assert!(ok, "{spec}: {stderr}");
-        let frames = frames(&dir);
-        let mut h = anim_core::util::Fnv64::default();
-        for (name, text) in &frames {
-            h.write_part(name.as_bytes());
-            h.write_part(text.as_bytes());
-        }
-        assert_eq!(frames.len(), count, "{spec}");
+        assert_eq!(frames(&whole).len(), count, "{spec}");
         assert_eq!(
-            format!("{:016x}", h.finish()),
-            hash,
+            fingerprint(&whole, &[".sdf"]),
+            cols[2],
             "{spec}'s frames changed"
+        );
+        let split = out.path().join(format!("{spec}.split"));
+        let run = common::anim()
+            .arg("generate")
+            .arg(repo().join("animations").join(spec))
+            .arg("-o")
+            .arg(&split)
+            .output()
+            .expect("run anim");
+        assert!(run.status.success(), "{spec}");
+        assert_eq!(
+            fingerprint(&split, &[".sdf", ".sdfi"]),
+            cols[3],
+            "{spec}'s split frames changed"
         );
     }
 }
