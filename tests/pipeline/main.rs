@@ -11,6 +11,8 @@
 //! - `bench`: `anim bench` at its tiny size, and the files it writes.
 //! - `animator`: aim, orientation keys, the inclusive end, curves kept in range, materials,
 //!   visibility, reuse, the early check of the base scene, and the example specs' frames.
+//! - `generated_frames`: frames read as what they say (no inference), and the first-frame
+//!   check that says what `anim check` would.
 //! - `service`: the one way from a scene file to images in memory, which `anim render` and
 //!   `anim preview` share, and the files a frame's fingerprint follows.
 
@@ -20,6 +22,7 @@ mod common;
 mod animator;
 mod bench;
 mod frames;
+mod generated_frames;
 mod holds;
 mod keyframe_spec;
 mod service;

@@ -92,7 +92,11 @@ pub fn run_generate_reporting(
     let anim = spec_file::validate(&spec_file, &base, &src)?;
     warnings.extend(anim.warnings.iter().cloned());
     for w in first_frame_warnings(&base, &anim, &src, &spec_file.scene, &spec_dir) {
-        if !warnings.iter().any(|d| d.to_string() == w.to_string()) {
+        // The base scene's own warnings are said already, at the same place.
+        if !warnings
+            .iter()
+            .any(|d| d.loc == w.loc && d.message == w.message)
+        {
             warnings.push(w);
         }
     }
@@ -307,10 +311,11 @@ fn load_base(
     Ok((statements, diags))
 }
 
-/// What `anim check` would say of the first frame, located in the base scene where a base
-/// statement is the cause: an unknown material, an image that would be blank. Said once here
-/// rather than by every frame at render time. A frame that cannot be made yields nothing:
-/// writing the frames reports that.
+/// What `anim check` would say of the first frame file, said once here rather than by every
+/// frame at render time: its text loaded as `anim check` loads a file (every warning of the
+/// reader and the builder, then what the camera would show), each warning moved from the
+/// frame's line to the statement it is about, in the base scene where a base statement is the
+/// cause. A frame that cannot be made yields nothing: writing the frames reports that.
 fn first_frame_warnings(
     base: &BaseScene,
     anim: &Animation,
@@ -318,14 +323,23 @@ fn first_frame_warnings(
     scene: &SceneSource,
     spec_dir: &Path,
 ) -> Vec<Diagnostic> {
-    let Ok(statements) = Generator::new(base, anim, src).frame_statements(0) else {
+    let generator = Generator::new(base, anim, src);
+    let Ok(statements) = generator.frame_statements(0) else {
         return Vec::new();
     };
     let path = match scene {
         SceneSource::File(rel) => spec_dir.join(rel),
         SceneSource::Inline(_) => src.path.to_path_buf(),
     };
-    let Ok(loaded) = anim_core::load::build(&statements, &path, &LoadOptions::default()) else {
+    let text = generator.write_frame(0, &statements, None);
+    // Read where the base scene is, so that its mesh files are found as written there.
+    let opts = LoadOptions {
+        material_fields: anim_core::sdf::MaterialLayout::Auto,
+        infer_transform_order: true,
+        allow_any_input: true,
+        ..LoadOptions::default()
+    };
+    let Ok(loaded) = anim_core::load::load_str(&text, &path, &opts) else {
         return Vec::new();
     };
     let mut warnings = loaded.diagnostics;
@@ -333,13 +347,24 @@ fn first_frame_warnings(
         &loaded.jobs,
         &path,
     ));
-    if matches!(scene, SceneSource::Inline(_)) {
-        warnings = warnings
-            .into_iter()
-            .map(|d| shift_into_spec(d, src))
-            .collect();
+    // The frame's lines: its header, then one statement a line.
+    let header = text.lines().count() - statements.len();
+    let warnings = warnings.into_iter().map(|mut d| {
+        let made_by = d.loc.as_ref().filter(|l| *l.file == *path).and_then(|l| {
+            let line = (l.line as usize).checked_sub(header + 1)?;
+            statements.get(line)
+        });
+        if let Some(s) = made_by {
+            d.loc = Some(s.loc.clone());
+            d.file = s.loc.file.to_path_buf();
+            d.source_line = None;
+        }
+        d
+    });
+    match scene {
+        SceneSource::Inline(_) => warnings.map(|d| shift_into_spec(d, src)).collect(),
+        SceneSource::File(_) => warnings.collect(),
     }
-    warnings
 }
 
 /// Points the base scene's OBJ files (`define shape obj`, relative to the base scene) at the
