@@ -63,9 +63,10 @@ echo "==> rendering $frames"
 "$anim" render "$frames" ${ANIM_RENDER_ARGS:-}
 
 echo "==> encoding $out"
-# The frame rate, as the generator wrote it in the first frame's header ("... at 24 fps").
+# The frame rate, as the generator wrote it in the first frame's header ("... at 24 fps", or
+# the exact ratio of a fractional rate, "... at 24000/1001 fps").
 # `sed -n 1p` reads to the end: `head` would leave early, and sort, still writing a long
 # list, would die of SIGPIPE, which pipefail makes the script's failure.
 first_frame=$(find "$frames" -maxdepth 1 -name '*.sdf' | sort | sed -n 1p)
-fps=$(sed -n '1s/.* at \([0-9][0-9]*\) fps.*/\1/p' "$first_frame")
+fps=$(sed -n '1s/.* at \([0-9][0-9]*\(\/[0-9][0-9]*\)\{0,1\}\) fps.*/\1/p' "$first_frame")
 "$root/scripts/encode.sh" "$frames" "$out" "${fps:-24}"

@@ -332,6 +332,7 @@ define camera cam 60 0 0 10 0 0 -1 0 1 0
         spec: dir.path().join("spec.ron"),
         out: Some(out.clone()),
         standalone: false,
+        frames: None,
     };
     anim_pipeline::keyframe::run_generate_reporting(&config, |warnings| {
         let written = std::fs::read_dir(&out).map_or(0, |d| d.count());

@@ -13,6 +13,7 @@
 //!   visibility, reuse, the early check of the base scene, and the example specs' frames.
 //! - `generated_frames`: frames read as what they say (no inference), and the first-frame
 //!   check that says what `anim check` would.
+//! - `timing`: keys at `Frames(n)`, fractional frame rates, `--frames A..B`.
 //! - `service`: the one way from a scene file to images in memory, which `anim render` and
 //!   `anim preview` share, and the files a frame's fingerprint follows.
 
@@ -27,3 +28,4 @@ mod holds;
 mod keyframe_spec;
 mod service;
 mod split;
+mod timing;

@@ -46,6 +46,10 @@ pub struct GenerateConfig {
     /// Whether each frame file holds the whole scene, rather than including the part no
     /// frame changes from [`split::STATIC_FILE`].
     pub standalone: bool,
+    /// Write only the frames from the first to the last of these (counting from 0). Every
+    /// frame is still made, so that the static part and the list of frames are the whole
+    /// animation's and the frames written are those a full run writes.
+    pub frames: Option<(usize, usize)>,
 }
 
 /// What `anim generate` did.
@@ -61,7 +65,7 @@ pub struct GenerateReport {
     /// has, removed so they cannot be rendered by mistake (`anim render DIR` then removes
     /// their images).
     pub removed: usize,
-    pub fps: u32,
+    pub fps: spec_file::Fps,
     /// The animation's length in seconds (the last frame's time, for `end: Inclusive`).
     pub duration: f64,
     /// Warnings about the spec and the base scene.
@@ -128,7 +132,8 @@ pub fn run_generate_reporting(
         )]
     })?;
     let result = rebase_mesh_files(&mut base.statements, &base_dir, &dir, &src)
-        .and_then(|()| write_frames(&base, &anim, &src, &dir, config.standalone));
+        .and_then(|()| selected_frames(config.frames, &anim, &src))
+        .and_then(|chosen| write_frames(&base, &anim, &src, &dir, config.standalone, chosen));
     match result {
         Ok((written, removed)) => Ok(GenerateReport {
             dir,
@@ -160,15 +165,34 @@ fn create_dirs(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
     Ok(missing)
 }
 
-/// Checks every frame, then writes those that changed (and, unless `standalone`, the static
-/// part they include), trims frames an earlier run wrote that the animation no longer has,
-/// and records the list. Returns (written, removed).
+/// The frames `--frames A..B` asks for, within the animation's; an error when it has none of
+/// them.
+fn selected_frames(
+    range: Option<(usize, usize)>,
+    anim: &Animation,
+    src: &Source,
+) -> Result<std::ops::RangeInclusive<usize>, Vec<Diagnostic>> {
+    let last = anim.frames - 1;
+    match range {
+        None => Ok(0..=last),
+        Some((a, _)) if a > last => Err(vec![Diagnostic::file_error(
+            &src.path,
+            format!("--frames asks for frames from {a}, but the animation's last frame is {last}"),
+        )]),
+        Some((a, b)) => Ok(a..=b.min(last)),
+    }
+}
+
+/// Checks every frame in `chosen`, then writes those that changed (and, unless `standalone`,
+/// the static part they include), trims frames an earlier run wrote that the animation no
+/// longer has, and records the list. Returns (written, removed).
 fn write_frames(
     base: &BaseScene,
     anim: &Animation,
     src: &Source,
     dir: &Path,
     standalone: bool,
+    chosen: std::ops::RangeInclusive<usize>,
 ) -> Result<(usize, usize), Vec<Diagnostic>> {
     // Every frame is made and checked (loaded as the renderer will) before any is written,
     // so an invalid spec writes nothing: in parallel, as the frames are independent, and the
@@ -179,7 +203,17 @@ fn write_frames(
     let groups = (!standalone).then(|| split::by_subject(&base.statements));
     let checked: Vec<Result<HashSet<String>, Vec<Diagnostic>>> = (0..anim.frames)
         .into_par_iter()
-        .map(|i| check_frame(&generator, anim, src, dir, i, groups.as_ref()))
+        .map(|i| {
+            if chosen.contains(&i) {
+                check_frame(&generator, anim, src, dir, i, groups.as_ref())
+            } else {
+                // Not written: only what it changes counts, for the static part.
+                let statements = generator.frame_statements(i)?;
+                Ok(groups
+                    .as_ref()
+                    .map_or_else(HashSet::new, |g| split::changed_subjects(g, &statements)))
+            }
+        })
         .collect();
     let mut changed = HashSet::new();
     for frame in checked {
@@ -210,11 +244,15 @@ fn write_frames(
         }
         e
     };
-    // Writes one file unless it holds `text` already; whether it was written.
-    let mut put = |name: &str, text: &str, created: &mut Vec<PathBuf>| {
+    // Lists one file and writes it unless it holds `text` already (or no text is given: a
+    // frame outside `chosen`); whether it was written.
+    let mut put = |name: &str, text: Option<&str>, created: &mut Vec<PathBuf>| {
         let path = dir.join(name);
         manifest.push_str(name);
         manifest.push('\n');
+        let Some(text) = text else {
+            return Ok(false);
+        };
         // Unchanged files are left alone, so they keep their identity for tools that look
         // at modification times.
         let before = std::fs::read(&path).ok();
@@ -229,18 +267,24 @@ fn write_frames(
         Ok::<bool, Vec<Diagnostic>>(true)
     };
     if let Some(split) = &split {
-        put(STATIC_FILE, &generator.static_text(split), &mut created)?;
+        put(
+            STATIC_FILE,
+            Some(&generator.static_text(split)),
+            &mut created,
+        )?;
     }
     for i in 0..anim.frames {
+        let name = anim.output.sdf(i, anim.digits());
+        if !chosen.contains(&i) {
+            // Listed all the same: it is one of the animation's frames.
+            put(&name, None, &mut created)?;
+            continue;
+        }
         let statements = generator
             .frame_statements(i)
             .map_err(|e| undo(&created, e))?;
         let text = generator.write_frame(i, &statements, split.as_ref());
-        written += usize::from(put(
-            &anim.output.sdf(i, anim.digits()),
-            &text,
-            &mut created,
-        )?);
+        written += usize::from(put(&name, Some(&text), &mut created)?);
     }
     let current: HashSet<&str> = manifest.lines().collect();
     let mut removed = 0;

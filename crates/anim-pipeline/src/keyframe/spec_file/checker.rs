@@ -1,7 +1,7 @@
 //! The collector of problems that the checks of a spec share, and the checks of keyed values:
 //! every key's time and value, each problem at its place in the spec.
 
-use super::model::Channel;
+use super::model::{Channel, Fps};
 use super::raw::KeySpec;
 use super::source::Source;
 use crate::keyframe::interp::{Key, Timing};
@@ -63,6 +63,8 @@ pub fn names_list(names: &[&str]) -> String {
 pub struct Checker<'a> {
     /// The animation's length in seconds, once known: keys must fall inside it.
     pub duration: f64,
+    /// The frame rate, once known: what keys written in frames count.
+    pub fps: Fps,
     pub src: &'a Source,
     pub errors: Vec<Diagnostic>,
     pub warnings: Vec<Diagnostic>,
@@ -75,6 +77,7 @@ impl<'a> Checker<'a> {
     pub fn new(src: &'a Source) -> Self {
         Checker {
             duration: 0.0,
+            fps: Fps::whole(24),
             src,
             errors: Vec::new(),
             warnings: Vec::new(),
@@ -126,8 +129,9 @@ impl<'a> Checker<'a> {
         let mut out = Vec::with_capacity(keys.len());
         for (i, k) in keys.iter().enumerate() {
             let key_path = index(path, i);
-            let previous = i.checked_sub(1).map(|p| keys[p].at);
-            self.key_time(k.at, previous, &key_path);
+            let at = k.at.seconds(self.fps);
+            let previous = i.checked_sub(1).map(|p| keys[p].at.seconds(self.fps));
+            self.key_time(at, previous, &key_path);
             self.key_curve(k, &key_path);
             let v = value(&k.value).into3();
             let value_path = field(&key_path, "value");
@@ -140,7 +144,7 @@ impl<'a> Checker<'a> {
                 self.err(&[&value_path, &key_path], format!("{what} {problem}"));
             }
             out.push(Key {
-                at: k.at,
+                at,
                 value: value(&k.value),
                 interp: k.interp,
             });

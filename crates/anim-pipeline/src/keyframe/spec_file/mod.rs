@@ -12,12 +12,12 @@ mod track;
 mod validate;
 
 pub use model::{
-    Aim, AimTarget, Animation, Channel, End, MaterialChannels, NamePattern, Orbit, OrientChannel,
-    SceneNames, TargetKind, Track,
+    Aim, AimTarget, Animation, Channel, End, Fps, MaterialChannels, NamePattern, Orbit,
+    OrientChannel, SceneNames, TargetKind, Track,
 };
 pub use raw::{
-    AimSpec, KeySpec, Length, OrbitSpec, Orientation, Rgb, Scale, SceneSource, SpecFile, TrackSpec,
-    V3,
+    AimSpec, FpsSpec, KeySpec, KeyTime, Length, OrbitSpec, Orientation, Rgb, Scale, SceneSource,
+    SpecFile, TimeUnit, TrackSpec, V3,
 };
 pub use source::Source;
 pub use validate::validate;

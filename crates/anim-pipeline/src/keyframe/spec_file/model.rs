@@ -268,10 +268,58 @@ pub enum End {
     Inclusive,
 }
 
+/// A frame rate, exact: `num` frames every `den` seconds (`24000/1001` is 23.976 fps). Frame
+/// times are computed from the ratio, never from a rounded rate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Fps {
+    pub num: u32,
+    pub den: u32,
+}
+
+impl Fps {
+    /// A whole number of frames per second.
+    pub fn whole(n: u32) -> Fps {
+        Fps { num: n, den: 1 }
+    }
+
+    /// `frames` frame intervals, in seconds. For a whole rate `n` this is `frames / n`, as
+    /// frame times always were.
+    pub fn seconds(self, frames: f64) -> f64 {
+        frames * f64::from(self.den) / f64::from(self.num)
+    }
+
+    /// Frames per second, rounded (for messages and players).
+    pub fn as_f64(self) -> f64 {
+        f64::from(self.num) / f64::from(self.den)
+    }
+
+    /// The frames of one second of timecode, which `Seconds(s)` lengths count: the rate
+    /// itself, but for the NTSC rates (`N·1000/1001`), whose timecode counts `N` frames a
+    /// second (two seconds at 23.976 fps are 48 frames, lasting 2.002 s).
+    pub fn timecode_rate(self) -> f64 {
+        if self.den == 1001 && self.num.is_multiple_of(1000) {
+            f64::from(self.num / 1000)
+        } else {
+            self.as_f64()
+        }
+    }
+}
+
+/// As the frame header writes it: `24`, or the exact ratio `24000/1001`.
+impl std::fmt::Display for Fps {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.den == 1 {
+            write!(f, "{}", self.num)
+        } else {
+            write!(f, "{}/{}", self.num, self.den)
+        }
+    }
+}
+
 /// A validated animation, ready to generate frames from.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Animation {
-    pub fps: u32,
+    pub fps: Fps,
     pub frames: usize,
     pub width: u32,
     pub height: u32,
@@ -299,8 +347,8 @@ impl Animation {
     /// frame (inclusive).
     pub fn duration(&self) -> f64 {
         match self.end {
-            End::Cyclic => self.frames as f64 / self.fps as f64,
-            End::Inclusive => self.frames.saturating_sub(1) as f64 / self.fps as f64,
+            End::Cyclic => self.fps.seconds(self.frames as f64),
+            End::Inclusive => self.fps.seconds(self.frames.saturating_sub(1) as f64),
         }
     }
 
@@ -318,12 +366,12 @@ impl Animation {
 
     /// Time of frame `i` in seconds.
     pub fn time(&self, i: usize) -> f64 {
-        i as f64 / self.fps as f64
+        self.fps.seconds(i as f64)
     }
 
     /// How long the shutter stays open, in seconds.
     pub fn exposure(&self) -> f64 {
-        self.shutter / self.fps as f64
+        self.fps.seconds(self.shutter)
     }
 
     /// The time `u` of the way through frame `i`'s exposure (0 at shutter open, 1 at close).

@@ -1,9 +1,10 @@
 //! The spec as the user writes it: serde types that mirror the RON text one to one, so that
 //! ron rejects every unknown field and variant with its position.
 
-use super::model::End;
+use super::model::{End, Fps};
 use crate::keyframe::interp::{Cycle, Interp};
 use crate::keyframe::rotation::EulerOrder;
+use anim_core::limits;
 use glam::DVec3;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
@@ -18,9 +19,9 @@ pub struct SpecFile {
     /// The camera to render; default: the base scene's `render` camera, else its first camera.
     #[serde(default)]
     pub camera: Option<String>,
-    /// Frames per second, a whole number (read as a number so that `24.5` gets a clear message).
+    /// Frames per second: a whole number, an NTSC rate (`23.976`) or a ratio (`"24000/1001"`).
     #[serde(default = "default_fps")]
-    pub fps: f64,
+    pub fps: FpsSpec,
     /// `Seconds(5)` or `Frames(120)`.
     pub length: Length,
     /// (width, height) in pixels.
@@ -61,13 +62,16 @@ pub struct SpecFile {
 }
 
 impl SpecFile {
-    /// Every key time written in the spec, sorted, once each (the preview marks them).
+    /// Every key time written in the spec, in seconds, sorted, once each (the preview marks
+    /// them). Keys written in frames count at the spec's rate (24 fps where it is wrong).
     pub fn key_times(&self) -> Vec<f64> {
+        let fps = self.fps.exact().unwrap_or(Fps::whole(24));
         let mut times: Vec<f64> = key_times(&self.ambient)
             .chain(key_times(&self.background))
+            .map(|at| at.seconds(fps))
             .collect();
         for t in self.tracks.iter().chain(&self.curves) {
-            times.extend(t.key_times().map(|at| at + t.offset));
+            times.extend(t.key_times().map(|at| at.seconds(fps) + t.offset));
         }
         times.retain(|t| t.is_finite());
         times.sort_by(f64::total_cmp);
@@ -76,12 +80,125 @@ impl SpecFile {
     }
 }
 
-fn key_times<T>(keys: &[KeySpec<T>]) -> impl Iterator<Item = f64> + '_ {
+fn key_times<T>(keys: &[KeySpec<T>]) -> impl Iterator<Item = KeyTime> + '_ {
     keys.iter().map(|k| k.at)
 }
 
-fn default_fps() -> f64 {
-    24.0
+fn default_fps() -> FpsSpec {
+    FpsSpec::Number(24.0)
+}
+
+/// The frame rate as written: a number (whole, or an NTSC rate such as 29.97), or a ratio
+/// `"A/B"`. Read as any number so that `24.5` gets a clear message.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FpsSpec {
+    Number(f64),
+    Ratio(String),
+}
+
+impl FpsSpec {
+    /// The exact rate, or what is wrong with it. A number with a fraction is an NTSC rate,
+    /// `N·1000/1001` written to three decimals or fewer (23.976, 29.97, 59.94); a ratio is
+    /// reduced (`48000/2002` is `24000/1001`). Either way from 1 to 1000 frames a second.
+    pub fn exact(&self) -> Result<Fps, String> {
+        let rates = limits::FPS;
+        let (lo, hi) = (f64::from(*rates.start()), f64::from(*rates.end()));
+        let expected = format!(
+            "fps must be a whole number from {lo} to {hi}, an NTSC rate (23.976, 29.97, 59.94) or a ratio \"A/B\""
+        );
+        let fps = match self {
+            FpsSpec::Number(n) if n.fract() == 0.0 && (lo..=hi).contains(n) => {
+                Fps::whole(*n as u32)
+            }
+            FpsSpec::Number(n) => {
+                let whole = (n * 1.001).round();
+                let ntsc = whole * 1000.0 / 1001.0;
+                if !((lo..=hi).contains(&whole) && (n - ntsc).abs() < 5e-4) {
+                    return Err(format!("{expected}, not {n}"));
+                }
+                Fps {
+                    num: whole as u32 * 1000,
+                    den: 1001,
+                }
+            }
+            FpsSpec::Ratio(text) => {
+                let parsed = text.split_once('/').and_then(|(a, b)| {
+                    Some((a.trim().parse::<u32>().ok()?, b.trim().parse::<u32>().ok()?))
+                });
+                let Some((a, b)) = parsed.filter(|&(a, b)| a > 0 && b > 0) else {
+                    return Err(format!("{expected}, not \"{text}\""));
+                };
+                let g = gcd(a, b);
+                Fps {
+                    num: a / g,
+                    den: b / g,
+                }
+            }
+        };
+        if (lo..=hi).contains(&fps.as_f64()) {
+            Ok(fps)
+        } else {
+            Err(format!("{expected}, not {fps} ({} fps)", fps.as_f64()))
+        }
+    }
+}
+
+fn gcd(a: u32, b: u32) -> u32 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+impl<'de> Deserialize<'de> for FpsSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Rate;
+        impl Visitor<'_> for Rate {
+            type Value = FpsSpec;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number of frames per second or a ratio \"A/B\"")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<FpsSpec, E> {
+                Ok(FpsSpec::Number(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<FpsSpec, E> {
+                Ok(FpsSpec::Number(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<FpsSpec, E> {
+                Ok(FpsSpec::Number(v as f64))
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<FpsSpec, E> {
+                Ok(FpsSpec::Ratio(v.to_string()))
+            }
+        }
+        d.deserialize_any(Rate)
+    }
+}
+
+/// A key's time: seconds, or `Frames(n)` at the spec's rate.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(untagged, expecting = "expected a number of seconds, or `Frames(n)`")]
+pub enum KeyTime {
+    Seconds(f64),
+    Counted(TimeUnit),
+}
+
+/// A time written with its unit.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+pub enum TimeUnit {
+    Frames(f64),
+    Seconds(f64),
+}
+
+impl KeyTime {
+    /// The time in seconds at `fps`.
+    pub fn seconds(self, fps: Fps) -> f64 {
+        match self {
+            KeyTime::Seconds(s) | KeyTime::Counted(TimeUnit::Seconds(s)) => s,
+            KeyTime::Counted(TimeUnit::Frames(n)) => fps.seconds(n),
+        }
+    }
 }
 
 fn default_output() -> String {
@@ -218,7 +335,7 @@ pub struct TrackSpec {
 
 impl TrackSpec {
     /// The times of every key the track itself writes.
-    pub fn key_times(&self) -> impl Iterator<Item = f64> + '_ {
+    pub fn key_times(&self) -> impl Iterator<Item = KeyTime> + '_ {
         key_times(&self.translate)
             .chain(key_times(&self.rotate))
             .chain(key_times(&self.scale))
@@ -266,8 +383,8 @@ pub enum AimSpec {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct KeySpec<T> {
-    /// Seconds from the start of the animation.
-    pub at: f64,
+    /// Seconds from the start of the animation, or `Frames(n)`.
+    pub at: KeyTime,
     pub value: T,
     /// How to move from this key to the next one.
     #[serde(default)]

@@ -416,7 +416,9 @@ impl Checker<'_> {
         let mut out = Vec::with_capacity(keys.len());
         for (i, k) in keys.iter().enumerate() {
             let key_path = index(&path, i);
-            self.key_time(k.at, i.checked_sub(1).map(|p| keys[p].at), &key_path);
+            let at = k.at.seconds(self.fps);
+            let previous = i.checked_sub(1).map(|p| keys[p].at.seconds(self.fps));
+            self.key_time(at, previous, &key_path);
             self.key_curve(k, &key_path);
             if k.interp.is_spline() {
                 self.err(
@@ -436,7 +438,7 @@ impl Checker<'_> {
                 }
             };
             out.push(Key {
-                at: k.at,
+                at,
                 value,
                 interp: k.interp,
             });

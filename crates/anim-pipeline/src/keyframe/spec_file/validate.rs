@@ -3,8 +3,8 @@
 //! spec, so that one run shows everything to fix.
 
 use super::checker::{names_list, non_negative3, rgb, Checker};
-use super::model::{Animation, End, NamePattern, Orbit, SceneNames, TargetKind};
-use super::raw::{Length, OrbitSpec, SpecFile};
+use super::model::{Animation, End, Fps, NamePattern, Orbit, SceneNames, TargetKind};
+use super::raw::{FpsSpec, Length, OrbitSpec, SpecFile};
 use super::source::Source;
 use crate::keyframe::interp::Timing;
 use crate::keyframe::tidy::tidy;
@@ -24,11 +24,12 @@ pub fn validate(
     src: &Source,
 ) -> Result<Animation, Vec<Diagnostic>> {
     let mut c = Checker::new(src);
-    let fps = c.fps(spec.fps);
+    let fps = c.fps(&spec.fps);
+    c.fps = fps;
     let frames = c.frame_count(spec.length, fps, spec.end);
     c.duration = match spec.end {
-        End::Cyclic => frames as f64 / fps as f64,
-        End::Inclusive => frames.saturating_sub(1) as f64 / fps as f64,
+        End::Cyclic => fps.seconds(frames as f64),
+        End::Inclusive => fps.seconds(frames.saturating_sub(1) as f64),
     };
     let (width, height) = c.image_size(spec);
     let output = c.output(spec);
@@ -51,7 +52,7 @@ pub fn validate(
     );
     let orbit_camera = orbit.is_some().then_some(camera.as_str());
     let tracks = c.tracks(spec, names, orbit_camera);
-    let last_frame = frames.saturating_sub(1) as f64 / fps as f64;
+    let last_frame = fps.seconds(frames.saturating_sub(1) as f64);
     if spec.end == End::Cyclic {
         c.unshown_last_keys(&tracks, &ambient, &background, last_frame);
     }
@@ -78,20 +79,11 @@ pub fn validate(
 
 impl Checker<'_> {
     /// The frame rate; the default rate when it is wrong, so that checking can go on.
-    fn fps(&mut self, fps: f64) -> u32 {
-        let rates = limits::FPS;
-        if fps.fract() == 0.0 && (*rates.start() as f64..=*rates.end() as f64).contains(&fps) {
-            return fps as u32;
-        }
-        self.err(
-            &["fps"],
-            format!(
-                "fps must be a whole number from {} to {}, not {fps}",
-                rates.start(),
-                rates.end()
-            ),
-        );
-        24
+    fn fps(&mut self, fps: &FpsSpec) -> Fps {
+        fps.exact().unwrap_or_else(|why| {
+            self.err(&["fps"], why);
+            Fps::whole(24)
+        })
     }
 
     /// The shutter fraction; 0 (no blur) when it is wrong, so that checking can go on.
@@ -107,7 +99,7 @@ impl Checker<'_> {
     }
 
     /// The number of frames; a usable stand-in when the length is wrong.
-    fn frame_count(&mut self, length: Length, fps: u32, end: End) -> usize {
+    fn frame_count(&mut self, length: Length, fps: Fps, end: End) -> usize {
         let frames = match length {
             Length::Frames(n) => {
                 if !(n.fract() == 0.0 && n >= 1.0) {
@@ -134,8 +126,9 @@ impl Checker<'_> {
         }
     }
 
-    fn frames_in_seconds(&mut self, s: f64, fps: u32) -> f64 {
-        let exact = s * fps as f64;
+    /// The frames in `s` seconds of timecode at `fps` (`Fps::timecode_rate`).
+    fn frames_in_seconds(&mut self, s: f64, fps: Fps) -> f64 {
+        let exact = s * fps.timecode_rate();
         let n = exact.round();
         if !s.is_finite() || s <= 0.0 {
             self.err(
