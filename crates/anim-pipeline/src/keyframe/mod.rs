@@ -9,6 +9,7 @@
 //! [`generate`] writes the frames.
 
 pub mod base;
+pub mod expr;
 pub mod generate;
 pub mod interp;
 pub mod keyed;
