@@ -4,6 +4,7 @@
 //! `EaseIn` on a key means the motion towards the next key starts slowly. The curves are
 //! documented for users in `docs/animation.md` ("Keys and curves").
 
+use super::expr::Val;
 use glam::DVec3;
 use serde::Deserialize;
 use std::f64::consts::PI;
@@ -204,6 +205,10 @@ fn cubic_bezier(x1: f64, y1: f64, x2: f64, y2: f64, s: f64) -> f64 {
 pub trait Keyable: Copy {
     /// How many numbers the value holds.
     const COMPONENTS: usize;
+    /// As an expression sees it (`value`).
+    fn to_val(self) -> Val;
+    /// An expression's result as this kind of value (a number on every axis of a vector).
+    fn from_val(v: Val) -> Self;
     fn add(self, o: Self) -> Self;
     fn sub(self, o: Self) -> Self;
     fn mul(self, k: f64) -> Self;
@@ -213,6 +218,12 @@ pub trait Keyable: Copy {
 
 impl Keyable for f64 {
     const COMPONENTS: usize = 1;
+    fn to_val(self) -> Val {
+        Val::Num(self)
+    }
+    fn from_val(v: Val) -> Self {
+        v.num()
+    }
     fn add(self, o: Self) -> Self {
         self + o
     }
@@ -232,6 +243,12 @@ impl Keyable for f64 {
 
 impl Keyable for DVec3 {
     const COMPONENTS: usize = 3;
+    fn to_val(self) -> Val {
+        Val::Vec(self)
+    }
+    fn from_val(v: Val) -> Self {
+        v.vec()
+    }
     fn add(self, o: Self) -> Self {
         self + o
     }

@@ -357,10 +357,11 @@ fn load_base(
 }
 
 /// What `anim check` would say of the first frame file, said once here rather than by every
-/// frame at render time: its text loaded as `anim check` loads a file (every warning of the
-/// reader and the builder, then what the camera would show), each warning moved from the
-/// frame's line to the statement it is about, in the base scene where a base statement is the
-/// cause. A frame that cannot be made yields nothing: writing the frames reports that.
+/// frame at render time, in the base scene where a base statement is the cause: the frame's
+/// statements built as the renderer builds them (each warning at the statement's own place),
+/// what the camera would show, and then every other warning of the frame's text loaded as
+/// `anim check` loads a file, moved from the frame's line to the statement written there. A
+/// frame that cannot be made yields nothing: writing the frames reports that.
 fn first_frame_warnings(
     base: &BaseScene,
     anim: &Animation,
@@ -376,6 +377,14 @@ fn first_frame_warnings(
         SceneSource::File(rel) => spec_dir.join(rel),
         SceneSource::Inline(_) => src.path.to_path_buf(),
     };
+    let Ok(built) = anim_core::load::build(&statements, &path, &LoadOptions::default()) else {
+        return Vec::new();
+    };
+    let mut warnings = built.diagnostics;
+    warnings.extend(anim_core::load::probe::blank_image_warnings(
+        &built.jobs,
+        &path,
+    ));
     let text = generator.write_frame(0, &statements, None);
     // Read where the base scene is, so that its mesh files are found as written there.
     let opts = LoadOptions {
@@ -384,32 +393,35 @@ fn first_frame_warnings(
         allow_any_input: true,
         ..LoadOptions::default()
     };
-    let Ok(loaded) = anim_core::load::load_str(&text, &path, &opts) else {
-        return Vec::new();
-    };
-    let mut warnings = loaded.diagnostics;
-    warnings.extend(anim_core::load::probe::blank_image_warnings(
-        &loaded.jobs,
-        &path,
-    ));
-    // The frame's lines: its header, then one statement a line.
-    let header = text.lines().count() - statements.len();
-    let warnings = warnings.into_iter().map(|mut d| {
-        let made_by = d.loc.as_ref().filter(|l| *l.file == *path).and_then(|l| {
-            let line = (l.line as usize).checked_sub(header + 1)?;
-            statements.get(line)
-        });
-        if let Some(s) = made_by {
-            d.loc = Some(s.loc.clone());
-            d.file = s.loc.file.to_path_buf();
-            d.source_line = None;
+    if let Ok(loaded) = anim_core::load::load_str(&text, &path, &opts) {
+        // The frame's lines: its header, then one statement a line.
+        let header = text.lines().count() - statements.len();
+        for mut d in loaded.diagnostics {
+            let made_by = d.loc.as_ref().filter(|l| *l.file == *path).and_then(|l| {
+                let line = (l.line as usize).checked_sub(header + 1)?;
+                statements.get(line)
+            });
+            if let Some(s) = made_by {
+                d.loc = Some(s.loc.clone());
+                d.file = s.loc.file.to_path_buf();
+                d.source_line = None;
+            }
+            let line = |d: &Diagnostic| d.loc.as_ref().map(|l| (l.file.clone(), l.line));
+            if !warnings
+                .iter()
+                .any(|w| w.message == d.message && line(w) == line(&d))
+            {
+                warnings.push(d);
+            }
         }
-        d
-    });
-    match scene {
-        SceneSource::Inline(_) => warnings.map(|d| shift_into_spec(d, src)).collect(),
-        SceneSource::File(_) => warnings.collect(),
     }
+    if matches!(scene, SceneSource::Inline(_)) {
+        warnings = warnings
+            .into_iter()
+            .map(|d| shift_into_spec(d, src))
+            .collect();
+    }
+    warnings
 }
 
 /// Points the base scene's OBJ files (`define shape obj`, relative to the base scene) at the

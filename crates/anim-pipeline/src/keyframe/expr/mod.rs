@@ -278,6 +278,27 @@ impl Expr {
         eval::eval(&self.nodes, &env, &named)
     }
 
+    /// A value that is the same at every time.
+    pub fn constant(v: Val) -> Expr {
+        let (nodes, ty) = match v {
+            Val::Num(n) => (vec![Node::Num(n)], Ty::Num),
+            Val::Vec(v) => (
+                vec![
+                    Node::Num(v.x),
+                    Node::Num(v.y),
+                    Node::Num(v.z),
+                    Node::Vec3([0, 1, 2]),
+                ],
+                Ty::Vec,
+            ),
+        };
+        Expr {
+            nodes,
+            ty,
+            named: Arc::default(),
+        }
+    }
+
     fn last_named_use(&self) -> Option<usize> {
         self.nodes
             .iter()

@@ -1,20 +1,43 @@
 //! The checked animation: what the generator needs, with every value valid.
 
+use crate::keyframe::expr::{Expr, Val};
 use crate::keyframe::interp::{cycled_time, sample_timed, segment, Interp, Key, Keyable, Timing};
 use anim_core::limits;
 use glam::{DQuat, DVec3};
+use std::sync::Arc;
 
-/// A keyed channel with the path of its key list (for messages about interpolated values).
+/// A keyed channel with the path of its key list (for messages about interpolated values),
+/// and the expression over it, if any.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Channel<T> {
     pub keys: Vec<Key<T>>,
     pub timing: Timing,
     pub path: String,
+    pub expr: Option<Driven>,
+}
+
+/// A channel's expression, with what it reads besides the time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Driven {
+    pub expr: Arc<Expr>,
+    /// `value` where the channel has no keys: the base scene's value (no motion, for motion).
+    pub base: Val,
+    pub fps: f64,
+    /// `wiggle`'s noise: drawn from the target's and the channel's names.
+    pub seed: u64,
+    /// The expression's text in the spec, for messages.
+    pub path: String,
 }
 
 impl<T: Keyable> Channel<T> {
+    /// The value at time `t`: the keys', then the expression's over them.
     pub fn at(&self, t: f64) -> Option<T> {
-        sample_timed(&self.keys, t, &self.timing)
+        let keyed = sample_timed(&self.keys, t, &self.timing);
+        let Some(d) = &self.expr else {
+            return keyed;
+        };
+        let value = keyed.map_or(d.base, T::to_val);
+        Some(T::from_val(d.expr.eval(t, d.fps, value, d.seed)))
     }
 }
 
@@ -391,4 +414,7 @@ pub trait SceneNames {
     /// Whether the base scene defines a material named `name` (a thing of the same name
     /// shadows it for tracks that key the thing's own channels).
     fn has_material(&self, name: &str) -> bool;
+    /// The value the base scene gives `channel` of `target` (of the scene for `ambient` and
+    /// `background`), as an expression reads it as `value` where no key sets it.
+    fn base_value(&self, target: &str, channel: &str) -> Option<Val>;
 }

@@ -47,10 +47,14 @@ pub struct SpecFile {
     pub orbit: Option<OrbitSpec>,
     /// Keyed ambient light (replaces the base scene's).
     #[serde(default)]
-    pub ambient: Vec<KeySpec<Rgb>>,
+    pub ambient: ChannelSpec<Rgb>,
     /// Keyed background colour (replaces the base scene's).
     #[serde(default)]
-    pub background: Vec<KeySpec<Rgb>>,
+    pub background: ChannelSpec<Rgb>,
+    /// Named values that expressions may use: a number, a vector or an expression (of `t`,
+    /// `frame`, `fps` and the values above it), in order.
+    #[serde(default)]
+    pub values: NamedValues,
     #[serde(default)]
     pub tracks: Vec<TrackSpec>,
     /// Named sets of keyed channels that tracks use with `curve: "name"`.
@@ -66,8 +70,8 @@ impl SpecFile {
     /// them). Keys written in frames count at the spec's rate (24 fps where it is wrong).
     pub fn key_times(&self) -> Vec<f64> {
         let fps = self.fps.exact().unwrap_or(Fps::whole(24));
-        let mut times: Vec<f64> = key_times(&self.ambient)
-            .chain(key_times(&self.background))
+        let mut times: Vec<f64> = key_times(&self.ambient.keys)
+            .chain(key_times(&self.background.keys))
             .map(|at| at.seconds(fps))
             .collect();
         for t in self.tracks.iter().chain(&self.curves) {
@@ -261,15 +265,15 @@ pub struct TrackSpec {
     #[serde(default)]
     pub curve: Option<String>,
     #[serde(default)]
-    pub translate: Vec<KeySpec<V3>>,
+    pub translate: ChannelSpec<V3>,
     /// Degrees about `axis`.
     #[serde(default)]
-    pub rotate: Vec<KeySpec<f64>>,
+    pub rotate: ChannelSpec<f64>,
     #[serde(default)]
     pub axis: Option<V3>,
     /// A number (uniform) or (x, y, z) per key.
     #[serde(default)]
-    pub scale: Vec<KeySpec<Scale>>,
+    pub scale: ChannelSpec<Scale>,
     /// Centre of rotation and scaling; default: the object's centre as the base scene places it.
     #[serde(default)]
     pub pivot: Option<V3>,
@@ -287,35 +291,35 @@ pub struct TrackSpec {
     pub up: Option<V3>,
     /// With `look_at`: degrees about the line of sight.
     #[serde(default)]
-    pub roll: Vec<KeySpec<f64>>,
+    pub roll: ChannelSpec<f64>,
     /// With `look_at` on an object: the direction that faces the target (default −z).
     #[serde(default)]
     pub forward: Option<V3>,
     /// Lights only.
     #[serde(default)]
-    pub brightness: Vec<KeySpec<f64>>,
+    pub brightness: ChannelSpec<f64>,
     /// Lights only.
     #[serde(default)]
-    pub color: Vec<KeySpec<Rgb>>,
+    pub color: ChannelSpec<Rgb>,
     /// Cameras only: horizontal field of view in degrees.
     #[serde(default)]
-    pub fov: Vec<KeySpec<f64>>,
+    pub fov: ChannelSpec<f64>,
     /// Materials only: ambient, diffuse and specular colours.
     #[serde(default)]
-    pub ka: Vec<KeySpec<Rgb>>,
+    pub ka: ChannelSpec<Rgb>,
     #[serde(default)]
-    pub kd: Vec<KeySpec<Rgb>>,
+    pub kd: ChannelSpec<Rgb>,
     #[serde(default)]
-    pub ks: Vec<KeySpec<Rgb>>,
+    pub ks: ChannelSpec<Rgb>,
     /// Materials only: 0–1.
     #[serde(default)]
-    pub reflectivity: Vec<KeySpec<f64>>,
+    pub reflectivity: ChannelSpec<f64>,
     /// Materials only: 0–1, 1 opaque.
     #[serde(default)]
-    pub opacity: Vec<KeySpec<f64>>,
+    pub opacity: ChannelSpec<f64>,
     /// Materials only: index of refraction, > 0.
     #[serde(default)]
-    pub ior: Vec<KeySpec<f64>>,
+    pub ior: ChannelSpec<f64>,
     /// Shapes and composites: shown (`true`) or not, stepped.
     #[serde(default)]
     pub visible: Vec<KeySpec<bool>>,
@@ -336,20 +340,20 @@ pub struct TrackSpec {
 impl TrackSpec {
     /// The times of every key the track itself writes.
     pub fn key_times(&self) -> impl Iterator<Item = KeyTime> + '_ {
-        key_times(&self.translate)
-            .chain(key_times(&self.rotate))
-            .chain(key_times(&self.scale))
+        key_times(&self.translate.keys)
+            .chain(key_times(&self.rotate.keys))
+            .chain(key_times(&self.scale.keys))
             .chain(key_times(&self.orient))
-            .chain(key_times(&self.roll))
-            .chain(key_times(&self.brightness))
-            .chain(key_times(&self.color))
-            .chain(key_times(&self.fov))
-            .chain(key_times(&self.ka))
-            .chain(key_times(&self.kd))
-            .chain(key_times(&self.ks))
-            .chain(key_times(&self.reflectivity))
-            .chain(key_times(&self.opacity))
-            .chain(key_times(&self.ior))
+            .chain(key_times(&self.roll.keys))
+            .chain(key_times(&self.brightness.keys))
+            .chain(key_times(&self.color.keys))
+            .chain(key_times(&self.fov.keys))
+            .chain(key_times(&self.ka.keys))
+            .chain(key_times(&self.kd.keys))
+            .chain(key_times(&self.ks.keys))
+            .chain(key_times(&self.reflectivity.keys))
+            .chain(key_times(&self.opacity.keys))
+            .chain(key_times(&self.ior.keys))
             .chain(key_times(&self.visible))
             .chain(match &self.look_at {
                 Some(AimSpec::Keys(k)) => k.iter().map(|k| k.at).collect::<Vec<_>>(),
@@ -477,5 +481,184 @@ impl<'de> Deserialize<'de> for Rgb {
             scalar_ok: true,
         })
         .map(Rgb)
+    }
+}
+
+/// A keyed channel as written: a list of keys, `Expr("…")` (the whole channel a formula) or
+/// `Expr("…", [keys])` (a formula over the keyed value). The name `Expr` itself is checked
+/// against the text ([`super::source::Source`] records it), as serde passes it over.
+#[derive(Debug)]
+pub struct ChannelSpec<T> {
+    pub keys: Vec<KeySpec<T>>,
+    pub expr: Option<String>,
+}
+
+impl<T> Default for ChannelSpec<T> {
+    fn default() -> Self {
+        ChannelSpec {
+            keys: Vec::new(),
+            expr: None,
+        }
+    }
+}
+
+impl<T> ChannelSpec<T> {
+    /// Whether it keys nothing.
+    pub fn is_empty(&self) -> bool {
+        self.keys.is_empty() && self.expr.is_none()
+    }
+
+    /// The path of its keys, given the channel's: inside `Expr("…", [keys])` they are its
+    /// second part.
+    pub fn keys_path(&self, path: &str) -> String {
+        match self.expr {
+            Some(_) => format!("{path}[1]"),
+            None => path.to_string(),
+        }
+    }
+}
+
+/// One part of a channel's list: a key, the text of an expression, or a list of keys.
+enum ChannelPart<T> {
+    Key(KeySpec<T>),
+    Text(String),
+    Keys(Vec<KeySpec<T>>),
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for ChannelPart<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Part<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> Visitor<'de> for Part<T> {
+            type Value = ChannelPart<T>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a key `(at: …, value: …)`")
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Self::Value, E> {
+                Ok(ChannelPart::Text(v.to_string()))
+            }
+            fn visit_map<A: de::MapAccess<'de>>(self, m: A) -> Result<Self::Value, A::Error> {
+                KeySpec::deserialize(de::value::MapAccessDeserializer::new(m)).map(ChannelPart::Key)
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+                let mut keys = Vec::new();
+                while let Some(k) = seq.next_element::<KeySpec<T>>()? {
+                    keys.push(k);
+                }
+                Ok(ChannelPart::Keys(keys))
+            }
+        }
+        d.deserialize_any(Part(std::marker::PhantomData))
+    }
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for ChannelSpec<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Channel<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> Visitor<'de> for Channel<T> {
+            type Value = ChannelSpec<T>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a list of keys `[(at: …, value: …), …]` or `Expr(\"…\")`")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+                let mut parts = Vec::new();
+                while let Some(p) = seq.next_element::<ChannelPart<T>>()? {
+                    parts.push(p);
+                }
+                let mut out = ChannelSpec::default();
+                let mut parts = parts.into_iter();
+                match parts.next() {
+                    Some(ChannelPart::Text(text)) => {
+                        out.expr = Some(text);
+                        match (parts.next(), parts.next()) {
+                            (None, _) => {}
+                            (Some(ChannelPart::Keys(keys)), None) => out.keys = keys,
+                            _ => return Err(de::Error::custom(EXPR_FORM)),
+                        }
+                    }
+                    Some(ChannelPart::Key(first)) => {
+                        out.keys.push(first);
+                        for p in parts {
+                            match p {
+                                ChannelPart::Key(k) => out.keys.push(k),
+                                _ => return Err(de::Error::custom("expected a key `(at: …, value: …)`: a list of keys holds keys only")),
+                            }
+                        }
+                    }
+                    Some(ChannelPart::Keys(_)) => return Err(de::Error::custom(EXPR_FORM)),
+                    None => {}
+                }
+                Ok(out)
+            }
+        }
+        d.deserialize_any(Channel(std::marker::PhantomData))
+    }
+}
+
+/// How an expression over keys is written.
+const EXPR_FORM: &str =
+    "an expression is written `Expr(\"…\")`, or `Expr(\"…\", [keys])` over keys that it reads as `value`";
+
+/// The spec's named values, in the order written.
+#[derive(Debug, Default)]
+pub struct NamedValues(pub Vec<(String, NamedValue)>);
+
+/// A named value: a number, a vector, or an expression.
+#[derive(Debug, Clone, PartialEq)]
+pub enum NamedValue {
+    Number(f64),
+    Vector(DVec3),
+    Expr(String),
+}
+
+impl<'de> Deserialize<'de> for NamedValue {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Value;
+        impl<'de> Visitor<'de> for Value {
+            type Value = NamedValue;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number, three numbers (x, y, z) or an expression in double quotes")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<NamedValue, E> {
+                Ok(NamedValue::Number(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<NamedValue, E> {
+                Ok(NamedValue::Number(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<NamedValue, E> {
+                Ok(NamedValue::Number(v as f64))
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<NamedValue, E> {
+                Ok(NamedValue::Expr(v.to_string()))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<NamedValue, A::Error> {
+                let v = TripleVisitor {
+                    what: "three numbers (x, y, z)",
+                    scalar_ok: false,
+                }
+                .visit_seq(seq)?;
+                Ok(NamedValue::Vector(v))
+            }
+        }
+        d.deserialize_any(Value)
+    }
+}
+
+impl<'de> Deserialize<'de> for NamedValues {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Values;
+        impl<'de> Visitor<'de> for Values {
+            type Value = NamedValues;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("named values `{\"name\": value, …}`")
+            }
+            fn visit_map<A: de::MapAccess<'de>>(self, mut m: A) -> Result<NamedValues, A::Error> {
+                let mut out = Vec::new();
+                while let Some((name, value)) = m.next_entry::<String, NamedValue>()? {
+                    out.push((name, value));
+                }
+                Ok(NamedValues(out))
+            }
+        }
+        d.deserialize_map(Values)
     }
 }

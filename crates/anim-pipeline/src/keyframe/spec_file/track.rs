@@ -3,12 +3,13 @@
 
 use super::checker::{
     names_list, non_negative, non_negative3, non_zero3, number, positive, rgb, unit_interval,
-    valid_fov, Checker,
+    valid_fov, ChannelAt, Checker, ValueCheck,
 };
 use super::model::{
     Aim, AimTarget, Channel, MaterialChannels, OrientChannel, SceneNames, TargetKind, Track,
 };
-use super::raw::{AimSpec, KeySpec, Orientation, Scale, SpecFile, TrackSpec, V3};
+use super::raw::{AimSpec, ChannelSpec, KeySpec, Orientation, Scale, SpecFile, TrackSpec, V3};
+use crate::keyframe::expr::Val;
 use crate::keyframe::interp::{Cycle, Interp, Key, Timing};
 use crate::keyframe::locate::{field, index};
 use crate::keyframe::rotation::{euler, EulerOrder};
@@ -23,6 +24,20 @@ struct Sources<'s> {
 }
 
 impl<'s> Sources<'s> {
+    /// Channel `name` as written (keys, an expression, or both) and its path in the spec: the
+    /// track's own, else its curve's.
+    fn spec<S>(
+        &self,
+        name: &str,
+        get: impl Fn(&'s TrackSpec) -> &'s ChannelSpec<S>,
+    ) -> (&'s ChannelSpec<S>, String) {
+        let own = get(self.track);
+        match &self.curve {
+            Some((curve, path)) if own.is_empty() => (get(curve), field(path, name)),
+            _ => (own, field(&self.path, name)),
+        }
+    }
+
     /// The keys of channel `name` and their path in the spec.
     fn keys<S>(
         &self,
@@ -228,21 +243,22 @@ impl Checker<'_> {
             }
         });
         let timing = self.timing(s, default_looping);
-        let translate = self.keys(s, "translate", |t| &t.translate, timing, |v: &V3| v.0);
-        let (rotate_keys, rotate_path) = s.keys("rotate", |t| &t.rotate);
-        let rotate = self.channel(rotate_keys, &rotate_path, timing, number, None);
-        let (scale_keys, scale_path) = s.keys("scale", |t| &t.scale);
-        let scale = self.channel(
-            scale_keys,
-            &scale_path,
-            timing,
-            |v: &Scale| v.0,
-            Some(non_zero3),
-        );
+        let motion = |c: &mut Self, name: &str, get: fn(&TrackSpec) -> &ChannelSpec<_>| {
+            let (spec, path) = s.spec(name, get);
+            let at = ChannelAt::new(&path, target_name(t), name, Val::Vec(DVec3::ZERO));
+            c.keyed(spec, at, timing, |v: &V3| v.0, None)
+        };
+        let translate = motion(self, "translate", |t| &t.translate);
+        let (spec, at_path) = s.spec("rotate", |t| &t.rotate);
+        let at = ChannelAt::new(&at_path, target_name(t), "rotate", Val::Num(0.0));
+        let rotate = self.keyed(spec, at, timing, number, None);
+        let (spec, at_path) = s.spec("scale", |t| &t.scale);
+        let at = ChannelAt::new(&at_path, target_name(t), "scale", Val::Vec(DVec3::ONE));
+        let scale = self.keyed(spec, at, timing, |v: &Scale| v.0, Some(non_zero3));
         let orient = self.orient(s, timing);
         let aim = self.aim(s, timing, kind);
-        let (brightness, color, fov) = self.parameters(s, timing);
-        let material = self.material(s, timing);
+        let (brightness, color, fov) = self.parameters(s, timing, names);
+        let material = self.material(s, timing, names);
         let visible = self.visible(s, timing);
         let axis = self.axis_and_pivot(s);
         if !keyed_channels(t).iter().any(|(_, keyed)| *keyed) && s.curve.is_none() {
@@ -275,53 +291,86 @@ impl Checker<'_> {
         })
     }
 
-    /// A channel of 3-vectors that takes any finite value.
-    fn keys<S>(
-        &mut self,
-        s: &Sources,
-        name: &str,
-        get: impl for<'t> Fn(&'t TrackSpec) -> &'t [KeySpec<S>],
-        timing: Timing,
-        value: impl Fn(&S) -> DVec3,
-    ) -> Option<Channel<DVec3>> {
-        let (keys, path) = s.keys(name, get);
-        self.channel(keys, &path, timing, value, None)
-    }
-
     /// Light and camera parameters: brightness, colour, field of view.
     #[allow(clippy::type_complexity)]
     fn parameters(
         &mut self,
         s: &Sources,
         timing: Timing,
+        names: &dyn SceneNames,
     ) -> (
         Option<Channel<f64>>,
         Option<Channel<DVec3>>,
         Option<Channel<f64>>,
     ) {
-        let (keys, path) = s.keys("brightness", |t| &t.brightness);
-        let brightness = self.channel(keys, &path, timing, number, Some(non_negative));
-        let (keys, path) = s.keys("color", |t| &t.color);
-        let color = self.channel(keys, &path, timing, rgb, Some(non_negative3));
-        let (keys, path) = s.keys("fov", |t| &t.fov);
-        let fov = self.channel(keys, &path, timing, number, Some(valid_fov));
+        let brightness = self.value(
+            s,
+            names,
+            "brightness",
+            |t| &t.brightness,
+            timing,
+            non_negative,
+        );
+        let (spec, path) = s.spec("color", |t| &t.color);
+        let at = self.base_of(s, names, &path, "color");
+        let color = self.keyed(spec, at, timing, rgb, Some(non_negative3));
+        let fov = self.value(s, names, "fov", |t| &t.fov, timing, valid_fov);
         (brightness, color, fov)
     }
 
-    fn material(&mut self, s: &Sources, timing: Timing) -> MaterialChannels {
-        let colour = |c: &mut Self, name: &str, get: fn(&TrackSpec) -> &[KeySpec<_>]| {
-            let (keys, path) = s.keys(name, get);
-            c.channel(keys, &path, timing, rgb, Some(non_negative3))
+    /// Where channel `name` of the track's target is, reading the base scene's value where no
+    /// key sets it.
+    fn base_of<'p>(
+        &self,
+        s: &Sources,
+        names: &dyn SceneNames,
+        path: &'p str,
+        name: &str,
+    ) -> ChannelAt<'p> {
+        let target = target_name(s.track);
+        let base = names.base_value(target, name).unwrap_or(Val::Num(0.0));
+        ChannelAt::new(path, target, name, base)
+    }
+
+    /// A numeric channel of the target's definition, its keys checked by `check`.
+    fn value(
+        &mut self,
+        s: &Sources,
+        names: &dyn SceneNames,
+        name: &str,
+        get: fn(&TrackSpec) -> &ChannelSpec<f64>,
+        timing: Timing,
+        check: ValueCheck,
+    ) -> Option<Channel<f64>> {
+        let (spec, path) = s.spec(name, get);
+        let at = self.base_of(s, names, &path, name);
+        self.keyed(spec, at, timing, number, Some(check))
+    }
+
+    fn material(
+        &mut self,
+        s: &Sources,
+        timing: Timing,
+        names: &dyn SceneNames,
+    ) -> MaterialChannels {
+        let colour = |c: &mut Self, name: &str, get: fn(&TrackSpec) -> &ChannelSpec<_>| {
+            let (spec, path) = s.spec(name, get);
+            let at = c.base_of(s, names, &path, name);
+            c.keyed(spec, at, timing, rgb, Some(non_negative3))
         };
         let ka = colour(self, "ka", |t| &t.ka);
         let kd = colour(self, "kd", |t| &t.kd);
         let ks = colour(self, "ks", |t| &t.ks);
-        let (keys, path) = s.keys("reflectivity", |t| &t.reflectivity);
-        let reflectivity = self.channel(keys, &path, timing, number, Some(unit_interval));
-        let (keys, path) = s.keys("opacity", |t| &t.opacity);
-        let opacity = self.channel(keys, &path, timing, number, Some(unit_interval));
-        let (keys, path) = s.keys("ior", |t| &t.ior);
-        let ior = self.channel(keys, &path, timing, number, Some(positive));
+        let reflectivity = self.value(
+            s,
+            names,
+            "reflectivity",
+            |t| &t.reflectivity,
+            timing,
+            unit_interval,
+        );
+        let opacity = self.value(s, names, "opacity", |t| &t.opacity, timing, unit_interval);
+        let ior = self.value(s, names, "ior", |t| &t.ior, timing, positive);
         MaterialChannels {
             ka,
             kd,
@@ -447,6 +496,7 @@ impl Checker<'_> {
             keys: out,
             timing,
             path,
+            expr: None,
         })
     }
 
@@ -506,6 +556,7 @@ impl Checker<'_> {
                         keys: Vec::new(),
                         timing,
                         path: path.clone(),
+                        expr: None,
                     }),
             ),
             AimSpec::Object(name) => AimTarget::Object(name.clone()),
@@ -549,8 +600,9 @@ impl Checker<'_> {
                 ),
             );
         }
-        let (keys, roll_path) = s.keys("roll", |t| &t.roll);
-        let roll = self.channel(keys, &roll_path, timing, number, None);
+        let (spec, roll_path) = s.spec("roll", |t| &t.roll);
+        let at = ChannelAt::new(&roll_path, target_name(s.track), "roll", Val::Num(0.0));
+        let roll = self.keyed(spec, at, timing, number, None);
         Some(Aim {
             target,
             up,
@@ -833,7 +885,8 @@ fn never_shown<T: crate::keyframe::interp::Keyable + PartialEq>(
     c: &Option<Channel<T>>,
     last_frame: f64,
 ) {
-    let Some(c) = c else {
+    // An expression shows on every frame whatever its keys do.
+    let Some(c) = c.as_ref().filter(|c| c.expr.is_none()) else {
         return;
     };
     let (Some(first), Some(last)) = (c.keys.first(), c.keys.last()) else {
