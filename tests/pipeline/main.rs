@@ -11,6 +11,7 @@
 //! - `bench`: `anim bench` at its tiny size, and the files it writes.
 //! - `animator`: aim, orientation keys, the inclusive end, curves kept in range, materials,
 //!   visibility, reuse, the early check of the base scene, and the example specs' frames.
+//! - `expressions`: channels as formulas of time, named values, noise.
 //! - `generated_frames`: frames read as what they say (no inference), and the first-frame
 //!   check that says what `anim check` would.
 //! - `timing`: keys at `Frames(n)`, fractional frame rates, `--frames A..B`.
@@ -22,6 +23,7 @@ mod common;
 
 mod animator;
 mod bench;
+mod expressions;
 mod frames;
 mod generated_frames;
 mod holds;
