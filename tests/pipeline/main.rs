@@ -15,6 +15,7 @@
 //! - `generated_frames`: frames read as what they say (no inference), and the first-frame
 //!   check that says what `anim check` would.
 //! - `timing`: keys at `Frames(n)`, fractional frame rates, `--frames A..B`.
+//! - `layering`: tracks on one value combined by `blend`, or refused without it.
 //! - `service`: the one way from a scene file to images in memory, which `anim render` and
 //!   `anim preview` share, and the files a frame's fingerprint follows.
 
@@ -28,6 +29,7 @@ mod frames;
 mod generated_frames;
 mod holds;
 mod keyframe_spec;
+mod layering;
 mod service;
 mod split;
 mod timing;

@@ -130,7 +130,7 @@ impl<'a> Generator<'a> {
 
         for (k, track) in anim.tracks.iter().enumerate() {
             keyed::set_parameters(&mut out, track, t, self.src, &when)?;
-            keyed::set_material(&mut out, track, t);
+            keyed::set_material(&mut out, track, t, self.src, &when)?;
             if self.is_aimed_camera(&track.target) {
                 continue;
             }
@@ -150,11 +150,18 @@ impl<'a> Generator<'a> {
             out.extend(moving);
         }
 
-        let hidden: Vec<&str> = anim
-            .tracks
+        // The last track that keys a thing's `visible` says whether it is shown.
+        let mut shown: Vec<(&str, bool)> = Vec::new();
+        for tr in &anim.tracks {
+            if let Some(v) = tr.visible.as_ref().and_then(|v| v.at(t)) {
+                shown.retain(|(name, _)| *name != tr.target);
+                shown.push((&tr.target, v != 0.0));
+            }
+        }
+        let hidden: Vec<&str> = shown
             .iter()
-            .filter(|tr| tr.visible.as_ref().and_then(|v| v.at(t)) == Some(0.0))
-            .map(|tr| tr.target.as_str())
+            .filter(|(_, on)| !on)
+            .map(|(name, _)| *name)
             .collect();
         keyed::hide(&mut out, self.base, &hidden);
 

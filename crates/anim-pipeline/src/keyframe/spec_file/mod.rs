@@ -12,7 +12,7 @@ mod track;
 mod validate;
 
 pub use model::{
-    Aim, AimTarget, Animation, Channel, End, Fps, MaterialChannels, NamePattern, Orbit,
+    Aim, AimTarget, Animation, Blend, Channel, End, Fps, MaterialChannels, NamePattern, Orbit,
     OrientChannel, SceneNames, TargetKind, Track,
 };
 pub use raw::{

@@ -164,10 +164,36 @@ impl TargetKind {
     }
 }
 
+/// How a track's values combine with what the tracks before it on the same target (or the
+/// base scene) give the same channel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
+pub enum Blend {
+    /// This track's value.
+    Replace,
+    /// The sum.
+    Add,
+    /// The product (each part of a colour by the same part).
+    Multiply,
+}
+
+impl Blend {
+    /// `new` combined with `current` (a track without `blend` replaces).
+    pub fn combine(blend: Option<Blend>, current: f64, new: f64) -> f64 {
+        match blend {
+            None | Some(Blend::Replace) => new,
+            Some(Blend::Add) => current + new,
+            Some(Blend::Multiply) => current * new,
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Track {
     pub target: String,
     pub kind: TargetKind,
+    /// How its values combine with the earlier tracks' (`None`: not said; only the first
+    /// track keying a channel may leave it out).
+    pub blend: Option<Blend>,
     pub translate: Option<Channel<DVec3>>,
     pub rotate: Option<Channel<f64>>,
     /// Unit-free, non-zero.
@@ -188,6 +214,36 @@ pub struct Track {
 }
 
 impl Track {
+    /// The values it sets in its target's definition (not motion), each named as in the spec,
+    /// with the path of its keys or expression.
+    pub fn values(&self) -> Vec<(&'static str, &str)> {
+        let m = &self.material;
+        let numbers = [
+            ("brightness", &self.brightness),
+            ("fov", &self.fov),
+            ("reflectivity", &m.reflectivity),
+            ("opacity", &m.opacity),
+            ("ior", &m.ior),
+            ("visible", &self.visible),
+        ];
+        let colours = [
+            ("color", &self.color),
+            ("ka", &m.ka),
+            ("kd", &m.kd),
+            ("ks", &m.ks),
+        ];
+        let mut out: Vec<(&'static str, &str)> = numbers
+            .into_iter()
+            .filter_map(|(n, c)| Some((n, c.as_ref()?.path.as_str())))
+            .collect();
+        out.extend(
+            colours
+                .into_iter()
+                .filter_map(|(n, c)| Some((n, c.as_ref()?.path.as_str()))),
+        );
+        out
+    }
+
     /// Whether the track moves its target (rather than setting its parameters only).
     pub fn moves(&self) -> bool {
         self.translate.is_some()

@@ -1,7 +1,7 @@
 //! The spec as the user writes it: serde types that mirror the RON text one to one, so that
 //! ron rejects every unknown field and variant with its position.
 
-use super::model::{End, Fps};
+use super::model::{Blend, End, Fps};
 use crate::keyframe::interp::{Cycle, Interp};
 use crate::keyframe::rotation::EulerOrder;
 use anim_core::limits;
@@ -335,6 +335,10 @@ pub struct TrackSpec {
     /// Seconds by which every key of the track plays later.
     #[serde(default)]
     pub offset: f64,
+    /// How the values this track sets combine with those of the tracks before it on the same
+    /// target (and with the base scene's).
+    #[serde(default)]
+    pub blend: Option<Blend>,
 }
 
 impl TrackSpec {

@@ -6,7 +6,7 @@ use super::checker::{
     valid_fov, ChannelAt, Checker, ValueCheck,
 };
 use super::model::{
-    Aim, AimTarget, Channel, MaterialChannels, OrientChannel, SceneNames, TargetKind, Track,
+    Aim, AimTarget, Blend, Channel, MaterialChannels, OrientChannel, SceneNames, TargetKind, Track,
 };
 use super::raw::{AimSpec, ChannelSpec, KeySpec, Orientation, Scale, SpecFile, TrackSpec, V3};
 use crate::keyframe::expr::Val;
@@ -150,7 +150,46 @@ impl Checker<'_> {
             })
             .collect();
         self.aims_fit(&tracks, names);
+        self.layers_fit(&tracks);
         tracks
+    }
+
+    /// Tracks that set one value of one target say how they combine: without `blend`, a
+    /// second track keying the same value is an error naming both. A `blend` must have a
+    /// value to combine, and `visible` is shown or not: it only replaces.
+    fn layers_fit(&mut self, tracks: &[Track]) {
+        for (k, track) in tracks.iter().enumerate() {
+            let values = track.values();
+            if let Some(blend) = track.blend {
+                let at = field(&track.path, "blend");
+                if values.is_empty() {
+                    self.err(
+                        &[&at, &track.path],
+                        "`blend` combines the values a track sets (brightness, colours, fov, material values): motion from several tracks always composes in order".into(),
+                    );
+                }
+                if blend != Blend::Replace && values.iter().any(|(n, _)| *n == "visible") {
+                    self.err(
+                        &[&at, &track.path],
+                        format!("`visible` is shown or not: it cannot be combined by `{blend:?}` (use `Replace`)"),
+                    );
+                }
+            }
+            for (name, path) in values {
+                let earlier = tracks[..k].iter().find(|t| {
+                    t.target == track.target && t.values().iter().any(|(n, _)| *n == name)
+                });
+                if let (Some(first), None) = (earlier, track.blend) {
+                    self.err(
+                        &[path, &track.path],
+                        format!(
+                            "{} and {} both key the {name} of '{}': give {} a `blend` (Replace, Add or Multiply) to say how they combine",
+                            first.path, track.path, track.target, track.path
+                        ),
+                    );
+                }
+            }
+        }
     }
 
     /// The curves' names, each checked; a curve with no name cannot be used.
@@ -257,8 +296,14 @@ impl Checker<'_> {
         let scale = self.keyed(spec, at, timing, |v: &Scale| v.0, Some(non_zero3));
         let orient = self.orient(s, timing);
         let aim = self.aim(s, timing, kind);
-        let (brightness, color, fov) = self.parameters(s, timing, names);
-        let material = self.material(s, timing, names);
+        // Values added to or multiplied with others may leave their range alone: what the
+        // frames carry is checked once combined.
+        let layered = matches!(
+            s.setting(|t| t.blend),
+            Some((Blend::Add | Blend::Multiply, _))
+        );
+        let (brightness, color, fov) = self.parameters(s, timing, names, layered);
+        let material = self.material(s, timing, names, layered);
         let visible = self.visible(s, timing);
         let axis = self.axis_and_pivot(s);
         if !keyed_channels(t).iter().any(|(_, keyed)| *keyed) && s.curve.is_none() {
@@ -275,6 +320,7 @@ impl Checker<'_> {
         Some(Track {
             target: target_name(t).to_string(),
             kind,
+            blend: s.setting(|t| t.blend).map(|(b, _)| b),
             translate,
             rotate,
             axis,
@@ -298,23 +344,25 @@ impl Checker<'_> {
         s: &Sources,
         timing: Timing,
         names: &dyn SceneNames,
+        layered: bool,
     ) -> (
         Option<Channel<f64>>,
         Option<Channel<DVec3>>,
         Option<Channel<f64>>,
     ) {
+        let check = |c: ValueCheck| (!layered).then_some(c);
         let brightness = self.value(
             s,
             names,
             "brightness",
             |t| &t.brightness,
             timing,
-            non_negative,
+            check(non_negative),
         );
         let (spec, path) = s.spec("color", |t| &t.color);
         let at = self.base_of(s, names, &path, "color");
-        let color = self.keyed(spec, at, timing, rgb, Some(non_negative3));
-        let fov = self.value(s, names, "fov", |t| &t.fov, timing, valid_fov);
+        let color = self.keyed(spec, at, timing, rgb, check(non_negative3));
+        let fov = self.value(s, names, "fov", |t| &t.fov, timing, check(valid_fov));
         (brightness, color, fov)
     }
 
@@ -340,11 +388,11 @@ impl Checker<'_> {
         name: &str,
         get: fn(&TrackSpec) -> &ChannelSpec<f64>,
         timing: Timing,
-        check: ValueCheck,
+        check: Option<ValueCheck>,
     ) -> Option<Channel<f64>> {
         let (spec, path) = s.spec(name, get);
         let at = self.base_of(s, names, &path, name);
-        self.keyed(spec, at, timing, number, Some(check))
+        self.keyed(spec, at, timing, number, check)
     }
 
     fn material(
@@ -352,25 +400,21 @@ impl Checker<'_> {
         s: &Sources,
         timing: Timing,
         names: &dyn SceneNames,
+        layered: bool,
     ) -> MaterialChannels {
+        let check = |c: ValueCheck| (!layered).then_some(c);
         let colour = |c: &mut Self, name: &str, get: fn(&TrackSpec) -> &ChannelSpec<_>| {
             let (spec, path) = s.spec(name, get);
             let at = c.base_of(s, names, &path, name);
-            c.keyed(spec, at, timing, rgb, Some(non_negative3))
+            c.keyed(spec, at, timing, rgb, check(non_negative3))
         };
         let ka = colour(self, "ka", |t| &t.ka);
         let kd = colour(self, "kd", |t| &t.kd);
         let ks = colour(self, "ks", |t| &t.ks);
-        let reflectivity = self.value(
-            s,
-            names,
-            "reflectivity",
-            |t| &t.reflectivity,
-            timing,
-            unit_interval,
-        );
-        let opacity = self.value(s, names, "opacity", |t| &t.opacity, timing, unit_interval);
-        let ior = self.value(s, names, "ior", |t| &t.ior, timing, positive);
+        let unit = check(unit_interval);
+        let reflectivity = self.value(s, names, "reflectivity", |t| &t.reflectivity, timing, unit);
+        let opacity = self.value(s, names, "opacity", |t| &t.opacity, timing, unit);
+        let ior = self.value(s, names, "ior", |t| &t.ior, timing, check(positive));
         MaterialChannels {
             ka,
             kd,
