@@ -4,6 +4,7 @@
 //!
 //! The format is documented for users in `docs/animation.md`.
 
+mod across;
 mod checker;
 mod model;
 mod raw;
