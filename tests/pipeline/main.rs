@@ -16,6 +16,7 @@
 //!   check that says what `anim check` would.
 //! - `timing`: keys at `Frames(n)`, fractional frame rates, `--frames A..B`.
 //! - `layering`: tracks on one value combined by `blend`, or refused without it.
+//! - `rigs`: paths at constant speed, `orient: AlongPath`, parents.
 //! - `service`: the one way from a scene file to images in memory, which `anim render` and
 //!   `anim preview` share, and the files a frame's fingerprint follows.
 
@@ -30,6 +31,7 @@ mod generated_frames;
 mod holds;
 mod keyframe_spec;
 mod layering;
+mod rigs;
 mod service;
 mod split;
 mod timing;

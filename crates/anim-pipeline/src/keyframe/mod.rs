@@ -16,6 +16,7 @@ pub mod keyed;
 pub mod locate;
 pub mod motion;
 pub mod orbit;
+pub mod path;
 pub mod placement;
 pub mod ranges;
 pub mod rotation;

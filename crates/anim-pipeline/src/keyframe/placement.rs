@@ -6,7 +6,7 @@ use super::base::{ops_transform, BaseScene};
 use super::motion::TrackPose;
 use super::orbit::Pose;
 use super::rotation::{can_look, facing, rolled_up};
-use super::spec_file::{Aim, AimTarget, Animation, TargetKind};
+use super::spec_file::{Aim, AimTarget, AlongPath, Animation, PathMotion, TargetKind};
 use super::tidy::tidy3;
 use anim_core::limits;
 use anim_core::math::Transform;
@@ -28,7 +28,12 @@ pub struct Placer<'a> {
     ancestors: BTreeMap<String, Vec<(String, Transform)>>,
     /// Each aimed camera's eye where the base scene puts it.
     eyes: BTreeMap<String, DVec3>,
+    /// The view direction of each camera that turns along a path, as the base scene puts it.
+    views: BTreeMap<String, DVec3>,
 }
+
+/// The gravity `bank` leans against, in scene units (as metres) a second squared.
+const GRAVITY: f64 = 9.81;
 
 impl<'a> Placer<'a> {
     pub fn new(base: &'a BaseScene, anim: &'a Animation) -> Self {
@@ -39,6 +44,19 @@ impl<'a> Placer<'a> {
             .collect();
         let (mut centres, mut ancestors, mut eyes) =
             (BTreeMap::new(), BTreeMap::new(), BTreeMap::new());
+        let mut views = BTreeMap::new();
+        for track in anim.tracks.iter().filter(|t| t.along_path.is_some()) {
+            let dir = base.statements.iter().rev().find_map(|s| match &s.kind {
+                StatementKind::Camera(c) if c.name == track.target => Some(c.dir),
+                _ => None,
+            });
+            if let Some(dir) = dir {
+                views.insert(
+                    track.target.clone(),
+                    base.own_transform(&track.target).vector(dir),
+                );
+            }
+        }
         for track in &anim.tracks {
             let Some(aim) = &track.aim else {
                 continue;
@@ -65,6 +83,7 @@ impl<'a> Placer<'a> {
             centres,
             ancestors,
             eyes,
+            views,
         }
     }
 
@@ -73,6 +92,9 @@ impl<'a> Placer<'a> {
     pub fn pose(&self, i: usize, t: f64) -> Result<TrackPose, String> {
         let track = &self.anim.tracks[i];
         let mut pose = TrackPose::at(track, t);
+        if let (Some(along), Some(travel)) = (&track.along_path, &track.travel) {
+            pose.orient = self.along_path(&track.target, along, travel, t)?;
+        }
         let Some(aim) = track
             .aim
             .as_ref()
@@ -95,6 +117,36 @@ impl<'a> Placer<'a> {
             }
         })?;
         Ok(pose)
+    }
+
+    /// The turn that faces `target` the way `travel` goes at time `t`, its up leaning into the
+    /// turn by `along.bank`: the sideways acceleration `v²·κ` (speed along the path, curvature
+    /// vector) against a gravity of 9.81 down `up`, as an aircraft banks in a coordinated turn.
+    fn along_path(
+        &self,
+        target: &str,
+        along: &AlongPath,
+        travel: &PathMotion,
+        t: f64,
+    ) -> Result<DQuat, String> {
+        let (dir, curvature) = travel.path.bend(travel.progress(t));
+        let speed = travel.speed(t);
+        let up = along.up.normalize();
+        let leaning = up * GRAVITY + curvature * (speed * speed * along.bank);
+        // The bank as a roll about the direction of travel, from `up` to the leaning up.
+        let across = |v: DVec3| v - dir * v.dot(dir);
+        let (u0, u1) = (across(up), across(leaning));
+        let roll = dir.dot(u0.cross(u1)).atan2(u0.dot(u1)).to_degrees();
+        let forward = along
+            .forward
+            .or_else(|| self.views.get(target).copied())
+            .unwrap_or(DVec3::NEG_Z);
+        facing(forward, dir, up, if roll.is_finite() { roll } else { 0.0 }).ok_or_else(|| {
+            format!(
+                "'{target}' would face straight along its up direction {} on its path",
+                fmt3(along.up)
+            )
+        })
     }
 
     /// Track `i`'s pivot at time `t`. An aimed track's pivot moves with its target as the
@@ -218,7 +270,7 @@ impl<'a> Placer<'a> {
                     let pose = self.camera_pose(&track.target, t)?.ok()?;
                     facing(-DVec3::Z, pose.dir, pose.up, 0.0)
                 })
-            } else if track.aim.is_some() || track.orient.is_some() {
+            } else if track.aim.is_some() || track.orient.is_some() || track.along_path.is_some() {
                 path(&|t| self.pose(i, t).ok().map(|p| p.orient))
             } else {
                 0.0

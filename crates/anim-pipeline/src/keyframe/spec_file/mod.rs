@@ -7,14 +7,15 @@
 mod across;
 mod checker;
 mod model;
+mod path;
 mod raw;
 mod source;
 mod track;
 mod validate;
 
 pub use model::{
-    Aim, AimTarget, Animation, Blend, Channel, End, Fps, MaterialChannels, NamePattern, Orbit,
-    OrientChannel, SceneNames, TargetKind, Track,
+    Aim, AimTarget, AlongPath, Animation, Blend, Channel, End, Fps, MaterialChannels, NamePattern,
+    Orbit, OrientChannel, PathMotion, SceneNames, TargetKind, Track,
 };
 pub use raw::{
     AimSpec, FpsSpec, KeySpec, KeyTime, Length, OrbitSpec, Orientation, Rgb, Scale, SceneSource,

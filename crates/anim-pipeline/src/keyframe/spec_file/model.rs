@@ -2,6 +2,7 @@
 
 use crate::keyframe::expr::{Expr, Val};
 use crate::keyframe::interp::{cycled_time, sample_timed, segment, Interp, Key, Keyable, Timing};
+use crate::keyframe::path::Path;
 use anim_core::limits;
 use glam::{DQuat, DVec3};
 use std::sync::Arc;
@@ -142,6 +143,52 @@ impl MaterialChannels {
     }
 }
 
+/// A translation along a path, at the distance `progress` says (default: constant speed over
+/// the animation).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PathMotion {
+    pub path: Path,
+    pub progress: Option<Channel<f64>>,
+    /// The animation's length: the default progress goes from 0 to 1 over it.
+    pub duration: f64,
+}
+
+impl PathMotion {
+    /// The fraction of the path travelled at time `t`.
+    pub fn progress(&self, t: f64) -> f64 {
+        match &self.progress {
+            Some(c) => c.at(t).unwrap_or(0.0),
+            None if self.duration > 0.0 => t / self.duration,
+            None => 0.0,
+        }
+    }
+
+    /// Where on the path the target is at time `t`.
+    pub fn at(&self, t: f64) -> DVec3 {
+        self.path.at(self.progress(t))
+    }
+
+    /// Its speed along the path at time `t`, in units a second.
+    pub fn speed(&self, t: f64) -> f64 {
+        let h = 1e-4;
+        let f = (self.progress(t + h) - self.progress(t - h)) / (2.0 * h);
+        f.abs() * self.path.length()
+    }
+}
+
+/// `orient: AlongPath`: the target turns so that `forward` points the way the path goes, with
+/// `up` kept up, leaning into turns by `bank`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AlongPath {
+    /// In the parent's frame as the base scene places the target (for a camera: `None`, its
+    /// own view direction).
+    pub forward: Option<DVec3>,
+    pub up: DVec3,
+    pub bank: f64,
+    /// `tracks[i].orient`, for messages.
+    pub path: String,
+}
+
 /// What a name in the base scene refers to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TargetKind {
@@ -205,6 +252,10 @@ pub struct Track {
     pub fov: Option<Channel<f64>>,
     /// Keyed orientation, applied about the pivot before `rotate`.
     pub orient: Option<OrientChannel>,
+    /// The translation along a `path`, instead of `translate` keys.
+    pub travel: Option<PathMotion>,
+    /// `orient: AlongPath`: facing the way the path goes.
+    pub along_path: Option<AlongPath>,
     pub aim: Option<Aim>,
     pub material: MaterialChannels,
     /// 1 shown, 0 hidden; stepped.
@@ -247,6 +298,7 @@ impl Track {
     /// Whether the track moves its target (rather than setting its parameters only).
     pub fn moves(&self) -> bool {
         self.translate.is_some()
+            || self.travel.is_some()
             || self.rotate.is_some()
             || self.scale.is_some()
             || self.orient.is_some()

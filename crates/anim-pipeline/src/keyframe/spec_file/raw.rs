@@ -277,9 +277,16 @@ pub struct TrackSpec {
     /// Centre of rotation and scaling; default: the object's centre as the base scene places it.
     #[serde(default)]
     pub pivot: Option<V3>,
-    /// Full 3-D orientation keys, slerped.
+    /// Full 3-D orientation keys, slerped, or `AlongPath`: facing the way the `path` goes.
     #[serde(default)]
-    pub orient: Vec<KeySpec<Orientation>>,
+    pub orient: OrientSpec,
+    /// The translation as a path travelled at constant speed (instead of `translate` keys).
+    #[serde(default)]
+    pub path: Option<PathSpec>,
+    /// With `orient: AlongPath`: how far the target leans into turns (0: level; 1: as an
+    /// aircraft in a coordinated turn, scene units as metres).
+    #[serde(default)]
+    pub bank: Option<f64>,
     /// The order of `Euler` angles: `XYZ` turns about x first (the parent's axes).
     #[serde(default)]
     pub euler_order: Option<EulerOrder>,
@@ -347,7 +354,8 @@ impl TrackSpec {
         key_times(&self.translate.keys)
             .chain(key_times(&self.rotate.keys))
             .chain(key_times(&self.scale.keys))
-            .chain(key_times(&self.orient))
+            .chain(key_times(&self.orient.keys))
+            .chain(self.path.iter().flat_map(|p| key_times(&p.progress.keys)))
             .chain(key_times(&self.roll.keys))
             .chain(key_times(&self.brightness.keys))
             .chain(key_times(&self.color.keys))
@@ -665,4 +673,73 @@ impl<'de> Deserialize<'de> for NamedValues {
         }
         d.deserialize_map(Values)
     }
+}
+
+/// `orient` as written: orientation keys, or `AlongPath`.
+#[derive(Debug, Default)]
+pub struct OrientSpec {
+    pub keys: Vec<KeySpec<Orientation>>,
+    /// `orient: AlongPath`; the name is checked against the text, which records it.
+    pub along_path: bool,
+}
+
+impl OrientSpec {
+    pub fn is_empty(&self) -> bool {
+        self.keys.is_empty() && !self.along_path
+    }
+}
+
+impl<'de> Deserialize<'de> for OrientSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Orient;
+        impl<'de> Visitor<'de> for Orient {
+            type Value = OrientSpec;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("orientation keys `[(at: …, value: Euler(…)), …]` or `AlongPath`")
+            }
+            fn visit_unit<E: de::Error>(self) -> Result<OrientSpec, E> {
+                Ok(OrientSpec {
+                    keys: Vec::new(),
+                    along_path: true,
+                })
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<OrientSpec, A::Error> {
+                let mut keys = Vec::new();
+                while let Some(k) = seq.next_element::<KeySpec<Orientation>>()? {
+                    keys.push(k);
+                }
+                Ok(OrientSpec {
+                    keys,
+                    along_path: false,
+                })
+            }
+        }
+        d.deserialize_any(Orient)
+    }
+}
+
+/// A path: the points it passes, whether it closes, its shape, and how far along it the
+/// target is over time.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PathSpec {
+    pub points: Vec<V3>,
+    #[serde(default)]
+    pub closed: bool,
+    #[serde(default)]
+    pub spline: PathSpline,
+    /// The fraction of the path's length travelled (0 its start, 1 its end); default: from 0
+    /// at the start of the animation to 1 at its end, at constant speed.
+    #[serde(default)]
+    pub progress: ChannelSpec<f64>,
+}
+
+/// The curve through a path's points.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+pub enum PathSpline {
+    /// Catmull-Rom: through every point without corners.
+    #[default]
+    Smooth,
+    /// Straight lines from point to point.
+    Linear,
 }

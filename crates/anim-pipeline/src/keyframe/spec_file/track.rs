@@ -17,16 +17,16 @@ use anim_core::diag::suggest;
 use glam::{DQuat, DVec3};
 
 /// Where a track's channels come from: its own keys, else those of the curve it uses.
-struct Sources<'s> {
-    track: &'s TrackSpec,
-    path: String,
-    curve: Option<(&'s TrackSpec, String)>,
+pub(super) struct Sources<'s> {
+    pub(super) track: &'s TrackSpec,
+    pub(super) path: String,
+    pub(super) curve: Option<(&'s TrackSpec, String)>,
 }
 
 impl<'s> Sources<'s> {
     /// Channel `name` as written (keys, an expression, or both) and its path in the spec: the
     /// track's own, else its curve's.
-    fn spec<S>(
+    pub(super) fn spec<S>(
         &self,
         name: &str,
         get: impl Fn(&'s TrackSpec) -> &'s ChannelSpec<S>,
@@ -52,21 +52,24 @@ impl<'s> Sources<'s> {
     }
 
     /// A per-track setting: the track's own, else its curve's.
-    fn setting<T>(&self, get: impl Fn(&'s TrackSpec) -> Option<T>) -> Option<(T, String)> {
+    pub(super) fn setting<T>(
+        &self,
+        get: impl Fn(&'s TrackSpec) -> Option<T>,
+    ) -> Option<(T, String)> {
         get(self.track).map(|v| (v, self.path.clone())).or_else(|| {
             let (curve, path) = self.curve.as_ref()?;
             get(curve).map(|v| (v, path.clone()))
         })
     }
 
-    fn either(&self, keyed: impl Fn(&TrackSpec) -> bool) -> bool {
+    pub(super) fn either(&self, keyed: impl Fn(&TrackSpec) -> bool) -> bool {
         keyed(self.track) || self.curve.as_ref().is_some_and(|(c, _)| keyed(c))
     }
 }
 
 /// Which channels a kind of target accepts, by field name.
 fn fits(kind: TargetKind, channel: &str) -> bool {
-    const MOTION: [&str; 5] = ["translate", "rotate", "scale", "orient", "pivot"];
+    const MOTION: [&str; 6] = ["translate", "path", "rotate", "scale", "orient", "pivot"];
     let moving = MOTION.contains(&channel);
     match kind {
         TargetKind::Shape | TargetKind::Composite => {
@@ -103,9 +106,10 @@ fn kinds_for(channel: &str) -> String {
 }
 
 /// Every channel field of a track, with whether it keys anything.
-fn keyed_channels(t: &TrackSpec) -> [(&'static str, bool); 17] {
+fn keyed_channels(t: &TrackSpec) -> [(&'static str, bool); 18] {
     [
         ("translate", !t.translate.is_empty()),
+        ("path", t.path.is_some()),
         ("rotate", !t.rotate.is_empty()),
         ("scale", !t.scale.is_empty()),
         ("orient", !t.orient.is_empty()),
@@ -257,6 +261,8 @@ impl Checker<'_> {
         let at = ChannelAt::new(&at_path, target_name(t), "scale", Val::Vec(DVec3::ONE));
         let scale = self.keyed(spec, at, timing, |v: &Scale| v.0, Some(non_zero3));
         let orient = self.orient(s, timing);
+        let path_motion = self.path_motion(s, timing);
+        let along_path = self.along_path(s, kind);
         let aim = self.aim(s, timing, kind);
         // Values added to or multiplied with others may leave their range alone: what the
         // frames carry is checked once combined.
@@ -292,6 +298,8 @@ impl Checker<'_> {
             color,
             fov,
             orient,
+            travel: path_motion,
+            along_path,
             aim,
             material,
             visible,
@@ -461,7 +469,7 @@ impl Checker<'_> {
 
     /// Orientation keys as quaternions.
     fn orient(&mut self, s: &Sources, timing: Timing) -> Option<OrientChannel> {
-        let (keys, path) = s.keys("orient", |t| &t.orient);
+        let (keys, path) = s.keys("orient", |t| &t.orient.keys);
         if keys.is_empty() {
             return None;
         }
@@ -539,10 +547,11 @@ impl Checker<'_> {
                     "forward" => s.either(|t| t.forward.is_some()),
                     _ => s.either(|t| !t.roll.is_empty()),
                 };
-                if given {
+                let along = extra != "roll" && s.either(|t| t.orient.along_path);
+                if given && !along {
                     self.err(
                         &[&field(&s.path, extra), &s.path],
-                        format!("`{extra}` goes with `look_at`, which this track does not have"),
+                        format!("`{extra}` goes with `look_at` (or `orient: AlongPath`), which this track does not have"),
                     );
                 }
             }
@@ -714,7 +723,7 @@ impl Checker<'_> {
 
     /// The orbit sets its camera's pose outright: keyed motion would fight it.
     fn not_moved_off_orbit(&mut self, s: &Sources) {
-        let moving = ["translate", "rotate", "scale", "orient", "look_at"]
+        let moving = ["translate", "path", "rotate", "scale", "orient", "look_at"]
             .into_iter()
             .find(|c| s.either(|t| keyed_channels(t).iter().any(|(n, k)| n == c && *k)));
         if let Some(channel) = moving {
