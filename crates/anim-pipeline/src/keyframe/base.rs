@@ -163,6 +163,10 @@ impl BaseScene {
 }
 
 impl SceneNames for BaseScene {
+    fn containers(&self, name: &str) -> Vec<&str> {
+        self.parents(name)
+    }
+
     fn kind_of(&self, name: &str) -> Option<TargetKind> {
         self.kinds.get(name).copied()
     }

@@ -4,12 +4,14 @@
 //! [`spec`] reads and checks the spec, [`interp`] samples keyed values, [`rotation`] handles
 //! orientations, [`base`] knows the base scene, [`orbit`] places the turntable camera,
 //! [`motion`] turns a track into transforms (and motion during a blurred frame's exposure),
-//! [`placement`] places things at a time (centres, pivots, aims), [`keyed`] writes keyed
+//! [`placement`] places things at a time (centres, pivots, aims, parents), [`follow`] turns a
+//! parent's motion into what its followers carry, [`keyed`] writes keyed
 //! values into definitions, [`ranges`] keeps ranged values in range between frames, and
 //! [`generate`] writes the frames.
 
 pub mod base;
 pub mod expr;
+pub mod follow;
 pub mod generate;
 pub mod interp;
 pub mod keyed;
@@ -203,24 +205,7 @@ fn write_frames(
     // generation is deterministic, so what is written is what was checked.
     let generator = Generator::new(base, anim, src);
     let groups = (!standalone).then(|| split::by_subject(&base.statements));
-    let checked: Vec<Result<HashSet<String>, Vec<Diagnostic>>> = (0..anim.frames)
-        .into_par_iter()
-        .map(|i| {
-            if chosen.contains(&i) {
-                check_frame(&generator, anim, src, dir, i, groups.as_ref())
-            } else {
-                // Not written: only what it changes counts, for the static part.
-                let statements = generator.frame_statements(i)?;
-                Ok(groups
-                    .as_ref()
-                    .map_or_else(HashSet::new, |g| split::changed_subjects(g, &statements)))
-            }
-        })
-        .collect();
-    let mut changed = HashSet::new();
-    for frame in checked {
-        changed.extend(frame?);
-    }
+    let changed = check_frames(&generator, dir, &chosen, groups.as_ref())?;
     let split = groups
         .map(|_| Split::new(&base.statements, changed))
         .filter(|split| !split.is_empty());
@@ -304,6 +289,34 @@ fn write_frames(
         undo(&created, e)
     })?;
     Ok((written, removed))
+}
+
+/// Makes every frame, checks those in `chosen` by loading them, and returns the subjects of
+/// `groups` that some frame changes; the earliest frame that fails is the one reported.
+fn check_frames(
+    generator: &Generator,
+    dir: &Path,
+    chosen: &std::ops::RangeInclusive<usize>,
+    groups: Option<&HashMap<&str, Vec<&StatementKind>>>,
+) -> Result<HashSet<String>, Vec<Diagnostic>> {
+    let (anim, src) = (generator.anim, generator.src);
+    let checked: Vec<Result<HashSet<String>, Vec<Diagnostic>>> = (0..anim.frames)
+        .into_par_iter()
+        .map(|i| {
+            if chosen.contains(&i) {
+                check_frame(generator, anim, src, dir, i, groups)
+            } else {
+                // Not written: only what it changes counts, for the static part.
+                let statements = generator.frame_statements(i)?;
+                Ok(groups.map_or_else(HashSet::new, |g| split::changed_subjects(g, &statements)))
+            }
+        })
+        .collect();
+    let mut changed = HashSet::new();
+    for frame in checked {
+        changed.extend(frame?);
+    }
+    Ok(changed)
 }
 
 /// Parses the base scene. Errors stop generation; warnings are passed on.

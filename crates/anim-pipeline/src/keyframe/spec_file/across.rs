@@ -10,6 +10,99 @@ use anim_core::diag::suggest;
 use glam::DVec3;
 
 impl Checker<'_> {
+    /// Parents that can be followed: a thing of the base scene other than the target, the
+    /// same for every track on a target, never round a loop; children placed by no composite
+    /// (a composite's child follows the composite) and not the orbiting camera.
+    pub(super) fn parents_fit(
+        &mut self,
+        tracks: &[Track],
+        names: &dyn SceneNames,
+        orbit_camera: Option<&str>,
+    ) {
+        for (k, track) in tracks.iter().enumerate() {
+            let Some(parent) = &track.parent else {
+                continue;
+            };
+            let at = [parent.path.as_str(), track.path.as_str()];
+            let name = &parent.name;
+            match names.kind_of(name) {
+                _ if *name == track.target => {
+                    self.err(&at, format!("'{name}' cannot follow itself"));
+                    continue;
+                }
+                Some(TargetKind::Material) | None => {
+                    let d = self.src.error(&at, format!("the base scene has no shape, composite, light or camera named '{name}' to follow"));
+                    let d = match suggest(name, names.names()) {
+                        Some(s) => d.with_help(format!("did you mean '{s}'?")),
+                        None => d,
+                    };
+                    if !self.full() {
+                        self.errors.push(d);
+                    }
+                    continue;
+                }
+                Some(_) => {}
+            }
+            if let Some(composite) = names.containers(&track.target).first() {
+                self.err(
+                    &at,
+                    format!(
+                        "'{}' is placed by composite '{composite}': give the composite the parent",
+                        track.target
+                    ),
+                );
+            }
+            if orbit_camera == Some(track.target.as_str()) {
+                self.err(
+                    &at,
+                    format!(
+                        "camera '{}' follows the orbit; it cannot follow '{name}' too",
+                        track.target
+                    ),
+                );
+            }
+            if orbit_camera == Some(name.as_str()) {
+                self.err(
+                    &at,
+                    format!("'{name}' is the orbiting camera, which cannot lead others"),
+                );
+            }
+            let other = tracks[..k].iter().filter_map(|t| {
+                let p = t.parent.as_ref()?;
+                (t.target == track.target && p.name != *name).then_some(t)
+            });
+            if let Some(first) = other.into_iter().next() {
+                self.err(
+                    &at,
+                    format!(
+                        "'{}' follows another parent in {} already",
+                        track.target, first.path
+                    ),
+                );
+            }
+            // Round a loop: from the parent, follow parents until the target comes back.
+            let parent_of = |n: &str| {
+                tracks
+                    .iter()
+                    .find_map(|t| (t.target == n).then_some(t.parent.as_ref()?.name.as_str()))
+            };
+            let mut chain = vec![track.target.as_str(), name.as_str()];
+            while let Some(next) = parent_of(chain[chain.len() - 1]) {
+                if chain.len() > tracks.len() + 1 {
+                    break;
+                }
+                chain.push(next);
+                if next == track.target {
+                    self.err(
+                        &at,
+                        format!("parents go round a loop: {}", chain.join(" → ")),
+                    );
+                    break;
+                }
+            }
+        }
+    }
+
     /// Tracks that set one value of one target say how they combine: without `blend`, a
     /// second track keying the same value is an error naming both. A `blend` must have a
     /// value to combine, and `visible` is shown or not: it only replaces.

@@ -14,8 +14,8 @@ mod track;
 mod validate;
 
 pub use model::{
-    Aim, AimTarget, AlongPath, Animation, Blend, Channel, End, Fps, MaterialChannels, NamePattern,
-    Orbit, OrientChannel, PathMotion, SceneNames, TargetKind, Track,
+    Aim, AimTarget, AlongPath, Animation, Blend, Channel, End, Follow, Fps, MaterialChannels,
+    NamePattern, Orbit, OrientChannel, Parent, PathMotion, SceneNames, TargetKind, Track,
 };
 pub use raw::{
     AimSpec, FpsSpec, KeySpec, KeyTime, Length, OrbitSpec, Orientation, Rgb, Scale, SceneSource,

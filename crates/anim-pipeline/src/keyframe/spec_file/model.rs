@@ -143,6 +143,26 @@ impl MaterialChannels {
     }
 }
 
+/// What of a parent's motion a child follows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
+pub enum Follow {
+    /// Where the parent's centre goes.
+    Translate,
+    /// How the parent turns, about its centre.
+    Rotate,
+    /// How it scales, about its centre.
+    Scale,
+}
+
+/// A target that follows another's motion: `parent` and what it follows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Parent {
+    pub name: String,
+    pub follow: Vec<Follow>,
+    /// `tracks[i].parent`, for messages.
+    pub path: String,
+}
+
 /// A translation along a path, at the distance `progress` says (default: constant speed over
 /// the animation).
 #[derive(Clone, Debug, PartialEq)]
@@ -256,6 +276,8 @@ pub struct Track {
     pub travel: Option<PathMotion>,
     /// `orient: AlongPath`: facing the way the path goes.
     pub along_path: Option<AlongPath>,
+    /// The thing whose motion the target follows, after its own tracks'.
+    pub parent: Option<Parent>,
     pub aim: Option<Aim>,
     pub material: MaterialChannels,
     /// 1 shown, 0 hidden; stepped.
@@ -515,6 +537,8 @@ impl Animation {
 pub trait SceneNames {
     /// What `name` is, if the base scene defines it.
     fn kind_of(&self, name: &str) -> Option<TargetKind>;
+    /// The composites that list `name` among their children.
+    fn containers(&self, name: &str) -> Vec<&str>;
     /// Every targetable name, for suggestions.
     fn names(&self) -> Vec<&str>;
     /// The camera used when the spec names none.

@@ -1,7 +1,7 @@
 //! The spec as the user writes it: serde types that mirror the RON text one to one, so that
 //! ron rejects every unknown field and variant with its position.
 
-use super::model::{Blend, End, Fps};
+use super::model::{Blend, End, Follow, Fps};
 use crate::keyframe::interp::{Cycle, Interp};
 use crate::keyframe::rotation::EulerOrder;
 use anim_core::limits;
@@ -346,6 +346,12 @@ pub struct TrackSpec {
     /// target (and with the base scene's).
     #[serde(default)]
     pub blend: Option<Blend>,
+    /// A shape, composite, light or camera whose motion the target follows.
+    #[serde(default)]
+    pub parent: Option<String>,
+    /// What of the parent's motion it follows (default all three).
+    #[serde(default)]
+    pub follow: Option<Vec<Follow>>,
 }
 
 impl TrackSpec {

@@ -6,7 +6,8 @@ use super::checker::{
     ChannelAt, Checker, ValueCheck,
 };
 use super::model::{
-    Aim, AimTarget, Blend, Channel, MaterialChannels, OrientChannel, SceneNames, TargetKind, Track,
+    Aim, AimTarget, Blend, Channel, Follow, MaterialChannels, OrientChannel, Parent, SceneNames,
+    TargetKind, Track,
 };
 use super::raw::{AimSpec, ChannelSpec, KeySpec, Orientation, Scale, SpecFile, TrackSpec, V3};
 use crate::keyframe::expr::Val;
@@ -69,7 +70,15 @@ impl<'s> Sources<'s> {
 
 /// Which channels a kind of target accepts, by field name.
 fn fits(kind: TargetKind, channel: &str) -> bool {
-    const MOTION: [&str; 6] = ["translate", "path", "rotate", "scale", "orient", "pivot"];
+    const MOTION: [&str; 7] = [
+        "translate",
+        "path",
+        "rotate",
+        "scale",
+        "orient",
+        "pivot",
+        "parent",
+    ];
     let moving = MOTION.contains(&channel);
     match kind {
         TargetKind::Shape | TargetKind::Composite => {
@@ -106,7 +115,7 @@ fn kinds_for(channel: &str) -> String {
 }
 
 /// Every channel field of a track, with whether it keys anything.
-fn keyed_channels(t: &TrackSpec) -> [(&'static str, bool); 18] {
+fn keyed_channels(t: &TrackSpec) -> [(&'static str, bool); 19] {
     [
         ("translate", !t.translate.is_empty()),
         ("path", t.path.is_some()),
@@ -126,6 +135,7 @@ fn keyed_channels(t: &TrackSpec) -> [(&'static str, bool); 18] {
         ("visible", !t.visible.is_empty()),
         ("roll", !t.roll.is_empty()),
         ("pivot", t.pivot.is_some()),
+        ("parent", t.parent.is_some()),
     ]
 }
 
@@ -155,6 +165,7 @@ impl Checker<'_> {
             .collect();
         self.aims_fit(&tracks, names);
         self.layers_fit(&tracks);
+        self.parents_fit(&tracks, names, orbit_camera);
         tracks
     }
 
@@ -300,6 +311,14 @@ impl Checker<'_> {
             orient,
             travel: path_motion,
             along_path,
+            parent: s.setting(|t| t.parent.clone()).map(|(name, p)| Parent {
+                name,
+                follow: s.setting(|t| t.follow.clone()).map_or(
+                    vec![Follow::Translate, Follow::Rotate, Follow::Scale],
+                    |(f, _)| f,
+                ),
+                path: field(&p, "parent"),
+            }),
             aim,
             material,
             visible,
@@ -723,9 +742,17 @@ impl Checker<'_> {
 
     /// The orbit sets its camera's pose outright: keyed motion would fight it.
     fn not_moved_off_orbit(&mut self, s: &Sources) {
-        let moving = ["translate", "path", "rotate", "scale", "orient", "look_at"]
-            .into_iter()
-            .find(|c| s.either(|t| keyed_channels(t).iter().any(|(n, k)| n == c && *k)));
+        let moving = [
+            "translate",
+            "path",
+            "rotate",
+            "scale",
+            "orient",
+            "look_at",
+            "parent",
+        ]
+        .into_iter()
+        .find(|c| s.either(|t| keyed_channels(t).iter().any(|(n, k)| n == c && *k)));
         if let Some(channel) = moving {
             self.err(
                 &[&field(&s.path, channel), &s.path],
