@@ -495,7 +495,13 @@ fn every_example_spec_generates_the_frames_it_always_has() {
 
 #[test]
 fn the_new_example_specs_generate_frames_that_load_without_warnings() {
-    for spec in ["logo.ron", "crowd.ron"] {
+    for spec in [
+        "logo.ron",
+        "crowd.ron",
+        "candle.ron",
+        "rig.ron",
+        "flythrough.ron",
+    ] {
         let out = tempfile::tempdir().unwrap();
         let (ok, stderr) = generate(&repo().join("animations").join(spec), out.path());
         assert!(ok && stderr.is_empty(), "{spec}: {stderr}");

@@ -17,6 +17,7 @@
 //! - `timing`: keys at `Frames(n)`, fractional frame rates, `--frames A..B`.
 //! - `layering`: tracks on one value combined by `blend`, or refused without it.
 //! - `rigs`: paths at constant speed, `orient: AlongPath`, parents.
+//! - `shots`: the example shots of round two (candle, rig, flythrough) do what they show.
 //! - `service`: the one way from a scene file to images in memory, which `anim render` and
 //!   `anim preview` share, and the files a frame's fingerprint follows.
 
@@ -33,5 +34,6 @@ mod keyframe_spec;
 mod layering;
 mod rigs;
 mod service;
+mod shots;
 mod split;
 mod timing;
