@@ -17,6 +17,7 @@
 //! - `timing`: keys at `Frames(n)`, fractional frame rates, `--frames A..B`.
 //! - `layering`: tracks on one value combined by `blend`, or refused without it.
 //! - `rigs`: paths at constant speed, `orient: AlongPath`, parents.
+//! - `tangents`: a key's `in` and `out` sides, and the clamped spline `Auto`.
 //! - `shots`: the example shots of round two (candle, rig, flythrough) do what they show.
 //! - `service`: the one way from a scene file to images in memory, which `anim render` and
 //!   `anim preview` share, and the files a frame's fingerprint follows.
@@ -36,4 +37,5 @@ mod rigs;
 mod service;
 mod shots;
 mod split;
+mod tangents;
 mod timing;

@@ -5,7 +5,7 @@ use super::model::{Channel, Driven, Fps};
 use super::raw::{ChannelSpec, KeySpec};
 use super::source::Source;
 use crate::keyframe::expr::{Expr, ExprError, Scope, Ty, Val};
-use crate::keyframe::interp::{Key, Keyable, Timing};
+use crate::keyframe::interp::{Key, Keyable, Side, Timing};
 use crate::keyframe::locate::{field, index};
 use anim_core::diag::Diagnostic;
 use anim_core::diag::Severity;
@@ -260,12 +260,49 @@ impl<'a> Checker<'a> {
                 interp: k.interp,
             });
         }
+        self.key_sides(keys, path, &mut out);
         Some(Channel {
             keys: out,
             timing,
             path: path.to_string(),
             expr: None,
         })
+    }
+
+    /// Shapes the segments of `out` (the keys at `path`, checked) by their keys' `in` and
+    /// `out` sides.
+    pub fn key_sides<S, T>(&mut self, keys: &[KeySpec<S>], path: &str, out: &mut [Key<T>]) {
+        let n = keys.len();
+        for (i, k) in keys.iter().enumerate() {
+            let key_path = index(path, i);
+            for (side, name) in [(k.ease_in, "in"), (k.ease_out, "out")] {
+                let Some(side) = side else {
+                    continue;
+                };
+                let at = [field(&key_path, name), key_path.clone()];
+                let at = [at[0].as_str(), at[1].as_str()];
+                if let Some(problem) = side.problem() {
+                    self.err(&at, problem);
+                } else if name == "in" && i == 0 {
+                    self.err(&at, "the first key has no segment arriving at it".into());
+                } else if name == "out" && i + 1 == n {
+                    self.err(&at, "the last key has no segment leaving it".into());
+                }
+            }
+        }
+        for i in 0..n.saturating_sub(1) {
+            let (out_side, in_side) = (keys[i].ease_out, keys[i + 1].ease_in);
+            if out_side.is_none() && in_side.is_none() {
+                continue;
+            }
+            match Side::segment(keys[i].interp, out_side, in_side) {
+                Ok(curve) => out[i].interp = curve,
+                Err(why) => {
+                    let key_path = index(path, i);
+                    self.err(&[&field(&key_path, "interp"), &key_path], why);
+                }
+            }
+        }
     }
 
     /// A key's curve parameters.

@@ -2,7 +2,7 @@
 //! ron rejects every unknown field and variant with its position.
 
 use super::model::{Blend, End, Follow, Fps};
-use crate::keyframe::interp::{Cycle, Interp};
+use crate::keyframe::interp::{Cycle, Interp, Side};
 use crate::keyframe::rotation::EulerOrder;
 use anim_core::limits;
 use glam::DVec3;
@@ -411,6 +411,12 @@ pub struct KeySpec<T> {
     /// How to move from this key to the next one.
     #[serde(default)]
     pub interp: Interp,
+    /// How the segment before this key arrives at it.
+    #[serde(default, rename = "in")]
+    pub ease_in: Option<Side>,
+    /// How the segment after this key leaves it.
+    #[serde(default, rename = "out")]
+    pub ease_out: Option<Side>,
 }
 
 /// `(x, y, z)` (or `[x, y, z]`).

@@ -525,6 +525,7 @@ impl Checker<'_> {
                 interp: k.interp,
             });
         }
+        self.key_sides(keys, &path, &mut out);
         Some(Channel {
             keys: out,
             timing,
