@@ -213,7 +213,7 @@ pub fn finish_diagnostics(mut diagnostics: Vec<Diagnostic>, opts: &LoadOptions) 
 }
 
 #[cfg(test)]
-mod generated_tests {
+mod tests {
     use super::*;
     use crate::load::load_str;
 
