@@ -308,3 +308,52 @@ fn parenting_mistakes_are_located() {
         );
     }
 }
+
+/// BALL with a composite of two small spheres beside the ball.
+const PAIR: &str = "define material red 0.2 0 0 0.8 0.1 0.1 0.5 0.5 0.5 20
+define shape sphere ball 0 0 0 1 red
+define shape sphere left 3 0 0 0.3 red
+define shape sphere right 4 0 0 0.3 red
+define shape composite pair left right
+define light sun 5 5 5 1 1 1 1
+define camera cam 60 0 0 10 0 0 -1 0 1 0
+";
+
+#[test]
+fn a_composite_rides_on_a_turning_parent_and_its_children_cannot_ride_alone() {
+    let shot = |tracks: &str| {
+        let spec = format!(
+            "(scene: File(\"base.sdf\"), fps: 8, length: Seconds(2), end: Inclusive, resolution: (16, 9),
+  tracks: [{tracks}])"
+        );
+        let dir = project(&[("base.sdf", PAIR), ("shot.ron", &spec)]);
+        let (ok, stderr) = generate(&dir.path().join("shot.ron"), &dir.path().join("f"));
+        (
+            ok,
+            stderr,
+            if ok {
+                frames(&dir.path().join("f"))
+            } else {
+                Vec::new()
+            },
+        )
+    };
+    let (ok, stderr, frames) = shot(
+        "(target: \"ball\", rotate: [(at: 0, value: 0), (at: 2, value: 90)], axis: (0, 0, 1)),
+         (target: \"pair\", parent: \"ball\")",
+    );
+    assert!(ok && stderr.is_empty(), "{stderr}");
+    for (i, (_, text)) in frames.iter().enumerate() {
+        // The pair swings round the ball's centre as the ball turns: 90° × t / 2 s about z.
+        let angle = (90.0 * (i as f64 / 8.0) / 2.0f64).to_radians();
+        let want = DVec3::new(3.0 * angle.cos(), 3.0 * angle.sin(), 0.0);
+        let got = place(text, "pair", DVec3::new(3.0, 0.0, 0.0));
+        assert!((got - want).length() < 1e-9, "frame {i}: {got} vs {want}");
+    }
+    let (ok, stderr, _) = shot("(target: \"left\", parent: \"ball\")");
+    assert!(!ok);
+    assert!(
+        stderr.contains("'left' is placed by composite 'pair': give the composite the parent"),
+        "{stderr}"
+    );
+}
