@@ -357,3 +357,46 @@ fn a_composite_rides_on_a_turning_parent_and_its_children_cannot_ride_alone() {
         "{stderr}"
     );
 }
+
+#[test]
+fn an_aim_follows_a_target_carried_by_its_parent() {
+    let spec = "(scene: File(\"base.sdf\"), fps: 8, length: Seconds(2), end: Inclusive, resolution: (16, 9),
+  tracks: [(target: \"ball\", translate: [(at: 0, value: (0, 0, 0)), (at: 2, value: (0, 4, -2))]),
+           (target: \"pair\", parent: \"ball\"),
+           (target: \"cam\", look_at: Object(\"pair\"))])";
+    let dir = project(&[("base.sdf", PAIR), ("shot.ron", spec)]);
+    let (ok, stderr) = generate(&dir.path().join("shot.ron"), &dir.path().join("f"));
+    assert!(ok && stderr.is_empty(), "{stderr}");
+    for (name, text) in frames(&dir.path().join("f")) {
+        let cam = numbers(&line_with(&text, "define camera cam")[3..]);
+        let (eye, view) = (
+            DVec3::new(cam[1], cam[2], cam[3]),
+            DVec3::new(cam[4], cam[5], cam[6]),
+        );
+        // The pair's centre (3.5, 0, 0), carried as the ball moves.
+        let centre = place(&text, "pair", DVec3::new(3.5, 0.0, 0.0));
+        let to = (centre - eye).normalize();
+        assert!(
+            view.normalize().dot(to) > 1.0 - 1e-9,
+            "{name}: {view} vs {to}"
+        );
+    }
+}
+
+#[test]
+fn follow_rotate_takes_the_parent_s_turn_about_where_it_stood() {
+    let spec = "(scene: File(\"base.sdf\"), fps: 8, length: Seconds(2), end: Inclusive, resolution: (16, 9),
+  tracks: [(target: \"ball\", translate: [(at: 0, value: (0, 0, 0)), (at: 2, value: (0, 5, 0))],
+            rotate: [(at: 0, value: 0), (at: 2, value: 90)], axis: (0, 0, 1)),
+           (target: \"pair\", parent: \"ball\", follow: [Rotate])])";
+    let dir = project(&[("base.sdf", PAIR), ("shot.ron", spec)]);
+    let (ok, stderr) = generate(&dir.path().join("shot.ron"), &dir.path().join("f"));
+    assert!(ok && stderr.is_empty(), "{stderr}");
+    for (i, (_, text)) in frames(&dir.path().join("f")).iter().enumerate() {
+        // Turned about the ball's base centre (the origin), not carried up with it.
+        let angle = (45.0 * i as f64 / 8.0).to_radians();
+        let want = DVec3::new(3.0 * angle.cos(), 3.0 * angle.sin(), 0.0);
+        let got = place(text, "pair", DVec3::new(3.0, 0.0, 0.0));
+        assert!((got - want).length() < 1e-9, "frame {i}: {got} vs {want}");
+    }
+}
