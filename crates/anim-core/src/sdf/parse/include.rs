@@ -14,6 +14,7 @@ use super::{At, Line, Parser};
 use crate::diag::Diagnostic;
 use crate::limits::MAX_INCLUDE_DEPTH;
 use crate::sdf::ast::{FlatShapes, Statement, StatementKind};
+use crate::sdf::MaterialLayout;
 use crate::util::Fnv64;
 use std::cell::{Cell, RefCell};
 use std::collections::{HashMap, HashSet};
@@ -60,6 +61,12 @@ struct Included {
     skipped: HashSet<String>,
     render_lines: usize,
     cameras_rejected: bool,
+    /// How it was read: a generated frame reads what it includes as it is read itself, with
+    /// the standard material layout whatever `--material-fields auto` would infer and without
+    /// the warnings that hint at another layout (`sdf::is_generated_frame`); a reading is used
+    /// again only for the same layout and kind of includer.
+    layout: MaterialLayout,
+    generated: bool,
 }
 
 impl Included {
@@ -89,7 +96,13 @@ impl IncludeCache {
         self.len() == 0
     }
 
-    fn get(&self, path: &Path, chain: &Chain, limit: u64) -> Option<Arc<Included>> {
+    fn get(
+        &self,
+        path: &Path,
+        chain: &Chain,
+        limit: u64,
+        layout: &MaterialLayout,
+    ) -> Option<Arc<Included>> {
         let entry = self
             .entries
             .lock()
@@ -97,7 +110,10 @@ impl IncludeCache {
             .get(path)
             .cloned()??;
         let cycle = entry.files.iter().any(|f| chain.files.contains(&f.path));
-        (!cycle && entry.files.iter().all(|f| f.unchanged(limit))).then_some(entry)
+        let same = entry.layout == *layout
+            && entry.generated == chain.generated
+            && entry.files.iter().all(|f| f.unchanged(limit));
+        (!cycle && same).then_some(entry)
     }
 
     /// Keeps `included` if its file was read before.
@@ -131,6 +147,9 @@ pub(in crate::sdf) struct Chain {
     read: Rc<Cell<u64>>,
     /// The files read for the file being read now and those it includes.
     deps: Rc<RefCell<Vec<FileRead>>>,
+    /// Whether the outermost file is a frame `anim generate` wrote
+    /// (`sdf::is_generated_frame`): it and everything it includes are read with no guess.
+    pub(in crate::sdf) generated: bool,
 }
 
 impl Chain {
@@ -151,6 +170,7 @@ impl Chain {
             files: vec![resolved],
             read: Rc::new(Cell::new(text.len() as u64)),
             deps: Rc::default(),
+            generated: crate::sdf::is_generated_frame(text),
         }
     }
 
@@ -162,6 +182,7 @@ impl Chain {
             files,
             read: self.read.clone(),
             deps: Rc::default(),
+            generated: self.generated,
         }
     }
 }
@@ -229,7 +250,10 @@ impl Parser<'_> {
         let limit = self.opts.max_input;
         let before = self.chain.read.get();
         let display = self.path.parent().unwrap_or(Path::new("")).join(written);
-        let cached = self.opts.includes.get(&path, &self.chain, limit);
+        let cached = self
+            .opts
+            .includes
+            .get(&path, &self.chain, limit, &self.opts.material_fields);
         let included = match cached {
             Some(included) => included,
             None => match self.read_included(line, &path, &display) {
@@ -340,6 +364,8 @@ impl Parser<'_> {
             skipped: parsed.omissions.skipped,
             render_lines: parsed.omissions.render_lines,
             cameras_rejected: parsed.omissions.cameras_rejected,
+            layout: self.opts.material_fields.clone(),
+            generated: self.chain.generated,
         });
         self.opts.includes.put(path.to_path_buf(), &included);
         Some(included)

@@ -63,6 +63,9 @@ pub struct Parsed {
     pub diagnostics: Vec<Diagnostic>,
     /// What the reader left out that the scene builder must account for.
     pub omissions: Omissions,
+    /// Whether the file is a frame `anim generate` wrote (`sdf::is_generated_frame`): it was
+    /// read, and is built, with every guess turned off.
+    pub generated: bool,
 }
 
 /// What the reader left out of the statements that building must still account for: its
@@ -114,6 +117,7 @@ pub(super) fn parse(
     flat: bool,
     chain: include::Chain,
 ) -> Parsed {
+    let generated = chain.generated;
     let mut p = Parser {
         chain,
         file: Arc::from(path),
@@ -187,6 +191,7 @@ pub(super) fn parse(
                 .map(|(name, line)| (name.to_string(), line))
                 .collect(),
         },
+        generated,
     }
 }
 
