@@ -55,7 +55,7 @@ impl Project {
             Some(self.input.clone())
         };
         if let Some(scene) = scene {
-            files.extend(referenced_files(&scene, self.load.max_input));
+            files.extend(referenced_files(&scene, &self.load));
             files.push(scene);
         }
         files.sort();
@@ -70,8 +70,7 @@ impl Project {
         let fingerprint = settings_fingerprint(&self.settings, &self.load);
         // A frame's key is what `anim render DIR` records for it: the spec is not part of it,
         // as the frame texts say all it means.
-        let key =
-            |path: &Path, bytes: &[u8]| frame_hash(bytes, path, &fingerprint, self.load.max_input);
+        let key = |path: &Path, bytes: &[u8]| frame_hash(bytes, path, &fingerprint, &self.load);
         if !self.is_spec() {
             // Checked here, so that an error shows as the build's, with the last good frame.
             let loaded = anim_core::load::load_file(&self.input, &self.load).map_err(text)?;

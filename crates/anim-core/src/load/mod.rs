@@ -19,7 +19,7 @@ use crate::sdf::ast::{Statement, StatementKind};
 use crate::sdf::{self, finish_diagnostics, LoadOptions, TransformOrder};
 use std::borrow::Cow;
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// A successfully loaded file: its images to render and the warnings met on the way.
 #[derive(Clone, Debug)]
@@ -70,8 +70,11 @@ pub fn build(
     conclude(
         jobs,
         finish_diagnostics(diagnostics, opts),
-        path,
-        opts.max_input,
+        Quoting {
+            path,
+            opts,
+            included: &[],
+        },
         || None,
     )
 }
@@ -103,13 +106,17 @@ fn finish_load<'t>(
     opts: &LoadOptions,
     text: impl FnOnce() -> Option<Cow<'t, str>>,
 ) -> Result<Loaded, Vec<Diagnostic>> {
-    let (mut jobs, mut built) = build_jobs(
-        &parsed.statements,
-        parsed.shapes,
-        path,
-        opts,
-        Some(&parsed.omissions),
-    );
+    let (mut jobs, mut built) = if parsed.omissions.abandoned {
+        (Vec::new(), Vec::new())
+    } else {
+        build_jobs(
+            &parsed.statements,
+            parsed.shapes,
+            path,
+            opts,
+            Some(&parsed.omissions),
+        )
+    };
     // The text is asked for at most once: here when the transform order is in question (a
     // generated frame says what it means), else by `conclude` for quoting.
     let mut text = Some(text);
@@ -143,13 +150,12 @@ fn finish_load<'t>(
         Some(t) => t,
         None => text.and_then(|read| read()),
     };
-    conclude(
-        jobs,
-        finish_diagnostics(diagnostics, opts),
+    let quoting = Quoting {
         path,
-        opts.max_input,
-        text,
-    )
+        opts,
+        included: &parsed.included,
+    };
+    conclude(jobs, finish_diagnostics(diagnostics, opts), quoting, text)
 }
 
 /// Whether the file is worth reading another way (`--transform-order auto`,
@@ -276,6 +282,14 @@ fn read_in_other_order(
     Some((other_jobs, built))
 }
 
+/// Where the lines diagnostics quote come from: the scene file `path` and the files it
+/// included (`included`, read again only while they hold what was read).
+struct Quoting<'q> {
+    path: &'q Path,
+    opts: &'q LoadOptions,
+    included: &'q [sdf::FileRead],
+}
+
 /// `Err` with the diagnostics when one is an error. They are capped first, then the kept
 /// ones that lack their source line quote it from `text()` (the file's text, `None` for
 /// statements made by a program, asked for only when a line is to be quoted): quoting is
@@ -285,27 +299,19 @@ fn read_in_other_order(
 fn conclude<'t>(
     jobs: Vec<RenderJob>,
     diagnostics: Vec<Diagnostic>,
-    path: &Path,
-    max_input: u64,
+    quoting: Quoting<'_>,
     text: impl FnOnce() -> Option<Cow<'t, str>>,
 ) -> Result<Loaded, Vec<Diagnostic>> {
+    let path = quoting.path;
     let failed = diagnostics.iter().any(Diagnostic::is_error);
     let mut diagnostics = cap(diagnostics, path);
     quote_lines(&mut diagnostics, path, text);
-    // Lines of the files a scene includes are quoted from those files.
-    let mut others: Vec<&Path> = diagnostics
-        .iter()
-        .filter(|d| d.source_line.is_none())
-        .filter_map(|d| d.loc.as_ref().map(|l| &*l.file))
-        .filter(|&f| f != path)
-        .collect();
-    others.sort_unstable();
-    others.dedup();
-    let others: Vec<PathBuf> = others.into_iter().map(Path::to_path_buf).collect();
-    for file in others {
-        quote_lines(&mut diagnostics, &file, || {
-            read_input(&file, max_input, "file")
-                .ok()
+    // Lines of the files a scene includes are quoted from those files, confined as when
+    // they were included, and only while they hold the bytes that were read: a file swapped
+    // since (for a link to another file) is not quoted.
+    for file in quoting.included {
+        quote_lines(&mut diagnostics, file.shown(), || {
+            file.read_again(path, quoting.opts)
                 .map(|b| Cow::Owned(String::from_utf8_lossy(&b).into_owned()))
         });
     }

@@ -11,7 +11,9 @@ mod parse;
 pub mod repair;
 
 pub use lexer::{image_names, raw_lines, scene_key, ImageName};
-pub use parse::{default_output, included_files, mesh_files, IncludeCache, Omissions, Parsed};
+pub use parse::{
+    default_output, mesh_files, references, FileRead, IncludeCache, Omissions, Parsed, Reference,
+};
 
 use crate::diag::{Diagnostic, Severity};
 use crate::shape::MeshCache;
@@ -160,7 +162,7 @@ pub fn parse_source_whole(text: &str, path: &Path, opts: &LoadOptions) -> Parsed
 }
 
 fn read(text: &str, path: &Path, opts: &LoadOptions, flat: bool) -> Parsed {
-    let chain = parse::Chain::outermost(path, text);
+    let chain = parse::Chain::outermost(path, text, opts);
     parse::parse(text, path, opts, flat, chain)
 }
 

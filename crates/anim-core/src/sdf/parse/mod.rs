@@ -20,7 +20,7 @@ mod shape;
 mod transform;
 
 pub(super) use include::Chain;
-pub use include::{included_files, mesh_files, IncludeCache};
+pub use include::{mesh_files, references, FileRead, IncludeCache, Reference};
 pub use resolve::default_output;
 
 use super::ast::{FlatShapes, NameRef, Span, Statement, StatementKind, StatementSpans};
@@ -63,6 +63,9 @@ pub struct Parsed {
     pub diagnostics: Vec<Diagnostic>,
     /// What the reader left out that the scene builder must account for.
     pub omissions: Omissions,
+    /// The files the scene includes, to any depth, each once: where their lines are quoted
+    /// from, when still the same.
+    pub included: Vec<FileRead>,
 }
 
 /// What the reader left out of the statements that building must still account for: its
@@ -80,6 +83,9 @@ pub struct Omissions {
     pub cameras_rejected: bool,
     /// Names defined only in commented-out lines → the line (see `commented_definitions`).
     pub commented: HashMap<String, u32>,
+    /// Whether a limit of the reading as a whole stopped it (its includes repeat too much):
+    /// the statements are dropped, and nothing is built from them.
+    pub abandoned: bool,
 }
 
 /// An error has been reported; the statement is dropped.
@@ -174,7 +180,14 @@ pub(super) fn parse(
             ),
         ));
     }
+    let included = p.chain.take_included();
+    let abandoned = p.chain.abandoned();
+    if abandoned {
+        p.statements = Vec::new();
+        p.shapes = FlatShapes::default();
+    }
     Parsed {
+        included,
         statements: p.statements,
         shapes: p.shapes,
         diagnostics: p.diagnostics,
@@ -186,6 +199,7 @@ pub(super) fn parse(
                 .into_iter()
                 .map(|(name, line)| (name.to_string(), line))
                 .collect(),
+            abandoned,
         },
     }
 }
