@@ -2,6 +2,7 @@
 //! included many times in turn; a frame directory whose shared part includes itself, a pipe
 //! or `/dev/stdin`; a million include lines.
 
+use crate::budgets::limited;
 use std::path::Path;
 use std::process::Stdio;
 use std::time::{Duration, Instant};
@@ -13,21 +14,6 @@ const HEAD: &str = "define material m 0.2 0.2 0.2 0.8 0.8 0.8 0 0 0 1\n\
 fn write(path: &Path, text: &str) {
     std::fs::create_dir_all(path.parent().unwrap()).unwrap();
     std::fs::write(path, text).unwrap();
-}
-
-/// `anim ARGS` in `dir` under `ulimit -v` of `kib` KiB, stopped after 30 s: (exit code,
-/// stderr, time taken). A signal leaves no exit code; being stopped, code 124.
-fn limited(dir: &Path, kib: u64, args: &str) -> (Option<i32>, String, Duration) {
-    let start = Instant::now();
-    let out = std::process::Command::new("sh")
-        .current_dir(dir)
-        .arg("-c")
-        .arg(format!("ulimit -v {kib} && exec timeout 30 \"$0\" {args}"))
-        .arg(env!("CARGO_BIN_EXE_anim"))
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    (out.status.code(), stderr, start.elapsed())
 }
 
 /// Eight files, each including the next ten times, the last holding a sphere: 10^7 spheres

@@ -269,8 +269,9 @@ pub fn escape(text: &str) -> std::borrow::Cow<'_, str> {
     std::borrow::Cow::Owned(out)
 }
 
-/// `text` cut in the middle (with `…`) when longer than [`MAX_MESSAGE_CHARS`].
-fn shorten(text: &str) -> std::borrow::Cow<'_, str> {
+/// `text` cut in the middle (with `…`) when longer than a message shows (a thousand
+/// characters): what a message quoting a token of megabytes holds of it.
+pub fn shorten(text: &str) -> std::borrow::Cow<'_, str> {
     if text.len() <= MAX_MESSAGE_CHARS {
         return std::borrow::Cow::Borrowed(text);
     }

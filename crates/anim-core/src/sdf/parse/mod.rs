@@ -484,7 +484,7 @@ impl Parser<'_> {
     // ----- numbers -----------------------------------------------------------------------
 
     fn bad_number(&mut self, line: &Line, i: usize, e: NumberError) -> Fail {
-        let text = line.tokens.get(i).map_or("", |t| t.text).to_string();
+        let text = crate::diag::shorten(line.tokens.get(i).map_or("", |t| t.text)).into_owned();
         let (message, help) = match e {
             NumberError::Malformed => {
                 let help = if text.contains(['O', 'o'])
@@ -566,6 +566,18 @@ impl Parser<'_> {
     // ----- dispatch ----------------------------------------------------------------------
 
     fn line(&mut self, written: &Line) {
+        match self.split_statements(written) {
+            Some(statements) => {
+                for statement in &statements {
+                    self.statement_line(statement);
+                }
+            }
+            None => self.statement_line(written),
+        }
+    }
+
+    /// One statement's tokens, as written on a line.
+    fn statement_line(&mut self, written: &Line) {
         let normalised;
         let line = if dialect::may_need_normalising(written) {
             match self.normalise(written) {
