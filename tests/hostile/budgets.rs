@@ -46,3 +46,64 @@ fn a_glued_number_line_of_150_mb_ends_within_its_memory() {
         std::fs::remove_file(dir.join(name)).unwrap();
     }
 }
+
+const HEAD: &str = "define camera c 60 0 0 0 0 0 -1 0 1 0\n\
+                    define material m 0.1 0.1 0.1 0.5 0.5 0.5 0 0 0 1\n\
+                    define light l 0 10 0 1 1 1\n";
+
+/// `n` spheres on a grid, one line each, named `name` followed by the index when `numbered`.
+fn spheres(n: usize, name: &str, numbered: bool) -> String {
+    let mut text = String::with_capacity(n * 48);
+    for i in 0..n {
+        let suffix = if numbered {
+            i.to_string()
+        } else {
+            String::new()
+        };
+        let (x, y) = (i % 1000, i / 1000);
+        text.push_str(&format!(
+            "define shape sphere {name}{suffix} {x} {y} -50 0.4 m\n"
+        ));
+    }
+    text
+}
+
+/// A million spheres through one include: the same located "needs about ... MiB" message as
+/// the flat file gets, where reading them through the include once cost nearly three times
+/// the memory and aborted.
+#[test]
+fn a_million_spheres_through_an_include_end_with_the_memory_message() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(dir.join("part.sdfi"), spheres(1_000_000, "s", true)).unwrap();
+    let scene = format!("{HEAD}include part.sdfi\nrender c out.png 8 6\n");
+    std::fs::write(dir.join("scene.sdf"), scene).unwrap();
+    for command in ["check", "render"] {
+        let (code, stderr, _) = limited(dir, 500_000, &format!("{command} scene.sdf"));
+        assert_eq!(code, Some(1), "{command}: {stderr}");
+        let message = "part.sdfi:1:21: error: the scene's 1000000 shapes need about ";
+        assert!(stderr.contains(message), "{command}: {stderr}");
+    }
+}
+
+/// Three hundred thousand shapes of one name: each is a warning, but only the first ones a
+/// report shows are kept, so the file reads within a budget that once aborted it.
+#[test]
+fn same_name_shapes_keep_only_the_warnings_shown() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let n = 300_000;
+    let scene = format!("{HEAD}{}render c out.png 8 6\n", spheres(n, "s", false));
+    std::fs::write(dir.join("same.sdf"), scene).unwrap();
+    let (code, stderr, _) = limited(dir, 300_000, "check same.sdf");
+    assert_eq!(code, Some(0), "{stderr}");
+    let shown = anim_core::limits::MAX_DIAGNOSTICS;
+    // Every shape but the first repeats a name; the first `shown` of those are listed.
+    let left_out = n - 1 - shown;
+    let note = format!("and {left_out} more ({left_out} warnings) not shown");
+    assert!(
+        stderr.contains(&note),
+        "{}",
+        &stderr[stderr.len().saturating_sub(2000)..]
+    );
+}

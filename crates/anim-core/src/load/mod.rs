@@ -7,12 +7,13 @@ mod camera_sense;
 pub mod probe;
 
 pub use crate::input::read_input;
+pub use crate::sdf::not_shown;
 #[cfg(test)]
 mod scale_tests;
 #[cfg(test)]
 mod tests;
 
-use crate::diag::{Diagnostic, Severity};
+use crate::diag::{Diagnostic, LeftOut, Severity};
 use crate::limits::MAX_DIAGNOSTICS;
 use crate::scene::{build_jobs, RenderJob};
 use crate::sdf::ast::{Statement, StatementKind};
@@ -358,43 +359,28 @@ fn quote_lines<'t>(
     }
 }
 
-/// The first [`MAX_DIAGNOSTICS`] diagnostics and, if there were more, one saying how many
-/// were left out ([`not_shown`]).
-fn cap(mut diagnostics: Vec<Diagnostic>, path: &Path) -> Vec<Diagnostic> {
-    if diagnostics.len() <= MAX_DIAGNOSTICS {
-        return diagnostics;
-    }
-    let rest = diagnostics.split_off(MAX_DIAGNOSTICS);
-    let errors = rest.iter().filter(|d| d.is_error()).count();
-    diagnostics.push(not_shown(path, errors, rest.len() - errors));
-    diagnostics
-}
-
-/// The last diagnostic of a file with more problems than are listed: how many `errors` and
-/// `warnings` were left out after the first [`MAX_DIAGNOSTICS`].
-/// An error if any of those is one, so that the count is never mistaken for harmless.
-pub fn not_shown(path: &Path, errors: usize, warnings: usize) -> Diagnostic {
-    let plural = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
-    let kinds: Vec<String> = [(errors, "error"), (warnings, "warning")]
+/// The first [`MAX_DIAGNOSTICS`] diagnostics and, if there were more (kept, or left out
+/// while reading: `sdf::keep_shown`), one saying how many were left out ([`not_shown`]).
+fn cap(diagnostics: Vec<Diagnostic>, path: &Path) -> Vec<Diagnostic> {
+    let mut left = LeftOut::default();
+    let mut kept: Vec<Diagnostic> = diagnostics
         .into_iter()
-        .filter(|(n, _)| *n > 0)
-        .map(|(n, what)| plural(n, what))
+        .filter(|d| {
+            if d.left_out.is_some() {
+                left.add(d);
+            }
+            d.left_out.is_none()
+        })
         .collect();
-    let severity = if errors > 0 {
-        Severity::Error
-    } else {
-        Severity::Warning
-    };
-    Diagnostic::file_error(
-        path,
-        format!(
-            "and {} more ({}) not shown: only the first {} problems of a file are listed",
-            errors + warnings,
-            kinds.join(", "),
-            MAX_DIAGNOSTICS
-        ),
-    )
-    .with_severity(severity)
+    if kept.len() > MAX_DIAGNOSTICS {
+        for d in kept.split_off(MAX_DIAGNOSTICS) {
+            left.add(&d);
+        }
+    }
+    if !left.is_empty() {
+        kept.push(not_shown(path, left.errors, left.warnings));
+    }
+    kept
 }
 
 #[cfg(test)]

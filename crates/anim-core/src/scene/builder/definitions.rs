@@ -327,7 +327,7 @@ impl Builder<'_> {
                 let message = format!("mesh file `{}` {}", m.file, d.message);
                 self.error(At::Statement(stmt), message, None);
             }
-            Err(d) => self.diagnostics.push(*d),
+            Err(d) => self.push(*d),
         }
     }
 

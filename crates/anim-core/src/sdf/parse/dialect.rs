@@ -359,7 +359,11 @@ mod tests {
             .collect();
         // Material, ambient (just after `10`), background (just after the last `0.1`); the
         // camera and the material named like a glued statement are names, left whole.
-        assert_eq!(kinds, ["1:1", "1:39", "1:58", "2:1", "3:1"], "{diagnostics:?}");
+        assert_eq!(
+            kinds,
+            ["1:1", "1:39", "1:58", "2:1", "3:1"],
+            "{diagnostics:?}"
+        );
         let warned: Vec<&str> = diagnostics.iter().map(|d| d.message.as_str()).collect();
         assert_eq!(warned.len(), 1, "{warned:?}");
         assert!(warned[0].starts_with("`10ambient` read as the number `10`"));

@@ -180,6 +180,7 @@ pub(super) fn parse(
             ),
         ));
     }
+    crate::sdf::keep_shown(&mut p.diagnostics, path);
     let included = p.chain.take_included();
     let abandoned = p.chain.abandoned();
     if abandoned {
@@ -566,6 +567,8 @@ impl Parser<'_> {
     // ----- dispatch ----------------------------------------------------------------------
 
     fn line(&mut self, written: &Line) {
+        // Between lines, where no line's problems are being gathered.
+        crate::sdf::keep_shown(&mut self.diagnostics, self.path);
         match self.split_statements(written) {
             Some(statements) => {
                 for statement in &statements {

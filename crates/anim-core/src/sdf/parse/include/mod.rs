@@ -213,20 +213,23 @@ impl Parser<'_> {
                 self.camera_names.push(c.name.clone());
             }
         }
-        let first = self.statements.is_empty() && self.shapes.is_empty();
-        if self.flat && first {
-            // The include opens a file that keeps its shapes apart (a generated frame): the
-            // included shapes stay compact, their places those of the included file.
-            self.flat = !included.statements.iter().any(|s| breaks_flat(&s.kind));
-            self.shapes = included.shapes;
-            self.statements.extend(included.statements);
-        } else {
+        let breaks = included.statements.iter().any(|s| breaks_flat(&s.kind));
+        let mut rest = Some((included.shapes, included.statements));
+        if let Some((shapes, statements)) = rest.take_if(|_| self.flat && !breaks) {
+            // Both files keep their shapes apart: the included shapes stay compact, each
+            // with its place in its own file, after the statements read so far.
+            match self.shapes.append(shapes, self.statements.len()) {
+                Ok(()) => self.statements.extend(statements),
+                Err(back) => rest = Some((*back, statements)),
+            }
+        }
+        if let Some((shapes, statements)) = rest {
             // Every shape is a statement from here on, in the order read.
             if self.flat {
                 self.merge_shapes();
             }
             self.flat = false;
-            let (all, _) = included.shapes.merge_into(included.statements);
+            let (all, _) = shapes.merge_into(statements);
             self.statements.extend(all);
         }
         self.diagnostics.extend(included.diagnostics);
