@@ -8,11 +8,17 @@
 //!   scene including its materials file), and plain HTTP requests to it.
 //! - `http`: the routes, refusals (traversal, encoded traversal, foreign `Host`), pixels, edits
 //!   and warnings, through plain HTTP requests.
+//!   The server under load: half-open connections, a client that never reads, the event
+//!   stream of a 100,000-frame spec.
+//! - `watch`: named pipes as a mesh, as the scene after an edit, as a spec's base scene.
+//! - `fuzz`: random requests and connection patterns (FUZZING.md).
 //! - `browser`: the page in headless Chromium, driven by `scripts/preview-browser.py`.
 
 #[path = "../common/mod.rs"]
 mod common;
 
 mod browser;
+mod fuzz;
 mod http;
 mod session;
+mod watch;

@@ -74,8 +74,10 @@ impl Project {
         if !self.is_spec() {
             // Checked here, so that an error shows as the build's, with the last good frame.
             let loaded = anim_core::load::load_file(&self.input, &self.load).map_err(text)?;
-            let bytes = std::fs::read(&self.input)
-                .map_err(|e| vec![format!("{}: error: {e}", self.input.display())])?;
+            // Read as the loader reads (bounded, never waiting on a pipe): the file may have
+            // been replaced since.
+            let bytes = anim_core::load::read_input(&self.input, self.load.max_input, "file")
+                .map_err(text)?;
             let key = key(&self.input, &bytes);
             return Ok(Built {
                 frames: vec![FrameSource {
@@ -98,7 +100,8 @@ impl Project {
         let frames = paths
             .into_iter()
             .map(|path| {
-                let key = key(&path, &std::fs::read(&path).unwrap_or_default());
+                let bytes = anim_core::load::read_input(&path, self.load.max_input, "file");
+                let key = key(&path, &bytes.unwrap_or_default());
                 FrameSource { path, key }
             })
             .collect();
