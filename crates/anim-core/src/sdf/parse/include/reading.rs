@@ -296,6 +296,11 @@ impl Chain {
         }
     }
 
+    /// Whether the file being read now is included by another.
+    pub(in crate::sdf) fn is_included(&self) -> bool {
+        self.files.len() > 1
+    }
+
     /// The files read for the file being read now, each once, taken.
     pub(in crate::sdf) fn take_included(&self) -> Vec<FileRead> {
         std::mem::take(&mut *self.deps.borrow_mut()).into_vec()
