@@ -141,6 +141,16 @@ fn pipes_and_stdin_included_by_a_frame_are_refused_without_waiting() {
     ] {
         assert!(stderr.contains(expected), "{expected}: {stderr}");
     }
+    // Allowed anywhere, `/dev/stdin` on a pipe is refused for what it is.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_anim"))
+        .args(["check", "--allow-any-input"])
+        .arg(frames.join("frame_0000.sdf"))
+        .stdin(Stdio::piped())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let expected = "frame_0000.sdf:4:9: error: `/dev/stdin` is not a regular file";
+    assert!(stderr.contains(expected), "{stderr}");
     assert!(
         start.elapsed() < Duration::from_secs(5),
         "{:?}",

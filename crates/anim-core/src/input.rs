@@ -175,10 +175,14 @@ pub fn open_named(path: &Path, scene: &Path, any: bool) -> Result<Opened, Refusa
         std::fs::metadata(real).is_ok_and(|m| m.dev() == opened.dev() && m.ino() == opened.ino())
     });
     let Some(real) = real else {
-        return Err(if allowed(&would_be(path)) {
-            Refusal::Changed
-        } else {
+        return Err(if !allowed(&would_be(path)) {
             Refusal::Outside
+        } else if !opened.is_file() && !opened.is_dir() {
+            // A pipe or socket no path names (`/dev/stdin` on a pipe): what it is is the
+            // reason, not a swap.
+            Refusal::NotRegular
+        } else {
+            Refusal::Changed
         });
     };
     if !allowed(&real) {
