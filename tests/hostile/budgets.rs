@@ -107,3 +107,30 @@ fn same_name_shapes_keep_only_the_warnings_shown() {
         &stderr[stderr.len().saturating_sub(2000)..]
     );
 }
+
+/// Under an address-space limit too small for a worker's stack, `check` says why it cannot
+/// start (the stack each worker reserves, the memory the process may use), where it once
+/// said only "cannot start worker threads".
+#[test]
+fn worker_threads_that_cannot_start_say_why() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(dir.join("s.sdf"), format!("{HEAD}render c out.png 8 6\n")).unwrap();
+    let (code, stderr, _) = limited(dir, 30_000, "check s.sdf");
+    assert_eq!(code, Some(1), "{stderr}");
+    let stack = anim_core::util::human_bytes(anim_core::limits::RENDER_STACK_BYTES as u64);
+    assert!(
+        stderr.contains("error: cannot start worker threads"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains(&format!(
+            "each reserves {stack} of address space for its stack"
+        )),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("this process may use 29.3 MiB in all"),
+        "{stderr}"
+    );
+}
