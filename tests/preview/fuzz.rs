@@ -7,7 +7,8 @@
 //! the server sends. See FUZZING.md; `scripts/fuzz.sh --http` runs it.
 //!
 //! Settings from the environment: `HTTP_FUZZ_REQUESTS` (default 300 000), `HTTP_FUZZ_SEED`
-//! (1). Deterministic in what it sends (`SplitMix64`), not in timing.
+//! (1), `HTTP_FUZZ_CLIENTS` (4 threads at once, client `i` drawing from seed + i).
+//! Deterministic in what each client sends (`SplitMix64`), not in timing.
 
 use crate::session::Preview;
 use anim_core::util::SplitMix64;
@@ -90,11 +91,15 @@ fn read_answers(stream: &mut TcpStream, wait: Duration) -> u64 {
     let _ = stream.set_read_timeout(Some(wait));
     let mut got = Vec::new();
     let mut chunk = [0u8; 16 << 10];
-    // An event stream never ends: a few reads of it are enough.
     for _ in 0..64 {
         match stream.read(&mut chunk) {
             Ok(0) | Err(_) => break,
             Ok(n) => got.extend_from_slice(&chunk[..n]),
+        }
+        // An event stream never ends: its first event is enough.
+        let stream_began = got.windows(17).any(|w| w == b"text/event-stream");
+        if stream_began && got.windows(6).any(|w| w == b"data: ") {
+            break;
         }
     }
     let text = String::from_utf8_lossy(&got);
@@ -182,8 +187,31 @@ fn page_is_served(preview: &Preview, tally: &mut Tally) {
     tally.slowest_check = tally.slowest_check.max(took);
 }
 
-fn run(requests: u64, seed: u64) -> Tally {
+/// `requests` requests from `clients` threads at once (client `i` draws from seed
+/// `seed + i`), the page checked every 500 requests of each client.
+fn run(requests: u64, seed: u64, clients: u64) -> Tally {
     let mut preview = Preview::start_scene();
+    let tallies: Vec<Tally> = std::thread::scope(|scope| {
+        let preview = &preview;
+        let workers: Vec<_> = (0..clients)
+            .map(|i| scope.spawn(move || client(preview, requests / clients, seed + i)))
+            .collect();
+        workers.into_iter().map(|w| w.join().unwrap()).collect()
+    });
+    let mut tally = Tally::default();
+    for t in tallies {
+        tally.requests += t.requests;
+        tally.connections += t.connections;
+        tally.answers += t.answers;
+        tally.checks += t.checks;
+        tally.slowest_check = tally.slowest_check.max(t.slowest_check);
+    }
+    page_is_served(&preview, &mut tally);
+    assert!(preview.stop(), "the preview did not end cleanly");
+    tally
+}
+
+fn client(preview: &Preview, requests: u64, seed: u64) -> Tally {
     let mut rng = SplitMix64::new(seed);
     let mut tally = Tally::default();
     let mut held = Vec::new();
@@ -194,13 +222,10 @@ fn run(requests: u64, seed: u64) -> Tally {
         tally.answers += answers;
         tally.connections += 1;
         if tally.requests >= next_check {
-            page_is_served(&preview, &mut tally);
+            page_is_served(preview, &mut tally);
             next_check = tally.requests + 500;
         }
     }
-    drop(held);
-    page_is_served(&preview, &mut tally);
-    assert!(preview.stop(), "the preview did not end cleanly");
     tally
 }
 
@@ -218,6 +243,7 @@ fn http_fuzz() {
     let tally = run(
         number("HTTP_FUZZ_REQUESTS", 300_000),
         number("HTTP_FUZZ_SEED", 1),
+        number("HTTP_FUZZ_CLIENTS", 4).max(1),
     );
     let secs = start.elapsed().as_secs_f64();
     eprintln!(
@@ -229,7 +255,7 @@ fn http_fuzz() {
 /// A short run on every test pass.
 #[test]
 fn http_fuzz_smoke() {
-    let tally = run(2_000, 7);
+    let tally = run(2_000, 7, 2);
     assert!(tally.answers > 0 && tally.checks > 2, "{tally:?}");
 }
 

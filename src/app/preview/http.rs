@@ -201,30 +201,18 @@ impl Connection {
     /// `request` is `None` for a request that could not be read.
     pub fn respond(&mut self, request: Option<&Request>, answer: &Answer) -> bool {
         let len = answer.body.len() as u64;
-        let head_only = request.is_some_and(|r| r.method == Method::Head);
-        self.respond_head(request, answer, len)
-            && (head_only || self.write(&answer.body))
-            && request.is_some_and(|r| !r.close)
+        let mut bytes = head(request, answer, len).into_bytes();
+        if request.is_none_or(|r| r.method != Method::Head) {
+            // One write: the answer leaves in as few packets as it fits.
+            bytes.extend_from_slice(&answer.body);
+        }
+        self.write(&bytes) && request.is_some_and(|r| !r.close)
     }
 
     /// Writes the head of `answer` for a body of `len` bytes, which the caller then writes;
     /// whether it was written.
     pub fn respond_head(&mut self, request: Option<&Request>, answer: &Answer, len: u64) -> bool {
-        let close = request.is_none_or(|r| r.close);
-        let mut head = format!(
-            "HTTP/1.1 {} {}\r\nContent-Length: {len}\r\n",
-            answer.status,
-            reason(answer.status),
-        );
-        for (name, value) in &answer.headers {
-            head.push_str(&format!("{name}: {value}\r\n"));
-        }
-        head.push_str(if close {
-            "Connection: close\r\n\r\n"
-        } else {
-            "\r\n"
-        });
-        self.write(head.as_bytes())
+        self.write(head(request, answer, len).as_bytes())
     }
 
     /// Writes `bytes`, waiting at most [`WRITE_TIMEOUT`] for the client to take them.
@@ -243,6 +231,26 @@ pub struct Answer {
     pub status: u16,
     pub headers: Vec<(&'static str, String)>,
     pub body: Vec<u8>,
+}
+
+/// The status line and headers of `answer` for a body of `len` bytes, closing the connection
+/// after it when the request asked (or could not be read).
+fn head(request: Option<&Request>, answer: &Answer, len: u64) -> String {
+    let close = request.is_none_or(|r| r.close);
+    let mut head = format!(
+        "HTTP/1.1 {} {}\r\nContent-Length: {len}\r\n",
+        answer.status,
+        reason(answer.status),
+    );
+    for (name, value) in &answer.headers {
+        head.push_str(&format!("{name}: {value}\r\n"));
+    }
+    head.push_str(if close {
+        "Connection: close\r\n\r\n"
+    } else {
+        "\r\n"
+    });
+    head
 }
 
 fn reason(status: u16) -> &'static str {
