@@ -416,6 +416,7 @@ fn execute(target: Target, input: &[u8], variant: u64, base: &BaseScene) {
                 );
             }
         }
+        Target::Include if variant.is_multiple_of(4) => diamond(input, variant / 4),
         Target::Include => included(input, variant),
         Target::Spec => {
             let src = Source::new(Path::new("fuzz.ron"), text.into_owned());
@@ -466,6 +467,40 @@ fn included(input: &[u8], variant: u64) {
     part.extend_from_slice(ending);
     std::fs::write(dir.join("part.sdfi"), &part).expect("a temporary file");
     let main = [b"include part.sdfi\n".as_slice(), tail].concat();
+    std::fs::write(dir.join("main.sdf"), main).expect("a temporary file");
+    let result = anim_core::load::load_file(&dir.join("main.sdf"), &LoadOptions::default());
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_printable(&result);
+}
+
+/// The input at the foot of a diamond of includes: `main.sdf` includes `d0.sdfi`, each
+/// `dN.sdfi` includes `dN+1.sdfi` 1 to 10 times (some lines spelling it `./dN+1.sdfi`), 1 to
+/// 8 levels deep, and the last holds the input's head (sometimes including `d0.sdfi` again:
+/// a loop); `main.sdf` holds its tail. 8 levels of 10 would splice the foot 10^8 times.
+fn diamond(input: &[u8], variant: u64) {
+    static INPUTS: AtomicU64 = AtomicU64::new(0);
+    let n = INPUTS.fetch_add(1, Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("anim-fuzz-diamond-{}-{n}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary folder");
+    let levels = 1 + (variant % 8) as usize;
+    let width = 1 + ((variant / 8) % 10) as usize;
+    let cut = ((variant / 80) as usize) % (input.len() + 1);
+    let (head, tail) = input.split_at(cut);
+    for level in 0..levels {
+        let lines: String = (0..width)
+            .map(|i| {
+                let dot = if i % 3 == 2 { "./" } else { "" };
+                format!("include {dot}d{}.sdfi\n", level + 1)
+            })
+            .collect();
+        std::fs::write(dir.join(format!("d{level}.sdfi")), lines).expect("a temporary file");
+    }
+    let mut foot = head.to_vec();
+    if (variant / 80 / 65536).is_multiple_of(4) {
+        foot.extend_from_slice(b"\ninclude d0.sdfi\n");
+    }
+    std::fs::write(dir.join(format!("d{levels}.sdfi")), foot).expect("a temporary file");
+    let main = [b"include d0.sdfi\n".as_slice(), tail].concat();
     std::fs::write(dir.join("main.sdf"), main).expect("a temporary file");
     let result = anim_core::load::load_file(&dir.join("main.sdf"), &LoadOptions::default());
     let _ = std::fs::remove_dir_all(&dir);
