@@ -10,8 +10,10 @@ runs it and compares the pixels with `anim render`'s.
 
 Writes into DIR: first.ppm, last.ppm (frames 0 and N-1 at full quality), edited.ppm (frame
 0 after the edit), included.ppm (frame 0 after the included file was replaced by
---included-edited, once it shows within 5 s), screenshot.png, and result.json (what was seen,
-with timings).
+--included-edited, once it shows within 5 s), export.mp4 (what Export gave once the included
+file was put back: frame 0 after the edit, as it was), screenshot.png,
+and result.json (what was seen, with timings; key_steps: each arrow key pressed with the
+timeline, a button or nothing focused, with the frame before and after).
 
     preview-browser.py --url URL --frames N --screenshot OUT.png [--at FRAME]
 
@@ -78,6 +80,26 @@ def screenshot(a):
     return 0
 
 
+def key_steps(page):
+    """Presses the arrow keys with the timeline (clicked, as a user does), a button and the
+    page focused; each press must step one frame. Returns [(focus, before, after, key)]."""
+    value = lambda: page.eval_on_selector("#scrub", "s => Number(s.value)")
+    steps = []
+    for target, key in [("#scrub", "ArrowRight"), ("#scrub", "ArrowLeft"), ("#play", "ArrowRight"),
+                        ("#next", "ArrowLeft"), ("body", "ArrowRight")]:
+        if target == "#scrub":
+            page.click(target)
+        else:
+            scrub(page, 2)
+            page.focus(target) if target != "body" else page.eval_on_selector(
+                "body", "b => document.activeElement.blur()")
+        before = value()
+        page.keyboard.press(key)
+        page.wait_for_timeout(100)
+        steps.append([target, before, value(), key])
+    return steps
+
+
 def edit_included(page, a, result):
     """Replaces the included file and waits (5 s at most) for frame 0 to change on screen."""
     scrub(page, 0)
@@ -88,6 +110,30 @@ def edit_included(page, a, result):
     result["included_edit_to_screen_s"] = time.monotonic() - edited_at
     shown(page, 0, "full")
     write_ppm(a.out / "included.ppm", page.eval_on_selector("#frame", READ_PIXELS))
+
+
+def export(page, a, result, original):
+    """Puts the included file back as it was (`original`: every frame is redrawn, small
+    first), presses Export as soon as frame 0 shows the change, notes what the page says
+    meanwhile, and saves the video as export.mp4."""
+    if original is not None:
+        scrub(page, 0)
+        before = shown(page, 0)
+        a.included.write_text(original)
+        shown(page, 0, version_not=before["version"], timeout=5000)
+    page.click("#export")
+    result["export_progress"] = page.inner_text("#export-status")
+    page.wait_for_function("() => document.getElementById('export-status').dataset.done === '1'",
+                           timeout=60000)
+    link = page.query_selector("#export-status a")
+    if link:
+        video = page.request.get(a.url + link.get_attribute("href").lstrip("/"))
+        (a.out / "export.mp4").write_bytes(video.body())
+        result["export"] = {"status": video.status, "bytes": len(video.body()),
+                            "mp4": video.body()[4:8] == b"ftyp",
+                            "said": page.inner_text("#export-status")}
+    else:
+        result["export"] = {"message": page.inner_text("#export-status")}
 
 
 def main():
@@ -137,6 +183,7 @@ def main():
         page.click("#prev")
         result["stepped"] = page.eval_on_selector("#scrub", "s => Number(s.value)") == after_step - 1 \
             or after_step == 0
+        result["key_steps"] = key_steps(page)
         scrub(page, 2)
         shown(page, 2, "full")
         page.screenshot(path=str(a.out / "screenshot.png"))
@@ -158,20 +205,11 @@ def main():
         page.wait_for_selector("#diagnostics", state="hidden", timeout=10000)
         result["fixed"] = True
 
+        original = a.included.read_text() if a.included else None
         if a.included:
             edit_included(page, a, result)
 
-        page.click("#export")
-        page.wait_for_function(
-            "() => !['', 'encoding…'].includes(document.getElementById('export-status').textContent)",
-            timeout=30000)
-        link = page.query_selector("#export-status a")
-        if link:
-            video = page.request.get(a.url + link.get_attribute("href").lstrip("/"))
-            result["export"] = {"status": video.status, "bytes": len(video.body()),
-                                "mp4": video.body()[4:8] == b"ftyp"}
-        else:
-            result["export"] = {"message": page.inner_text("#export-status")}
+        export(page, a, result, original)
 
         refused = {}
         for path in ["../../../etc/passwd", "%2e%2e/%2e%2e/etc/passwd", "frame/..%2f..%2fsmall.ron",

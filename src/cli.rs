@@ -109,6 +109,20 @@ pub struct RenderArgs {
     /// (NAME.pfm: little-endian 32-bit floats, bottom row first).
     #[arg(long)]
     pub hdr: bool,
+    /// Bits per channel: 8 or 16 for PNG (16: tone-mapped like the 8-bit image, or linear with
+    /// --linear), 16 (half, the default) or 32 (float) for OpenEXR (.exr); other formats hold
+    /// 8.
+    #[arg(long, value_name = "BITS", value_parser = parse_depth)]
+    pub depth: Option<u8>,
+    /// Write linear radiance (clipped to [0, 1], marked by a gAMA chunk of 1.0) rather than the
+    /// tone map's values: 16-bit PNG only; OpenEXR is always linear.
+    #[arg(long)]
+    pub linear: bool,
+    /// Add an alpha channel: each pixel's coverage by geometry (a camera sample that hits
+    /// nothing is transparent), without the background colour. Straight in PNG and TGA,
+    /// premultiplied in OpenEXR.
+    #[arg(long)]
+    pub alpha: bool,
     /// Write images where render lines say even outside the scene's folder (or --out):
     /// absolute paths and paths climbing out with `..`.
     #[arg(long)]
@@ -177,7 +191,8 @@ pub struct PreviewArgs {
     #[arg(long)]
     pub open: bool,
     /// Render every frame at full quality, encode them into this MP4 with ffmpeg and stop
-    /// (no server).
+    /// (no server). Checked first: its folder must exist, and it must not be a file the
+    /// preview reads (the spec, its scene, includes, meshes).
     #[arg(long, value_name = "OUT.mp4")]
     pub export: Option<PathBuf>,
     /// Worker threads (default: one per core).
@@ -385,6 +400,15 @@ fn parse_image_side(s: &str) -> Result<u32, String> {
     whole_in(s, limits::IMAGE_SIDE)
 }
 
+fn parse_depth(s: &str) -> Result<u8, String> {
+    match s.trim() {
+        "8" => Ok(8),
+        "16" => Ok(16),
+        "32" => Ok(32),
+        _ => Err(format!("'{s}' is not a channel depth: 8, 16 or 32")),
+    }
+}
+
 fn parse_max_depth(s: &str) -> Result<u32, String> {
     whole_in(s, 0..=limits::MAX_DEPTH)
 }
@@ -445,6 +469,9 @@ impl RenderArgs {
             allow_any_output: self.allow_any_output,
             max_memory: self.scene.max_memory(),
             hdr: self.hdr,
+            depth: self.depth,
+            linear: self.linear,
+            alpha: self.alpha,
         }
     }
 }

@@ -222,3 +222,4 @@ pub fn unit(a: V) -> V {
 }
 
 pub mod hdr;
+pub mod media;

@@ -80,6 +80,7 @@ const WORDS: &[&str] = &[
     "cylinder",
     "cone",
     "plane",
+    "obj",
     "material",
     "light",
     "camera",
@@ -805,4 +806,16 @@ fn fuzz_smoke() {
     // The shared corpus may be absent on other machines; the repository's seeds suffice.
     let report = run(&settings);
     assert_eq!((report.crashes, report.hangs), (0, 0));
+}
+
+/// Mutations insert every keyword of a primitive, so a new primitive's reader is fuzzed too.
+#[test]
+fn the_vocabulary_names_every_primitive() {
+    for kind in anim_core::shape::Shape::KINDS {
+        let keyword = if kind == "mesh" { "obj" } else { kind };
+        assert!(
+            WORDS.contains(&keyword),
+            "WORDS lacks the primitive keyword {keyword}"
+        );
+    }
 }

@@ -12,12 +12,15 @@
 //! - `mesh`: OBJ meshes drawn like the formulas and like the equivalent boxes; OBJ errors.
 //! - `instancing`: shared composites kept once, and drawn to the bytes of their flattened
 //!   rewrite.
+//! - `formats`: OpenEXR against the PFM, 16-bit PNG against the 8-bit one, and `--alpha`
+//!   against each pixel's coverage worked out from the geometry.
 
 #[path = "../common/mod.rs"]
 mod common;
 
 mod adaptive;
 mod finite_pixels;
+mod formats;
 mod glass_edges;
 mod golden;
 mod instancing;

@@ -101,6 +101,81 @@ fn second_render_skips_everything_and_a_changed_frame_renders_alone() {
     );
 }
 
+/// Every format anim writes, with the options it can hold, goes through the record alike:
+/// the record vouches for the exact bytes, a second run skips, a damaged image renders again
+/// (to the same bytes), a hold is copied byte for byte, shards split the frames, and a change
+/// of `--alpha` or `--depth` renders again.
+#[test]
+fn every_image_format_is_recorded_skipped_held_and_sharded_alike() {
+    let cases: [(&str, &[&str]); 7] = [
+        ("exr", &["--alpha"]),
+        ("exr", &["--depth", "32"]),
+        ("png", &["--depth", "16", "--linear", "--alpha"]),
+        ("tga", &["--alpha"]),
+        ("jpg", &[]),
+        ("bmp", &[]),
+        ("ppm", &[]),
+    ];
+    for (ext, options) in cases {
+        let dir = tempfile::tempdir().expect("tempdir");
+        // Frames 1 and 2 show one scene: a hold.
+        for (i, x) in [0.0, 0.5, 0.5, 1.0].into_iter().enumerate() {
+            let name = format!("shot_{i}");
+            let text = frame_text(x, &name).replace(".png", &format!(".{ext}"));
+            std::fs::write(dir.path().join(format!("{name}.sdf")), text).expect("write");
+        }
+        let image = |i: usize| dir.path().join(format!("shot_{i}.{ext}"));
+        let first = render(dir.path(), options);
+        assert_eq!(
+            first.rendered.len(),
+            3,
+            "{ext} {options:?}: {:?}",
+            first.failed
+        );
+        assert_eq!(first.copied.len(), 1, "{ext}: the hold is copied");
+        let bytes: Vec<Vec<u8>> = (0..4)
+            .map(|i| std::fs::read(image(i)).expect("image"))
+            .collect();
+        assert_eq!(bytes[1], bytes[2], "{ext}: the copy is the rendered image");
+        for (i, written) in bytes.iter().enumerate() {
+            let record = std::fs::read_to_string(record_path(dir.path(), &format!("shot_{i}.sdf")))
+                .expect("record");
+            let line = format!(
+                "image {} {:016x} shot_{i}.{ext}",
+                written.len(),
+                anim_core::util::Fnv64::of(written)
+            );
+            assert!(record.lines().any(|l| l == line), "{ext}: {record}");
+        }
+        assert_eq!(render(dir.path(), options).skipped.len(), 4, "{ext}");
+        // A damaged image renders again, to the bytes it had.
+        let mut damaged = bytes[3].clone();
+        let middle = damaged.len() / 2;
+        damaged[middle] ^= 0xff;
+        std::fs::write(image(3), damaged).expect("write");
+        let again = render(dir.path(), options);
+        assert_eq!(again.rendered, ["shot_3.sdf"], "{ext}");
+        assert_eq!(std::fs::read(image(3)).expect("image"), bytes[3], "{ext}");
+        // Shards split the work; a change of the image options renders everything.
+        let changed: Vec<&str> = match options.contains(&"--alpha") {
+            true => options
+                .iter()
+                .copied()
+                .filter(|o| *o != "--alpha")
+                .collect(),
+            false => vec!["--force"],
+        };
+        let halves: usize = ["1/2", "2/2"]
+            .iter()
+            .map(|k| {
+                let shard = render(dir.path(), &[&changed[..], &["--shard", k]].concat());
+                shard.rendered.len() + shard.copied.len()
+            })
+            .sum();
+        assert_eq!(halves, 4, "{ext}: the shards render every frame once");
+    }
+}
+
 /// A triangle `size` from its centre (on the view axis, 5 in front of the eye) to each side,
 /// as an OBJ file.
 fn triangle_obj(size: f64) -> String {

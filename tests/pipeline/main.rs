@@ -7,6 +7,9 @@
 //!   transforms compose with the base scene's own.
 //! - `frames`: generate → render a directory → encode, with skipping of unchanged frames,
 //!   resuming, shards and failures.
+//! - `encode`: `scripts/encode.sh` and `animate.sh`: the rate and the images' names read from
+//!   the frames, the codecs (alpha kept where it can be), OpenEXR and 16-bit frames tone-mapped
+//!   as anim's 8-bit images, and the refusals that come before any work.
 //! - `holds`: frames of one scene rendered once and copied, byte for byte.
 //! - `bench`: `anim bench` at its tiny size, and the files it writes.
 //! - `animator`: aim, orientation keys, the inclusive end, curves kept in range, materials,
@@ -19,6 +22,7 @@ mod common;
 
 mod animator;
 mod bench;
+mod encode;
 mod frames;
 mod holds;
 mod keyframe_spec;

@@ -4,6 +4,7 @@
 //! what it saw. Where Chromium or Playwright is
 //! missing the test says so and passes, unless `CI` is set: CI installs both (`.ci/run`).
 
+use crate::common::media::psnr_per_frame;
 use crate::common::read_ppm;
 use crate::common::Rgb8;
 use crate::session::{
@@ -152,12 +153,65 @@ fn the_page_plays_scrubs_and_follows_edits_in_chromium() {
     assert!(result.contains("\"included_edit_to_screen_s\""), "{result}");
     // Every climbing URL the browser sent was refused with a 4xx.
     assert!(result.contains("\"all_refused\": true"), "{result}");
+    // Each arrow key steps one frame, whatever has the focus.
+    let steps = key_steps(&result);
+    assert_eq!(steps.len(), 5, "{result}");
+    for (focus, before, after, key) in steps {
+        let by = if key == "ArrowRight" { 1 } else { FRAMES - 1 };
+        assert_eq!(after, (before + by) % FRAMES, "{key} on {focus}: {result}");
+    }
     // Export encodes with ffmpeg where it is installed, and says how to install it where not.
     let ffmpeg = Command::new("ffmpeg").arg("-version").output().is_ok();
     if ffmpeg {
         assert!(result.contains("\"mp4\": true"), "{result}");
+        the_export_is_at_full_quality(dir, &result, &after);
     } else {
         assert!(result.contains("apt-get install -y ffmpeg"), "{result}");
     }
     eprintln!("{said}");
+}
+
+/// `result.json`'s key steps: (focus, frame before, frame after, key).
+fn key_steps(result: &str) -> Vec<(String, usize, usize, String)> {
+    let steps = result.split("\"key_steps\": [").nth(1).expect("key_steps");
+    let steps = &steps[..steps.find("]\n  ]").expect("the list's end") + 1];
+    steps
+        .split('[')
+        .skip(1)
+        .map(|step| {
+            let fields: Vec<&str> = step
+                .split(['"', ',', ']', '\n', ' '])
+                .filter(|f| !f.is_empty())
+                .collect();
+            let number = |f: &str| f.parse().expect("a frame number");
+            (
+                fields[0].to_string(),
+                number(fields[1]),
+                number(fields[2]),
+                fields[3].to_string(),
+            )
+        })
+        .collect()
+}
+
+/// Export, pressed while the frames were drafts again, said so, waited, and encoded every
+/// frame as `anim render` draws it (`expected`): at least 40 dB each, where an up-scaled
+/// draft scores about 26.
+fn the_export_is_at_full_quality(dir: &Path, result: &str, expected: &[image::RgbImage]) {
+    assert!(
+        result.contains("export: waiting for full quality"),
+        "{result}"
+    );
+    assert!(
+        result.contains(&format!("exported {FRAMES} frames at full quality")),
+        "{result}"
+    );
+    for (i, image) in expected.iter().enumerate() {
+        image.save(dir.join(format!("ref_{i:04}.png"))).unwrap();
+    }
+    let db = psnr_per_frame(&dir.join("export.mp4"), &dir.join("ref_%04d.png"));
+    assert_eq!(db.len(), FRAMES, "{result}");
+    for (i, db) in db.iter().enumerate() {
+        assert!(*db >= 40.0, "exported frame {i}: {db:.1} dB");
+    }
 }

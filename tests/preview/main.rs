@@ -12,6 +12,8 @@
 //!   stream of a 100,000-frame spec.
 //! - `watch`: named pipes as a mesh, as the scene after an edit, as a spec's base scene.
 //! - `fuzz`: random requests and connection patterns (FUZZING.md).
+//! - `lifecycle`: `--export` (full-quality frames only, wrong outputs refused before any
+//!   render), SIGTERM and SIGHUP, the diagnostics the terminal prints.
 //! - `browser`: the page in headless Chromium, driven by `scripts/preview-browser.py`.
 
 #[path = "../common/mod.rs"]
@@ -20,5 +22,6 @@ mod common;
 mod browser;
 mod fuzz;
 mod http;
+mod lifecycle;
 mod session;
 mod watch;

@@ -71,6 +71,16 @@ pub const FIRST_KEY: &str = "(0, 0, 0)";
 pub const EDITED_KEY: &str = "(0, 1.5, 0)";
 pub const FRAMES: usize = 6;
 
+/// A folder holding the test animation: `small.ron`, its base scene `showcase.sdf` and the
+/// materials file that includes.
+pub fn test_animation() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("showcase.sdf"), base_scene()).unwrap();
+    std::fs::write(dir.path().join(MATERIALS), materials()).unwrap();
+    std::fs::write(dir.path().join("small.ron"), spec(FIRST_KEY)).unwrap();
+    dir
+}
+
 pub struct Preview {
     pub dir: tempfile::TempDir,
     pub port: u16,
@@ -82,11 +92,7 @@ pub struct Preview {
 impl Preview {
     /// Starts `anim preview` on the test animation; returns once it prints its address.
     pub fn start() -> Preview {
-        let dir = tempfile::tempdir().unwrap();
-        std::fs::write(dir.path().join("showcase.sdf"), base_scene()).unwrap();
-        std::fs::write(dir.path().join(MATERIALS), materials()).unwrap();
-        std::fs::write(dir.path().join("small.ron"), spec(FIRST_KEY)).unwrap();
-        Preview::launch(dir, "small.ron")
+        Preview::launch(test_animation(), "small.ron")
     }
 
     /// Starts `anim preview` on one scene file, `scene.sdf`: the showcase, small.
@@ -225,8 +231,14 @@ impl Preview {
 
     /// Stops the preview as Ctrl-C does; returns whether it ended cleanly.
     pub fn stop(&mut self) -> bool {
+        self.signal("INT")
+    }
+
+    /// Sends the preview signal `name` (`INT`, `TERM`, `HUP`); returns whether it ended
+    /// cleanly within 10 s.
+    pub fn signal(&mut self, name: &str) -> bool {
         let _ = Command::new("kill")
-            .args(["-INT", &self.child.id().to_string()])
+            .args([&format!("-{name}"), &self.child.id().to_string()])
             .status();
         let start = Instant::now();
         while start.elapsed() < Duration::from_secs(10) {

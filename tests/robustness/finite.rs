@@ -12,14 +12,7 @@ fn proptest_primitives() -> &'static [(String, Primitive)] {
     PRIMS.get_or_init(|| {
         let mut rng = SplitMix64::new(0x9A9);
         let mut out = Vec::new();
-        for kind in [
-            Kind::Sphere,
-            Kind::Box,
-            Kind::Plane,
-            Kind::Triangle,
-            Kind::Cylinder,
-            Kind::Cone,
-        ] {
+        for kind in Kind::ALL {
             for (i, scale) in [1.0, 1e-3, 1e4, 0.3].into_iter().enumerate() {
                 let obj = random_object(kind, &mut rng);
                 let xf = if i == 0 {

@@ -111,6 +111,18 @@ enum Kind {
 }
 
 impl Kind {
+    /// Every kind of primitive a scene statement writes with numbers (meshes, read from
+    /// files, have their own tests); `every_kind_of_primitive_is_generated` holds it to the
+    /// renderer's list, so a new primitive cannot miss these tests.
+    const ALL: [Kind; 6] = [
+        Kind::Sphere,
+        Kind::Box,
+        Kind::Plane,
+        Kind::Triangle,
+        Kind::Cylinder,
+        Kind::Cone,
+    ];
+
     fn is_closed(self) -> bool {
         !matches!(self, Kind::Plane | Kind::Triangle)
     }
@@ -608,4 +620,21 @@ fn spawn_and_check(
             }
         }
     }
+}
+
+#[test]
+fn every_kind_of_primitive_is_generated() {
+    let generated: Vec<String> = Kind::ALL
+        .iter()
+        .map(|k| format!("{k:?}").to_lowercase())
+        .collect();
+    let drawn: Vec<&str> = anim_core::shape::Shape::KINDS
+        .into_iter()
+        .filter(|k| *k != "mesh")
+        .collect();
+    assert_eq!(
+        generated, drawn,
+        "a primitive the renderer draws has no generator in these tests (Kind, random_object, \
+         interior_point, centre, reference_hit)"
+    );
 }

@@ -120,14 +120,7 @@ fn reintersection_cone() {
 #[test]
 #[ignore = "measurement, not a check; prints a table"]
 fn offset_margin_sweep() {
-    for kind in [
-        Kind::Sphere,
-        Kind::Box,
-        Kind::Plane,
-        Kind::Triangle,
-        Kind::Cylinder,
-        Kind::Cone,
-    ] {
+    for kind in Kind::ALL {
         let mut line = format!("{kind:?}:");
         for e in 0..=16 {
             let factor = 0.5f32.powi(e);

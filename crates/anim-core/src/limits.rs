@@ -56,11 +56,12 @@ pub const RENDER_STACK_BYTES: usize = 64 << 20;
 
 /// Bytes an image costs per pixel while it is made, at the adaptive sampler's peak: the centre
 /// sample with the primitive it hit (32), its tone (16), the lights it did not see clear (4),
-/// the refined radiance (12), sample count (1) and error estimate (4); in a frame with motion
-/// also the centre ray's sweep (28) and the tones that the motion pass reads (16). The 8-bit
-/// image and the encoded file come after the sampler's buffers are freed. `render::sampler`
-/// checks this against the sizes of its buffers.
-pub const IMAGE_BYTES_PER_PIXEL: u64 = 32 + 16 + 4 + 12 + 1 + 4 + 28 + 16;
+/// the refined radiance (12), coverage (4), sample count (1) and error estimate (4); in a
+/// frame with motion also the centre ray's sweep (28) and the tones that the motion pass
+/// reads (16). The image as stored (at most 16 bytes a pixel: float RGBA) and the encoded
+/// file come after the sampler's buffers are freed. `render::sampler` checks this against the
+/// sizes of its buffers.
+pub const IMAGE_BYTES_PER_PIXEL: u64 = 32 + 16 + 4 + 12 + 4 + 1 + 4 + 28 + 16;
 
 /// The memory a scene or an image may take when neither `--max-memory` nor the machine says:
 /// 4 GiB.
@@ -97,7 +98,7 @@ pub fn fixed_radius(r: f64) -> f64 {
 
 /// The image file extensions anim writes (lower case); the extension picks the format.
 pub const IMAGE_EXTENSIONS: &[&str] = &[
-    "png", "ppm", "pgm", "pnm", "pbm", "pam", "bmp", "jpg", "jpeg", "tga",
+    "png", "ppm", "pgm", "pnm", "pbm", "pam", "bmp", "jpg", "jpeg", "tga", "exr",
 ];
 
 /// Whether `ext` (any case) names an image format anim writes.
@@ -238,9 +239,9 @@ mod tests {
     #[test]
     fn every_image_extension_maps_to_a_writable_format() {
         for ext in IMAGE_EXTENSIONS {
-            let format = image::ImageFormat::from_extension(ext)
-                .unwrap_or_else(|| panic!("{ext} is not an image format"));
-            assert!(format.writing_enabled(), "{ext} cannot be written");
+            let name = format!("a.{ext}");
+            let format = crate::render::film::ImageFormat::for_path(name.as_ref(), false);
+            assert!(format.is_some(), "{ext} cannot be written");
         }
         assert!(is_image_extension("PNG"));
         assert!(!is_image_extension("sdf"));

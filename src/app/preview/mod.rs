@@ -39,6 +39,10 @@ pub struct PreviewConfig {
 }
 
 pub fn run(config: &PreviewConfig, pool: &ThreadPool) -> ExitCode {
+    if !config.input.is_file() {
+        eprintln!("{}: error: no such file", super::shown(&config.input));
+        return ExitCode::FAILURE;
+    }
     let temp = match tempfile::Builder::new().prefix("anim-preview-").tempdir() {
         Ok(t) => t,
         Err(e) => {
@@ -46,16 +50,19 @@ pub fn run(config: &PreviewConfig, pool: &ThreadPool) -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    if !config.input.is_file() {
-        eprintln!("{}: error: no such file", super::shown(&config.input));
-        return ExitCode::FAILURE;
-    }
     let mut project = Project {
         input: config.input.clone(),
         frames_dir: temp.path().join("frames"),
         load: config.load.clone(),
         settings: config.settings.clone(),
     };
+    if let Some(out) = &config.export {
+        // Before anything renders: a wrong name would otherwise cost the whole render.
+        if let Err(e) = export::check_output(out, &project.watched()) {
+            eprintln!("{e}");
+            return ExitCode::FAILURE;
+        }
+    }
     if project.is_spec() {
         // The frames in the temporary folder name the base scene's meshes, which were
         // confined when `anim generate` read the base scene.
@@ -64,7 +71,9 @@ pub fn run(config: &PreviewConfig, pool: &ThreadPool) -> ExitCode {
     let shared = Arc::new(Shared::default());
     {
         let shared = shared.clone();
-        // A second Ctrl-C while stopping is the same request.
+        // Ctrl-C, SIGTERM (a process manager, `kill`) and SIGHUP (the terminal closed) all
+        // stop the preview the same way, so its temporary folder goes with it. A second
+        // signal while stopping is the same request.
         let _ = ctrlc::set_handler(move || shared.stop());
     }
     let export = Export::new(temp.path().join("export"));
@@ -141,53 +150,30 @@ fn serve(config: &PreviewConfig, shared: &Arc<Shared>, export: Export) -> ExitCo
     ExitCode::SUCCESS
 }
 
-/// `--export`: waits until every frame is drawn in full, then encodes them into `out`.
+/// `--export`: waits until every frame is drawn in full, then encodes them into `out`. The
+/// build's diagnostics are the terminal's already (`Shared::publish` prints them).
 fn export_only(shared: &Shared, export: &Export, out: &Path) -> ExitCode {
     let start = Instant::now();
-    loop {
-        let state = shared.lock();
-        if state.stop {
-            return ExitCode::FAILURE;
-        }
-        if !state.diagnostics.is_empty() {
-            for d in &state.diagnostics {
-                eprintln!("{d}");
-            }
-            return ExitCode::FAILURE;
-        }
-        if state.all_full() {
-            break;
-        }
-        drop(shared.wait(&shared.changed, state, Duration::from_millis(200)));
-    }
-    let failed: Vec<String> = shared
-        .lock()
-        .frames
-        .iter()
-        .filter_map(|f| f.error.clone())
-        .collect();
-    if !failed.is_empty() {
-        for e in failed {
-            eprintln!("{e}");
-        }
-        return ExitCode::FAILURE;
-    }
-    let copied = export::encode(shared, export).and_then(|()| {
+    let copied = export::encode(shared, export).and_then(|frames| {
         std::fs::copy(export.video(), out)
-            .map(|_| ())
-            .map_err(|e| format!("{}: {e}", out.display()))
+            .map(|_| frames)
+            .map_err(|e| format!("error: {}: {e}", out.display()))
     });
     match copied {
-        Ok(()) => {
+        Ok(frames) => {
             eprintln!(
-                "wrote {} in {:.2} s",
+                "wrote {} ({frames} frames at full quality) in {:.2} s",
                 out.display(),
                 start.elapsed().as_secs_f64()
             );
             ExitCode::SUCCESS
         }
+        Err(_) if shared.lock().builds == 0 => {
+            eprintln!("error: nothing exported: the animation does not build");
+            ExitCode::FAILURE
+        }
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("{e}");
             ExitCode::FAILURE
         }
     }

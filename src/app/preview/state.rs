@@ -140,6 +140,8 @@ pub struct State {
     pub builds: u64,
     /// The warnings shown when the terminal last heard of them.
     printed: Vec<String>,
+    /// The diagnostics the terminal last heard of (empty: the build was good).
+    printed_diagnostics: Vec<String>,
 }
 
 /// The state with the two wake-ups: `changed` for the page's event streams, `work` for the
@@ -178,10 +180,12 @@ impl Shared {
     }
 
     /// Wakes everyone after a change made under `state` (a build or a frame taken in), and
-    /// prints the warnings it brought.
+    /// prints what it brought: a build's diagnostics, or that it builds again, and the new
+    /// warnings.
     pub fn publish(&self, mut state: MutexGuard<'_, State>) {
         self.touch(&mut state);
-        let news = state.new_warnings();
+        let mut news = state.build_news();
+        news.extend(state.new_warnings());
         drop(state);
         for warning in news {
             eprintln!("{warning}");
@@ -280,15 +284,6 @@ impl State {
         }
     }
 
-    /// Whether every frame is drawn at full quality (or failed).
-    pub fn all_full(&self) -> bool {
-        self.builds > 0
-            && self
-                .frames
-                .iter()
-                .all(|f| f.state() == "full" || f.state() == "error")
-    }
-
     /// The warnings to show: the build's, then each warning of the frames drawn in full (what
     /// `anim render` says of them) once, with the number of frames that had it.
     fn shown_warnings(&self) -> Vec<(String, usize)> {
@@ -319,6 +314,25 @@ impl State {
             .collect();
         self.printed = shown;
         news
+    }
+
+    /// What the terminal should hear of the last build, once: its diagnostics when they
+    /// differ from those it printed last (the page shows the same), or one line when the
+    /// animation builds again after diagnostics.
+    fn build_news(&mut self) -> Vec<String> {
+        if self.diagnostics == self.printed_diagnostics {
+            return Vec::new();
+        }
+        let mended = self.diagnostics.is_empty();
+        self.printed_diagnostics = self.diagnostics.clone();
+        if mended {
+            vec![format!(
+                "note: the animation builds again ({} frames)",
+                self.frames.len()
+            )]
+        } else {
+            self.diagnostics.clone()
+        }
     }
 
     /// The state as the page reads it (JSON).
@@ -441,4 +455,32 @@ pub fn json_string(s: &str) -> String {
     }
     out.push('"');
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_terminal_hears_each_new_set_of_diagnostics_then_that_it_builds_again() {
+        let mut state = State::default();
+        assert!(
+            state.build_news().is_empty(),
+            "a good first build says nothing"
+        );
+        let broken = vec!["a.ron:3:7: error: expected `)`".to_string()];
+        state.diagnostics = broken.clone();
+        assert_eq!(state.build_news(), broken);
+        assert!(state.build_news().is_empty(), "printed once");
+        let other = vec!["a.ron:4:1: error: expected `,`".to_string()];
+        state.diagnostics = other.clone();
+        assert_eq!(state.build_news(), other);
+        state.frames = vec![Frame::default(); 3];
+        state.diagnostics.clear();
+        assert_eq!(
+            state.build_news(),
+            ["note: the animation builds again (3 frames)"]
+        );
+        assert!(state.build_news().is_empty());
+    }
 }

@@ -51,6 +51,11 @@ use view::Viewpoint;
 pub struct Rendered {
     /// Linear radiance of every pixel.
     pub image: HdrImage,
+    /// Per pixel (row-major), the fraction of its camera samples that hit a surface: 0 where
+    /// every one saw the background, 1 where none did. Adaptive sampling's flat pixels keep
+    /// their centre sample, so theirs is 0 or 1; an edge is refined and takes its coverage
+    /// from its samples. The alpha of `--alpha` (`film::Coverage`).
+    pub coverage: Vec<f32>,
     /// The rays traced.
     pub rays: RayCounts,
     /// Camera samples traced per pixel, on average.
@@ -180,6 +185,7 @@ pub fn render_prepared(
             height,
             pixels: sampled.pixels,
         },
+        coverage: sampled.coverage,
         mean_spp: counts.primary as f64 / (width as f64 * height as f64),
         rays: counts,
         dropped: prepared.dropped.clone(),

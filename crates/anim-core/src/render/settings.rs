@@ -30,6 +30,13 @@ pub struct RenderSettings {
     pub max_memory: u64,
     /// Also write each image's linear radiance beside it as PFM (`film::hdr_path`).
     pub hdr: bool,
+    /// Bits per channel of the image files (`--depth`); `None`: each format's default
+    /// (`film::Encoding`).
+    pub depth: Option<u8>,
+    /// Write linear radiance rather than the tone map's values (`--linear`).
+    pub linear: bool,
+    /// Give the images an alpha channel: each pixel's coverage (`--alpha`).
+    pub alpha: bool,
 }
 
 impl Default for RenderSettings {
@@ -46,6 +53,9 @@ impl Default for RenderSettings {
             allow_any_output: false,
             max_memory: crate::limits::default_memory_budget(),
             hdr: false,
+            depth: None,
+            linear: false,
+            alpha: false,
         }
     }
 }

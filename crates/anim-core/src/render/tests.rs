@@ -406,3 +406,97 @@ fn an_opaque_blocker_above_glass_casts_a_full_shadow() {
         img.pixels[4]
     );
 }
+
+/// Spheres of radius 0.3 at z = −10 on an `n × n` grid, one unit apart, centred on the view.
+fn sphere_grid(n: usize) -> Scene {
+    let half = (n as f64 - 1.0) / 2.0;
+    let instances: Vec<Instance> = (0..n * n)
+        .map(|i| {
+            let (x, y) = ((i % n) as f64 - half, (i / n) as f64 - half);
+            sphere([x, y, -10.0], 0.3, 0)
+        })
+        .collect();
+    Scene {
+        materials: vec![material("m", 0.2, [0.6, 0.5, 0.4], 0.0, 1.0)],
+        instances: instances.into(),
+        background: Vec3::new(0.3, 0.2, 0.1),
+        ..Scene::default()
+    }
+}
+
+/// How many of the rays of `camera` through pixel (x, y) at `offsets` meet one of `scene`'s
+/// spheres, worked out from the ray's distance to each centre; `None` when a ray passes
+/// within a hair of a silhouette, where f32 and f64 may disagree.
+fn hits_by_formula(
+    scene: &Scene,
+    camera: &camera::PinholeCamera,
+    (x, y): (u32, u32),
+    offsets: &[(f32, f32)],
+) -> Option<u32> {
+    let mut hits = 0;
+    for &(dx, dy) in offsets {
+        let ray = camera.ray(x as f32 + dx, y as f32 + dy);
+        let (o, d) = (
+            Vec3::from(ray.origin).as_dvec3(),
+            Vec3::from(ray.dir).as_dvec3().normalize(),
+        );
+        let mut hit = false;
+        for instance in scene.instances.iter() {
+            let Geometry::Sphere { center, radius } = instance.geometry else {
+                continue;
+            };
+            let to = center - o;
+            let miss = to.cross(d).length() - radius;
+            if miss.abs() < 1e-4 {
+                return None;
+            }
+            hit |= miss < 0.0 && to.dot(d) > 0.0;
+        }
+        hits += u32::from(hit);
+    }
+    Some(hits)
+}
+
+/// A pixel's coverage is the share of its camera samples that hit a surface, whether its rays
+/// were traced one by one or in packets (the grid's hierarchy is deep enough for them).
+#[test]
+fn coverage_is_the_share_of_samples_that_hit() {
+    let camera = Camera::default_with_fov("cam", 40.0);
+    for (n, packets) in [(1, false), (12, true)] {
+        let job = job(sphere_grid(n), camera.clone(), 48, 36);
+        let prepared = Prepared::new(&job);
+        let pinhole = camera::PinholeCamera::new(prepared.camera(), 48, 36).unwrap();
+        for spp in [1, 16] {
+            let settings = RenderSettings {
+                spp: Some(spp),
+                ..RenderSettings::default()
+            };
+            let viewpoint = Viewpoint {
+                view: pinhole.view(),
+                size: (48, 36),
+                camera_rays: 48 * 36 * u64::from(spp),
+                motion: false,
+            };
+            let plan = prepared.compile(Some(&viewpoint)).plan();
+            assert_eq!(plan.1.camera_packets, packets, "{n}×{n} spheres");
+            let rendered = render_prepared(&prepared, &settings, &|_| {}).unwrap();
+            let offsets = sampler::sample_offsets(spp);
+            let (mut partial, mut checked) = (0, 0);
+            for (i, &coverage) in rendered.coverage.iter().enumerate() {
+                let at = (i as u32 % 48, i as u32 / 48);
+                let Some(hits) = hits_by_formula(&job.scene, &pinhole, at, &offsets) else {
+                    continue;
+                };
+                assert_eq!(
+                    coverage,
+                    hits as f32 / spp as f32,
+                    "pixel {at:?}, {spp} spp"
+                );
+                partial += usize::from(coverage > 0.0 && coverage < 1.0);
+                checked += 1;
+            }
+            assert!(checked > 48 * 36 * 9 / 10, "{checked} pixels checked");
+            assert_eq!(partial > 0, spp > 1, "{partial} pixels partly covered");
+        }
+    }
+}

@@ -132,6 +132,13 @@ impl Shape {
         }
     }
 
+    /// Whether the shape has an apex, where rays spawned near it may need
+    /// [`Shape::apex_escape_near`] (a cone).
+    #[inline]
+    pub fn has_apex(&self) -> bool {
+        matches!(self, Shape::Cone(_))
+    }
+
     /// At a cone's side next to its apex, where moving by `step` into the solid would take a
     /// point half way to the axis or beyond, the apex's way out (`Cone::apex_escape_near`).
     pub fn apex_escape_near(&self, point: Vec3A, step: Vec3A) -> Option<(Vec3A, f32)> {

@@ -285,6 +285,9 @@ mod tests {
             allow_any_output,
             max_memory,
             hdr,
+            depth,
+            linear,
+            alpha,
         } = base.clone();
         vec![
             RenderSettings {
@@ -329,6 +332,18 @@ mod tests {
             },
             RenderSettings {
                 hdr: !hdr,
+                ..base.clone()
+            },
+            RenderSettings {
+                depth: Some(depth.map_or(16, |d| d * 2)),
+                ..base.clone()
+            },
+            RenderSettings {
+                linear: !linear,
+                ..base.clone()
+            },
+            RenderSettings {
+                alpha: !alpha,
                 ..base.clone()
             },
         ]

@@ -8,7 +8,7 @@ use anim_core::diag::{Diagnostic, Severity};
 use anim_core::limits;
 use anim_core::load::probe;
 use anim_core::render::camera::CameraError;
-use anim_core::render::film::{self, ImageFormat};
+use anim_core::render::film::{self, Coverage, Encoding, ImageFormat};
 use anim_core::render::{render_prepared, Prepared, RayCounts, RenderSettings, Rendered};
 use anim_core::scene::RenderJob;
 use anim_core::sdf::LoadOptions;
@@ -77,7 +77,7 @@ pub(super) struct Planned<'j, T> {
     pub job: &'j RenderJob,
     pub settings: RenderSettings,
     pub target: T,
-    pub format: ImageFormat,
+    pub encoding: Encoding,
 }
 
 /// Loads scene file `path` and renders the images `sink` wants into memory, handing each to
@@ -139,7 +139,8 @@ pub(super) fn blank_warnings<S: ImageSink>(
 
 /// Checks every image `sink` wants of `jobs` (of scene file `path`) before anything renders:
 /// an image too large for the memory budget is refused before anything else about it is
-/// judged, then the sink checks where it goes. `Err` holds every error, in the order of the
+/// judged, then the sink checks where it goes, then its format must hold what the settings
+/// ask (`--depth`, `--linear`, `--alpha`). `Err` holds every error, in the order of the
 /// render lines.
 pub(super) fn plan<'j, S: ImageSink>(
     path: &Path,
@@ -157,12 +158,26 @@ pub(super) fn plan<'j, S: ImageSink>(
             errors.push(refusal);
             continue;
         }
-        match sink.check(job, &settings, warnings) {
-            Ok((target, format)) => planned.push(Planned {
+        let checked = sink
+            .check(job, &settings, warnings)
+            .and_then(|(target, format)| {
+                let (depth, linear, alpha) = (settings.depth, settings.linear, settings.alpha);
+                Encoding::new(format, depth, linear, alpha)
+                    .map(|encoding| (target, encoding))
+                    .map_err(|why| {
+                        vec![job_error(
+                            path,
+                            job,
+                            format!("'{}': {why}", job.output.display()),
+                        )]
+                    })
+            });
+        match checked {
+            Ok((target, encoding)) => planned.push(Planned {
                 job,
                 settings,
                 target,
-                format,
+                encoding,
             }),
             Err(e) => errors.extend(e),
         }
@@ -240,6 +255,7 @@ fn render_planned<S: ImageSink>(
         }
         let Rendered {
             image,
+            coverage,
             rays: counts,
             dropped,
             ..
@@ -266,7 +282,11 @@ fn render_planned<S: ImageSink>(
                 None => job_error(path, job, message).with_severity(Severity::Warning),
             });
         }
-        let encoded = match film::encode_image(&image, p.format) {
+        let coverage = Coverage {
+            fraction: &coverage,
+            background: job.scene.background,
+        };
+        let encoded = match film::encode_image(&image, Some(&coverage), p.encoding) {
             Ok(bytes) => Encoded {
                 image: bytes,
                 radiance: p.settings.hdr.then(|| film::encode_pfm(&image)),

@@ -93,6 +93,7 @@ function update(next) {
   $("warnings").hidden = state.warnings.length === 0;
   $("warn-text").textContent = state.warnings.join("\n\n");
   document.body.dataset.version = String(state.version);
+  exportProgress();
   show(current);
 }
 
@@ -114,19 +115,46 @@ function connect() {
 
 scrub.addEventListener("input", () => { setPlaying(false); show(Number(scrub.value)); focus(current); });
 $("play").addEventListener("click", () => setPlaying(!playing));
-$("prev").addEventListener("click", () => { setPlaying(false); show(current - 1); });
-$("next").addEventListener("click", () => { setPlaying(false); show(current + 1); });
-document.addEventListener("keydown", (e) => {
-  if (e.key === " ") { e.preventDefault(); setPlaying(!playing); }
-  if (e.key === "ArrowLeft") { setPlaying(false); show(current - 1); }
-  if (e.key === "ArrowRight") { setPlaying(false); show(current + 1); }
-});
+$("prev").addEventListener("click", () => step(-1));
+$("next").addEventListener("click", () => step(1));
+// The page's keys, caught before any control sees them (capture on window) and kept from
+// it: a focused timeline would step a second time on an arrow, a focused button would click
+// on a space.
+const KEYS = { " ": () => setPlaying(!playing), ArrowLeft: () => step(-1), ArrowRight: () => step(1) };
+window.addEventListener("keydown", (e) => {
+  const act = KEYS[e.key];
+  if (!act || e.altKey || e.ctrlKey || e.metaKey) return;
+  e.preventDefault();
+  e.stopPropagation();
+  if (!e.repeat || e.key !== " ") act();
+}, true);
+window.addEventListener("keyup", (e) => { if (e.key === " ") e.preventDefault(); }, true);
+function step(by) { setPlaying(false); show(current + by); focus(current); }
+
+// Export: the server waits for every frame at full quality before it encodes; meanwhile
+// the page counts them down from the state it streams.
+let exporting = false;
+function exportProgress() {
+  if (!exporting || !state) return;
+  const n = frameCount(), full = state.frames.filter((f) => f.state === "full").length;
+  $("export-status").textContent = full < n
+    ? `export: waiting for full quality, ${full} of ${n} frames drawn…`
+    : `export: encoding ${n} frames at full quality…`;
+}
 $("export").addEventListener("click", async () => {
   const out = $("export-status");
-  out.textContent = "encoding…";
-  const answer = await (await fetch("/api/export", { method: "POST" })).json();
+  out.dataset.done = "";
+  exporting = true;
+  exportProgress();
+  let answer;
+  try {
+    answer = await (await fetch("/api/export", { method: "POST" })).json();
+  } catch (e) {
+    answer = { ok: false, error: `export failed: ${e}` };
+  }
+  exporting = false;
   if (answer.ok) {
-    out.innerHTML = "";
+    out.textContent = `exported ${answer.note}: `;
     const link = document.createElement("a");
     link.href = answer.url;
     link.textContent = "download preview.mp4";
@@ -134,5 +162,6 @@ $("export").addEventListener("click", async () => {
   } else {
     out.textContent = answer.error;
   }
+  out.dataset.done = "1";
 });
 connect();

@@ -447,7 +447,7 @@ impl Primitive {
         lift: Lift,
         to_shape: impl Fn(Vec3A) -> Vec3A,
     ) -> Option<(Vec3A, f32)> {
-        if !matches!(self.shape, Shape::Cone(_)) {
+        if !self.shape.has_apex() {
             return None;
         }
         let step = -lift.inward * relative_offset(world).max(lift.inward_min);

@@ -29,14 +29,32 @@
 
 use super::first_pass::{around, FirstPass};
 use super::pattern::{self, tone3, Moments, PixelPattern, MOTION_MIN_SAMPLES, PRIOR_SAMPLES};
-use super::{Frame, Sampled};
+use super::{coverage, Frame, Sampled};
+use crate::render::compile::NO_HIT;
 use crate::render::counts::RayCounts;
 use crate::render::integrator::{PixelPrior, TraceState};
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 
-/// Pass 2's result: pixels, samples taken, error estimates, rays.
-type Refined = (Vec<Vec3>, Vec<u8>, Vec<f32>, RayCounts);
+/// Pass 2's result, per pixel (row-major), and the rays it traced.
+struct Refined {
+    pixels: Vec<Vec3>,
+    coverage: Vec<f32>,
+    /// Samples taken, up to 255 (0: the pixel kept its centre).
+    taken: Vec<u8>,
+    estimates: Vec<f32>,
+    rays: RayCounts,
+}
+
+/// One pixel after pass 2.
+struct Pixel {
+    mean: Vec3,
+    coverage: f32,
+    /// Samples taken, up to 255 (0: it kept its centre).
+    taken: u8,
+    /// The estimate of its error where it stopped (NaN when it kept its centre).
+    estimate: f32,
+}
 
 /// Adaptive sampling of one frame.
 pub(super) struct Adaptive<'f> {
@@ -52,20 +70,22 @@ impl Adaptive<'_> {
     /// pixels is refined.
     pub fn render(&self, on_pixels: &(dyn Fn(u64) + Sync)) -> Sampled {
         let (first, mut counts) = FirstPass::trace(self.frame);
-        let (mut pixels, taken, estimates, refined) = self.refine(&first, on_pixels);
-        counts += refined;
+        let mut refined = self.refine(&first, on_pixels);
+        counts += refined.rays;
         if self.frame.shutter.is_some() && self.max_spp > 1 {
-            counts += self.recheck_motion(&first, &mut pixels, &taken);
+            counts += self.recheck_motion(&first, &mut refined);
         }
         Sampled {
-            pixels,
+            pixels: refined.pixels,
+            coverage: refined.coverage,
             rays: counts,
-            error_estimates: estimates,
+            error_estimates: refined.estimates,
         }
     }
 
-    /// Sample `i` of pixel (x, y)'s own pattern: its radiance. The first `PRIOR_SAMPLES` take
-    /// what `prior` knows of the lights; the others trace every shadow ray.
+    /// Sample `i` of pixel (x, y)'s own pattern: its radiance, and whether it hit a surface.
+    /// The first `PRIOR_SAMPLES` take what `prior` knows of the lights; the others trace
+    /// every shadow ray.
     fn sample(
         &self,
         (x, y): (usize, usize),
@@ -73,7 +93,7 @@ impl Adaptive<'_> {
         i: u32,
         prior: &PixelPrior,
         st: &mut TraceState,
-    ) -> Vec3A {
+    ) -> (Vec3A, bool) {
         let (dx, dy) = pattern.sample(i);
         let (px, py) = (x as f32 + dx, y as f32 + dy);
         let frame = self.frame;
@@ -86,46 +106,59 @@ impl Adaptive<'_> {
         } else {
             &PixelPrior::NONE
         };
-        frame.integrator.camera_sample(&ray, prior, st).radiance
+        let sample = frame.integrator.camera_sample(&ray, prior, st);
+        (sample.radiance, sample.t.is_some())
     }
 
-    /// Pass 2: every pixel, its centre kept or refined. Per pixel also the samples it took,
-    /// up to 255 (0: it kept its centre), for pass 3, and the estimate of its error where it
-    /// stopped (NaN: it kept its centre, and nothing was estimated).
+    /// Pass 2: every pixel, its centre kept or refined, with the samples it took for pass 3.
     fn refine(&self, first: &FirstPass, on_pixels: &(dyn Fn(u64) + Sync)) -> Refined {
         let (w, h) = self.frame.size;
         let mut pixels = vec![Vec3::ZERO; w * h];
+        let mut coverage = vec![0.0f32; w * h];
         let mut taken = vec![0u8; w * h];
         let mut estimates = vec![f32::NAN; w * h];
-        let counts = pixels
+        let rays = pixels
             .par_chunks_mut(w)
+            .zip(coverage.par_chunks_mut(w))
             .zip(taken.par_chunks_mut(w))
             .zip(estimates.par_chunks_mut(w))
             .enumerate()
-            .map(|(y, ((row, taken_row), estimate_row))| {
+            .map(|(y, (((row, coverage_row), taken_row), estimate_row))| {
                 let mut st = TraceState::refining();
-                let cells = row.iter_mut().zip(taken_row).zip(estimate_row);
-                for (x, ((out, taken), estimate)) in cells.enumerate() {
-                    (*out, *taken, *estimate) = self.refine_pixel(first, (x, y), &mut st);
+                let cells = row.iter_mut().zip(coverage_row).zip(taken_row);
+                for (x, (((out, cov), taken), estimate)) in cells.zip(estimate_row).enumerate() {
+                    let p = self.refine_pixel(first, (x, y), &mut st);
+                    (*out, *cov, *taken, *estimate) = (p.mean, p.coverage, p.taken, p.estimate);
                 }
                 on_pixels(row.len() as u64);
                 st.scratch.counts
             })
             .reduce(RayCounts::default, RayCounts::sum);
-        (pixels, taken, estimates, counts)
+        Refined {
+            pixels,
+            coverage,
+            taken,
+            estimates,
+            rays,
+        }
     }
 
-    /// Pixel (x, y) after pass 2, the samples it took (0: it kept its centre) and the
-    /// estimate of its error where it stopped (NaN when it kept its centre).
+    /// Pixel (x, y) after pass 2.
     fn refine_pixel(
         &self,
         first: &FirstPass,
         (x, y): (usize, usize),
         st: &mut TraceState,
-    ) -> (Vec3, u8, f32) {
+    ) -> Pixel {
         let (w, max_spp) = (self.frame.size.0, self.max_spp);
         let Some((contrast, moving)) = first.refinement(x, y).filter(|_| max_spp > 1) else {
-            return (Vec3::from(first.centres[y * w + x].0), 0, f32::NAN);
+            let (centre, prim) = first.centres[y * w + x];
+            return Pixel {
+                mean: Vec3::from(centre),
+                coverage: coverage(u32::from(prim != NO_HIT), 1),
+                taken: 0,
+                estimate: f32::NAN,
+            };
         };
         let mut at_least = pattern::min_samples(contrast, self.error, max_spp);
         if moving {
@@ -134,16 +167,23 @@ impl Adaptive<'_> {
         let prior = first.prior(x, y);
         let pattern = PixelPattern::new(x as u32, y as u32);
         let mut m = Moments::default();
+        let mut hits = 0;
         while m.n < max_spp {
-            m.add(self.sample((x, y), &pattern, m.n, &prior, st));
+            let (radiance, hit) = self.sample((x, y), &pattern, m.n, &prior, st);
+            m.add(radiance);
+            hits += u32::from(hit);
             // Checked at powers of two only: there every prefix is a full net.
             if m.n >= at_least && m.n.is_power_of_two() && m.error() <= self.error {
                 break;
             }
         }
         st.scratch.counts.primary += m.n as u64;
-        let taken = m.n.min(u8::MAX as u32) as u8;
-        (Vec3::from(m.mean()), taken, m.error())
+        Pixel {
+            mean: Vec3::from(m.mean()),
+            coverage: coverage(hits, m.n),
+            taken: m.n.min(u8::MAX as u32) as u8,
+            estimate: m.error(),
+        }
     }
 
     /// Pass 3, in a frame with motion. A pixel that motion touches and whose samples all
@@ -154,18 +194,22 @@ impl Adaptive<'_> {
     /// with its own pattern, doubling its samples until the new half agrees with the old
     /// (`Moments::resume`) or it reaches `max_spp`. Reads only pass 2's finished image, so
     /// the result does not depend on the order pixels are visited in.
-    fn recheck_motion(&self, first: &FirstPass, pixels: &mut [Vec3], taken: &[u8]) -> RayCounts {
+    fn recheck_motion(&self, first: &FirstPass, refined: &mut Refined) -> RayCounts {
         let w = self.frame.size.0;
+        let pixels = &mut refined.pixels;
+        let taken = &refined.taken;
         let tones: Vec<Vec3A> = pixels.par_iter().map(|c| tone3(Vec3A::from(*c))).collect();
         pixels
             .par_chunks_mut(w)
+            .zip(refined.coverage.par_chunks_mut(w))
             .enumerate()
-            .map(|(y, row)| {
+            .map(|(y, (row, coverage_row))| {
                 let mut st = TraceState::refining();
-                for (x, out) in row.iter_mut().enumerate() {
+                for (x, (out, cov)) in row.iter_mut().zip(coverage_row).enumerate() {
                     let n = taken[y * w + x] as u32;
                     if self.rechecks(first, &tones, (x, y), n) {
-                        *out = self.resume(*out, n, (x, y), first.prior(x, y), &mut st);
+                        let prior = first.prior(x, y);
+                        (*out, *cov) = self.resume((*out, *cov), n, (x, y), prior, &mut st);
                     }
                 }
                 st.scratch.counts
@@ -194,24 +238,29 @@ impl Adaptive<'_> {
         255.0 * differs > contrast + 2.0 * self.error
     }
 
-    /// Pixel (x, y), whose `n` samples had mean `mean`, taking more of its own pattern.
+    /// Pixel (x, y), whose `n` samples had mean `mean` and coverage `covered`, taking more of
+    /// its own pattern.
     fn resume(
         &self,
-        mean: Vec3,
+        (mean, covered): (Vec3, f32),
         n: u32,
         (x, y): (usize, usize),
         prior: PixelPrior,
         st: &mut TraceState,
-    ) -> Vec3 {
+    ) -> (Vec3, f32) {
         let pattern = PixelPattern::new(x as u32, y as u32);
         let mut m = Moments::resume(Vec3A::from(mean), n);
+        // Exact: the coverage of n ≤ 255 samples is a count over n.
+        let mut hits = (covered * n as f32).round() as u32;
         while m.n < self.max_spp {
-            m.add(self.sample((x, y), &pattern, m.n, &prior, st));
+            let (radiance, hit) = self.sample((x, y), &pattern, m.n, &prior, st);
+            m.add(radiance);
+            hits += u32::from(hit);
             if m.n.is_power_of_two() && m.error() <= self.error {
                 break;
             }
         }
         st.scratch.counts.primary += (m.n - n) as u64;
-        Vec3::from(m.mean())
+        (Vec3::from(m.mean()), coverage(hits, m.n))
     }
 }

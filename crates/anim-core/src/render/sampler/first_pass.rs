@@ -299,7 +299,8 @@ mod tests {
     #[test]
     fn the_budget_per_pixel_covers_the_sampler_s_buffers() {
         let first_pass = size_of::<(Vec3A, u32)>() + size_of::<Vec3A>() + size_of::<u32>();
-        let refined = size_of::<glam::Vec3>() + size_of::<u8>() + size_of::<f32>();
+        let refined =
+            size_of::<glam::Vec3>() + size_of::<f32>() + size_of::<u8>() + size_of::<f32>();
         let motion = size_of::<Sweep>() + size_of::<Vec3A>();
         let per_pixel = (first_pass + refined + motion) as u64;
         assert!(

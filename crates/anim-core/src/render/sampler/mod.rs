@@ -40,6 +40,9 @@ pub(super) struct Frame<'a> {
 pub(super) struct Sampled {
     /// Linear radiance, row-major from the top.
     pub pixels: Vec<Vec3>,
+    /// Per pixel, the fraction of its camera samples that hit a surface (see
+    /// `Rendered::coverage`).
+    pub coverage: Vec<f32>,
     pub rays: RayCounts,
     /// Adaptive sampling's estimate of each pixel's error (see `Rendered::error_estimates`);
     /// empty for uniform sampling.
@@ -54,14 +57,7 @@ pub(super) fn render(
     on_pixels: &(dyn Fn(u64) + Sync),
 ) -> Sampled {
     match sampling {
-        Sampling::Uniform(spp) => {
-            let (pixels, rays) = uniform::render(frame, spp, on_pixels);
-            Sampled {
-                pixels,
-                rays,
-                error_estimates: Vec::new(),
-            }
-        }
+        Sampling::Uniform(spp) => uniform::render(frame, spp, on_pixels),
         Sampling::Adaptive { error, max_spp } => adaptive::Adaptive {
             frame,
             error,
@@ -69,4 +65,10 @@ pub(super) fn render(
         }
         .render(on_pixels),
     }
+}
+
+/// The fraction of `n` camera samples that hit a surface, `hits` of them: exactly 0 or 1
+/// where none or all did.
+fn coverage(hits: u32, n: u32) -> f32 {
+    hits as f32 / n as f32
 }

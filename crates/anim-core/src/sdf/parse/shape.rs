@@ -539,6 +539,15 @@ mod tests {
     use crate::sdf::{parse, LoadOptions};
     use crate::shape::Geometry;
     use glam::DVec3;
+
+    #[test]
+    fn every_shape_keyword_has_its_own_number_layout() {
+        // `Layout::of` falls back to the plane's layout; a keyword added to SHAPE_KINDS
+        // without its own row would silently read as a plane.
+        for kind in super::SHAPE_KINDS.iter().filter(|k| **k != "composite") {
+            assert_eq!(super::Layout::of(kind).kind, *kind);
+        }
+    }
     use std::path::Path;
 
     fn shapes(text: &str, strict: bool) -> (Vec<Geometry>, Vec<crate::diag::Diagnostic>) {
