@@ -585,6 +585,8 @@ struct Settings {
     timeout: Duration,
     corpus: PathBuf,
     out: PathBuf,
+    /// Runs only this execution (the others are drawn, not run): a finding reproduced.
+    replay: Option<u64>,
 }
 
 fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
@@ -690,6 +692,12 @@ fn run(settings: &Settings) -> Report {
     for exec in 0..settings.execs {
         let (target, input) = next_input(&mut rng, &seeds);
         let variant = rng.next_u64();
+        if settings.replay.is_some_and(|only| only != exec) {
+            continue;
+        }
+        if settings.replay.is_some() {
+            eprintln!("fuzz: replaying exec {exec}: {target:?}, variant {variant}");
+        }
         let began = Instant::now();
         worker
             .jobs
@@ -719,6 +727,9 @@ fn run(settings: &Settings) -> Report {
             }
         }
         let took = began.elapsed();
+        if settings.replay.is_some() {
+            eprintln!("fuzz: exec {exec} took {took:?}");
+        }
         if took > slowest.0 {
             slowest = (took, exec);
         }
@@ -779,6 +790,9 @@ fn settings_from_env(default_execs: u64) -> Settings {
         out: std::env::var_os("FUZZ_OUT")
             .map(PathBuf::from)
             .unwrap_or_else(|| repo.join("target/fuzz-findings")),
+        replay: std::env::var("FUZZ_REPLAY")
+            .ok()
+            .and_then(|v| v.trim().parse().ok()),
     }
 }
 
@@ -803,6 +817,7 @@ fn fuzz() {
 fn fuzz_smoke() {
     let mut settings = settings_from_env(2_000);
     settings.execs = 2_000;
+    settings.replay = None;
     // The shared corpus may be absent on other machines; the repository's seeds suffice.
     let report = run(&settings);
     assert_eq!((report.crashes, report.hangs), (0, 0));

@@ -301,6 +301,9 @@ struct Scan {
     counts: [u64; 3],
     triangles: usize,
     farthest: [Farthest; 3],
+    /// The first relative index of each kind met before the file defined any of that kind:
+    /// harmless if it never does (`tobj` ignores the kind), else it reaches before the first.
+    early: [Option<Farthest>; 3],
 }
 
 impl Scan {
@@ -353,6 +356,20 @@ fn scan(mut reader: impl BufRead) -> Result<Scan, Problem> {
         };
         scan_line(&mut s, line, line_no)
             .map_err(|(start, end, message)| at(start, end, message))?;
+    }
+    for (kind, early) in s.early.iter().enumerate() {
+        if let Some(early) = early.as_ref().filter(|_| s.counts[kind] > 0) {
+            return Err(Problem {
+                line: early.line,
+                start: early.start,
+                end: early.end,
+                message: format!(
+                    "relative {} index -{} reaches before the first one (0 defined so far)",
+                    KINDS[kind], early.index
+                ),
+                text: None,
+            });
+        }
     }
     for (kind, far) in s.farthest.iter().enumerate() {
         // Every index must name something the file defines: `tobj` ignores indices of kinds
@@ -563,6 +580,14 @@ fn face_vertex(s: &mut Scan, at: usize, word: &str, line_no: u64) -> Result<(), 
             ));
         }
         if index < 0 {
+            if defined == 0 && kind != 0 && s.early[kind].is_none() {
+                s.early[kind] = Some(Farthest {
+                    index: index.unsigned_abs(),
+                    line: line_no,
+                    start: span.0,
+                    end: span.1,
+                });
+            }
             if index.unsigned_abs() > defined && (kind == 0 || defined > 0) {
                 return Err((
                     span.0,
@@ -610,6 +635,23 @@ mod tests {
     fn relative_and_slashed_indices_are_accepted() {
         let s = scan_str("v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0 1\nf -3//1 -2//1 -1//-1\n").unwrap();
         assert_eq!(s.triangles, 1);
+    }
+
+    /// Found by the fuzz harness: a relative normal index before any normal, in a file that
+    /// defines one later, made `tobj` overflow (a panic where overflow is checked).
+    #[test]
+    fn a_relative_index_before_the_first_of_its_kind_is_refused_if_one_comes_later() {
+        let early = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3//-1 -2//-1 -1//-1\n";
+        assert!(
+            scan_str(early).is_ok(),
+            "no normal at all: the index is ignored"
+        );
+        let problem = scan_str(&format!("{early}vn 0 0 1\n")).unwrap_err();
+        assert_eq!((problem.line, problem.start, problem.end), (4, 6, 8));
+        assert_eq!(
+            problem.message,
+            "relative normal index -1 reaches before the first one (0 defined so far)"
+        );
     }
 
     #[test]
