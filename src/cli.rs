@@ -53,8 +53,9 @@ pub struct SceneArgs {
     /// order (one warning says which).
     #[arg(long, value_enum, default_value = "auto")]
     pub transform_order: TransformOrderArg,
-    /// Largest scene file read, in bytes; larger files are refused unread.
-    #[arg(long, value_name = "BYTES", default_value_t = limits::DEFAULT_MAX_INPUT)]
+    /// Largest scene file read, e.g. 512M or 2G (bytes without a unit); larger files are
+    /// refused unread.
+    #[arg(long, value_name = "BYTES", default_value_t = limits::DEFAULT_MAX_INPUT, value_parser = parse_bytes)]
     pub max_input: u64,
     /// Read meshes and included files wherever a scene names them; by default only files
     /// inside the scene's folder or the current directory are read.

@@ -44,17 +44,8 @@ pub enum Command {
 /// Runs `command` on a rayon pool of `threads` workers (default: one per core), the one pool
 /// of the process: the rows of a frame and the frames of a directory share it.
 pub fn run(command: Command, threads: Option<u32>) -> ExitCode {
-    // Deep mirror recursion (up to limits::MAX_DEPTH) runs on these threads.
-    let mut builder = rayon::ThreadPoolBuilder::new().stack_size(limits::RENDER_STACK_BYTES);
-    if let Some(n) = threads {
-        builder = builder.num_threads(n as usize);
-    }
-    let pool = match builder.build() {
-        Ok(pool) => pool,
-        Err(e) => {
-            eprintln!("error: cannot start worker threads: {e}");
-            return ExitCode::FAILURE;
-        }
+    let Some(pool) = worker_pool(threads) else {
+        return ExitCode::FAILURE;
     };
     // The preview serves pages from this thread while the pool renders.
     if let Command::Preview(config) = &command {
@@ -75,6 +66,40 @@ pub fn run(command: Command, threads: Option<u32>) -> ExitCode {
         } => bench::run(config, *stress, out.as_deref()),
         Command::Preview(config) => preview::run(config, &pool),
     })
+}
+
+/// The pool of `threads` workers (default: one per core, else one when the process may not
+/// have that many stacks), or `None` after saying why none can start.
+fn worker_pool(threads: Option<u32>) -> Option<rayon::ThreadPool> {
+    // Deep mirror recursion (up to limits::MAX_DEPTH) runs on these threads.
+    let build = |n: Option<u32>| {
+        let mut builder = rayon::ThreadPoolBuilder::new().stack_size(limits::RENDER_STACK_BYTES);
+        if let Some(n) = n {
+            builder = builder.num_threads(n as usize);
+        }
+        builder.build()
+    };
+    let error = match build(threads) {
+        Ok(pool) => return Some(pool),
+        Err(e) => e,
+    };
+    if threads.is_none() {
+        if let Ok(pool) = build(Some(1)) {
+            return Some(pool);
+        }
+    }
+    let stack = anim_core::util::human_bytes(limits::RENDER_STACK_BYTES as u64);
+    let room = match anim_core::util::memory_limit() {
+        Some(limit) => format!(
+            ", and this process may use {} in all (ulimit -v, or the machine's or its control group's memory)",
+            anim_core::util::human_bytes(limit)
+        ),
+        None => String::new(),
+    };
+    eprintln!(
+        "error: cannot start worker threads ({error}): each reserves {stack} of address space for its stack (deep reflections recurse on it){room}"
+    );
+    None
 }
 
 /// A path or name as printed: control characters written as escapes (`\u{1b}`), as

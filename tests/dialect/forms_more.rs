@@ -53,6 +53,47 @@ fn numbers_glued_by_a_sign_are_read_as_a_stream_reader_reads_them() {
     assert!(red_at(&image, 20, 15), "the box is not drawn");
 }
 
+/// A loader that reads its file as a stream of words (`file >> x`) takes a number glued to
+/// the next statement's first word as the number, then that statement: the material ends at
+/// `20` and `ambient 1 1 1` lights the sphere, which has no other light. Read with the
+/// newline put back, the file gives the same image, byte for byte.
+#[test]
+fn a_number_glued_to_the_next_statement_is_read_as_a_stream_reader_reads_it() {
+    let scene = |joint: &str| {
+        format!(
+            "define material lit 0.5 0 0 0 0 0 0 0 0 20{joint}ambient 1 1 1\n\
+             define shape sphere s 0 0 -5 1 lit\n{CAMERA}"
+        )
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(dir.join("scene.sdf"), scene("")).unwrap();
+    std::fs::write(
+        dir.join("whole.sdf"),
+        scene("\n").replace("image.ppm", "whole.ppm"),
+    )
+    .unwrap();
+    let (code, err) = run_in(dir, &["render", "whole.sdf"]);
+    assert_eq!(code, 0, "{err}");
+    let (code, err) = run_in(dir, &["render", "scene.sdf"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains(
+            "scene.sdf:1:41: warning: `20ambient` read as the number `20` and then a new statement from `ambient`"
+        ),
+        "{err}"
+    );
+    let (glued, whole) = (
+        read_ppm(&dir.join("image.ppm")),
+        read_ppm(&dir.join("whole.ppm")),
+    );
+    assert_eq!(glued.data, whole.data);
+    // Ka·I_ambient = 0.5 in red: c/(c+1) = 1/3 of 255.
+    assert_eq!(glued.at(20, 15), [85, 0, 0]);
+    let (code, _) = run_in(dir, &["check", "scene.sdf", "--strict"]);
+    assert_ne!(code, 0);
+}
+
 #[test]
 fn dreieck_is_a_triangle() {
     let image = read_with_warning(

@@ -241,3 +241,38 @@ fn files_outside_the_scene_folder_are_read_from_inside_the_current_directory_or_
         "the file's content is quoted: {err}"
     );
 }
+
+/// `motion` lines in an included file may name the including file's shapes, as `transform`
+/// lines may: the file renders as the one written whole. A name neither file defines is
+/// still refused, at its line in the included file.
+#[test]
+fn motion_lines_of_an_included_file_name_the_including_files_shapes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let motion = "motion ball 0 translate 0 0 0\nmotion ball 1 translate 0.8 0 0\n";
+    write(
+        dir,
+        "whole.sdf",
+        &format!("{MATERIALS}{SHAPES}{motion}{FRAME}"),
+    );
+    write(dir, "moves.sdfi", motion);
+    write(
+        dir,
+        "parts.sdf",
+        &format!("{MATERIALS}{SHAPES}include moves.sdfi\n{FRAME}"),
+    );
+    assert_eq!(render(dir, "parts.sdf", "b"), render(dir, "whole.sdf", "a"));
+    write(dir, "typo.sdfi", "motion bal 0 translate 0 0 0\n");
+    write(
+        dir,
+        "typo.sdf",
+        &format!("{MATERIALS}{SHAPES}include typo.sdfi\n{FRAME}"),
+    );
+    let (code, err) = run_in(dir, &["check", "typo.sdf"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("typo.sdfi:1:8: error: motion of 'bal', which is not a shape"),
+        "{err}"
+    );
+    assert!(err.contains("did you mean `ball`?"), "{err}");
+}

@@ -250,6 +250,28 @@ fn endless_and_oversized_inputs_are_refused_unread() {
         small.as_os_str(),
     ]);
     assert!(ok, "{}", String::from_utf8_lossy(&stderr));
+
+    // The limit takes a unit, as --max-memory does: 1K is 1024 bytes.
+    let padded = format!("{SCENE_LF}{}", "# padding\n".repeat(300));
+    let padded = write(dir.path(), "padded.sdf", padded.as_bytes());
+    let (ok, _, stderr, _) = run(&[
+        "check".as_ref(),
+        "--max-input".as_ref(),
+        "1K".as_ref(),
+        padded.as_os_str(),
+    ]);
+    let stderr = String::from_utf8_lossy(&stderr);
+    assert!(
+        !ok && stderr.contains("more than the limit of 1024 bytes"),
+        "{stderr}"
+    );
+    let (ok, _, stderr, _) = run(&[
+        "check".as_ref(),
+        "--max-input".as_ref(),
+        "1M".as_ref(),
+        padded.as_os_str(),
+    ]);
+    assert!(ok, "{}", String::from_utf8_lossy(&stderr));
 }
 
 #[test]

@@ -417,6 +417,7 @@ fn execute(target: Target, input: &[u8], variant: u64, base: &BaseScene) {
                 );
             }
         }
+        Target::Include if variant.is_multiple_of(4) => diamond(input, variant / 4),
         Target::Include => included(input, variant),
         Target::Spec => {
             let src = Source::new(Path::new("fuzz.ron"), text.into_owned());
@@ -467,6 +468,40 @@ fn included(input: &[u8], variant: u64) {
     part.extend_from_slice(ending);
     std::fs::write(dir.join("part.sdfi"), &part).expect("a temporary file");
     let main = [b"include part.sdfi\n".as_slice(), tail].concat();
+    std::fs::write(dir.join("main.sdf"), main).expect("a temporary file");
+    let result = anim_core::load::load_file(&dir.join("main.sdf"), &LoadOptions::default());
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_printable(&result);
+}
+
+/// The input at the foot of a diamond of includes: `main.sdf` includes `d0.sdfi`, each
+/// `dN.sdfi` includes `dN+1.sdfi` 1 to 10 times (some lines spelling it `./dN+1.sdfi`), 1 to
+/// 8 levels deep, and the last holds the input's head (sometimes including `d0.sdfi` again:
+/// a loop); `main.sdf` holds its tail. 8 levels of 10 would splice the foot 10^8 times.
+fn diamond(input: &[u8], variant: u64) {
+    static INPUTS: AtomicU64 = AtomicU64::new(0);
+    let n = INPUTS.fetch_add(1, Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("anim-fuzz-diamond-{}-{n}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary folder");
+    let levels = 1 + (variant % 8) as usize;
+    let width = 1 + ((variant / 8) % 10) as usize;
+    let cut = ((variant / 80) as usize) % (input.len() + 1);
+    let (head, tail) = input.split_at(cut);
+    for level in 0..levels {
+        let lines: String = (0..width)
+            .map(|i| {
+                let dot = if i % 3 == 2 { "./" } else { "" };
+                format!("include {dot}d{}.sdfi\n", level + 1)
+            })
+            .collect();
+        std::fs::write(dir.join(format!("d{level}.sdfi")), lines).expect("a temporary file");
+    }
+    let mut foot = head.to_vec();
+    if (variant / 80 / 65536).is_multiple_of(4) {
+        foot.extend_from_slice(b"\ninclude d0.sdfi\n");
+    }
+    std::fs::write(dir.join(format!("d{levels}.sdfi")), foot).expect("a temporary file");
+    let main = [b"include d0.sdfi\n".as_slice(), tail].concat();
     std::fs::write(dir.join("main.sdf"), main).expect("a temporary file");
     let result = anim_core::load::load_file(&dir.join("main.sdf"), &LoadOptions::default());
     let _ = std::fs::remove_dir_all(&dir);
@@ -550,6 +585,8 @@ struct Settings {
     timeout: Duration,
     corpus: PathBuf,
     out: PathBuf,
+    /// Runs only this execution (the others are drawn, not run): a finding reproduced.
+    replay: Option<u64>,
 }
 
 fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
@@ -655,6 +692,12 @@ fn run(settings: &Settings) -> Report {
     for exec in 0..settings.execs {
         let (target, input) = next_input(&mut rng, &seeds);
         let variant = rng.next_u64();
+        if settings.replay.is_some_and(|only| only != exec) {
+            continue;
+        }
+        if settings.replay.is_some() {
+            eprintln!("fuzz: replaying exec {exec}: {target:?}, variant {variant}");
+        }
         let began = Instant::now();
         worker
             .jobs
@@ -684,6 +727,9 @@ fn run(settings: &Settings) -> Report {
             }
         }
         let took = began.elapsed();
+        if settings.replay.is_some() {
+            eprintln!("fuzz: exec {exec} took {took:?}");
+        }
         if took > slowest.0 {
             slowest = (took, exec);
         }
@@ -744,6 +790,9 @@ fn settings_from_env(default_execs: u64) -> Settings {
         out: std::env::var_os("FUZZ_OUT")
             .map(PathBuf::from)
             .unwrap_or_else(|| repo.join("target/fuzz-findings")),
+        replay: std::env::var("FUZZ_REPLAY")
+            .ok()
+            .and_then(|v| v.trim().parse().ok()),
     }
 }
 
@@ -768,6 +817,7 @@ fn fuzz() {
 fn fuzz_smoke() {
     let mut settings = settings_from_env(2_000);
     settings.execs = 2_000;
+    settings.replay = None;
     // The shared corpus may be absent on other machines; the repository's seeds suffice.
     let report = run(&settings);
     assert_eq!((report.crashes, report.hangs), (0, 0));

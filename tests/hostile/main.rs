@@ -5,6 +5,12 @@
 //!
 //! - `files`: line endings, control bytes, composite trees that multiply out, huge lines,
 //!   endless devices, thousands of bad lines.
+//! - `budgets`: reading and parsing within the memory `ulimit -v` leaves: huge glued lines,
+//!   many shapes through an include, big meshes, same-name shapes.
+//! - `confinement`: files swapped for links while anim opens them, `/` and the home folder
+//!   as the current directory, messages that would tell whether a file outside exists.
+//! - `includes`: includes that multiply, a frame directory whose shared part includes itself,
+//!   a pipe or `/dev/stdin`, a million include lines.
 //! - `hardening`: deep recursion, huge images, paths outside the scene's folder, corrupted
 //!   images, two runs on one frame directory.
 //! - `scale`: files beyond the old shape cap, and refusal only past `--max-memory`.
@@ -13,7 +19,10 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod budgets;
+mod confinement;
 mod files;
 mod fuzz;
 mod hardening;
+mod includes;
 mod scale;

@@ -162,7 +162,7 @@ fn a_frame_refers_to_its_includes_to_any_depth_and_their_meshes() {
         d,
         "include a.sdfi\ninclude missing.sdfi\ndefine camera cam 60\nrender cam f.png 8 6\n",
     );
-    let referenced = frames::referenced_files(&frame, u64::MAX);
+    let referenced = frames::referenced_files(&frame, &LoadOptions::default());
     let names: Vec<&Path> = referenced
         .iter()
         .map(|p| p.strip_prefix(d).unwrap())
@@ -173,7 +173,7 @@ fn a_frame_refers_to_its_includes_to_any_depth_and_their_meshes() {
     // The fingerprint follows the file two includes deep, and the mesh's size.
     let hash = || {
         let bytes = std::fs::read(&frame).unwrap();
-        frames::frame_hash(&bytes, &frame, "settings", u64::MAX)
+        frames::frame_hash(&bytes, &frame, "settings", &LoadOptions::default())
     };
     let first = hash();
     std::fs::write(

@@ -5,8 +5,9 @@ use crate::session::{
     all_full, materials, per_frame, red_floor, rendered_by_anim_render, request, request_with,
     small_showcase, spec, Preview, EDITED_KEY, FIRST_KEY, FRAMES, MATERIALS,
 };
+use std::io::{Read as _, Write as _};
 use std::process::Command;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 #[test]
 fn refuses_what_is_not_its_own() {
@@ -277,4 +278,98 @@ fn the_preview_shows_the_warnings_anim_render_prints() {
         per_frame(s, "state") == ["full"] && !s.contains("is degenerate")
     });
     assert!(state.contains("\"warnings\":[]"), "{state}");
+}
+
+/// A one-frame scene, small, under `ulimit -n 1024`: 600 connections that never send a byte
+/// (about 510 once made the server's library panic on accept and refuse every connection
+/// from then on). The page is served while they are open and after they are gone.
+#[test]
+fn half_open_connections_leave_the_page_served() {
+    let preview = Preview::start_limited(&[("scene.sdf", small_showcase())], "-n 1024");
+    let mut idle = Vec::new();
+    for _ in 0..600 {
+        match std::net::TcpStream::connect(("127.0.0.1", preview.port)) {
+            Ok(s) => idle.push(s),
+            Err(e) => panic!("connection {} refused: {e}", idle.len()),
+        }
+    }
+    let (status, body) = preview.get("/");
+    assert_eq!(status, 200);
+    assert!(String::from_utf8_lossy(&body).contains("<html"));
+    drop(idle);
+    let (status, _) = preview.get("/");
+    assert_eq!(status, 200);
+    assert_eq!(preview.get("/api/state").0, 200);
+}
+
+/// One client pipelines requests for the script and never reads an answer: another client's
+/// request is answered within a second all the same (it once waited for the first).
+#[test]
+fn a_client_that_never_reads_does_not_delay_another() {
+    let preview = Preview::start_scene();
+    let port = preview.port;
+    let mut hog = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+    hog.set_write_timeout(Some(Duration::from_secs(3))).unwrap();
+    let one = format!("GET /app.js HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n");
+    let many = one.repeat(2000);
+    // Until the server stops taking requests because the hog's answers fill its socket.
+    let _ = hog.write_all(many.as_bytes());
+    for _ in 0..3 {
+        let start = Instant::now();
+        let (status, _) = preview.get("/style.css");
+        assert_eq!(status, 200);
+        let took = start.elapsed();
+        assert!(took < Duration::from_secs(1), "took {took:?}");
+    }
+    drop(hog);
+}
+
+/// The event stream of a 100,000-frame spec, for ten seconds once it is built: the whole
+/// state once, then only the frames that changed (it once sent the whole state, megabytes,
+/// ten times a second).
+#[test]
+fn an_event_stream_sends_what_changed() {
+    let frames = 100_000;
+    let big = spec(FIRST_KEY)
+        .replace("length: Frames(6)", &format!("length: Frames({frames})"))
+        .replace("resolution: (96, 54)", "resolution: (16, 9)");
+    // One sphere, so that a hundred thousand frame files stay small.
+    let scene = "define camera cam 60 0 0 9 0 0 -1 0 1 0\n\
+                 define material m 0.1 0.1 0.1 0.5 0.5 0.5 0 0 0 1\n\
+                 define light l 0 10 0 1 1 1\n\
+                 define shape sphere ball 0 0 0 1 m\n";
+    let preview = Preview::start_with(&[("showcase.sdf", scene.to_string()), ("big.ron", big)]);
+    preview.wait_for(Duration::from_secs(300), |s| !s.contains("\"builds\":0,"));
+    let mut events = std::net::TcpStream::connect(("127.0.0.1", preview.port)).unwrap();
+    write!(
+        events,
+        "GET /events HTTP/1.1\r\nHost: 127.0.0.1:{}\r\n\r\n",
+        preview.port
+    )
+    .unwrap();
+    let start = Instant::now();
+    let mut received = Vec::new();
+    let mut chunk = vec![0u8; 1 << 16];
+    while start.elapsed() < Duration::from_secs(10) {
+        events
+            .set_read_timeout(Some(Duration::from_millis(200)))
+            .unwrap();
+        match events.read(&mut chunk) {
+            Ok(0) => break,
+            Ok(n) => received.extend_from_slice(&chunk[..n]),
+            Err(_) => {}
+        }
+    }
+    let text = String::from_utf8_lossy(&received);
+    // The whole state came first: every frame is in it.
+    let first = text.split("\n\n").next().unwrap_or("");
+    let shown = first.get(..200).unwrap_or(first);
+    assert_eq!(first.matches("\"state\":").count(), frames, "{shown}");
+    let deltas = text.matches("event: delta\ndata: ").count();
+    assert!(deltas > 0, "no delta in {} bytes", received.len());
+    assert!(
+        received.len() < 10 << 20,
+        "{} bytes in 10 s",
+        received.len()
+    );
 }

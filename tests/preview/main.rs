@@ -8,6 +8,10 @@
 //!   scene including its materials file), and plain HTTP requests to it.
 //! - `http`: the routes, refusals (traversal, encoded traversal, foreign `Host`), pixels, edits
 //!   and warnings, through plain HTTP requests.
+//!   The server under load: half-open connections, a client that never reads, the event
+//!   stream of a 100,000-frame spec.
+//! - `watch`: named pipes as a mesh, as the scene after an edit, as a spec's base scene.
+//! - `fuzz`: random requests and connection patterns (FUZZING.md).
 //! - `lifecycle`: `--export` (full-quality frames only, wrong outputs refused before any
 //!   render), SIGTERM and SIGHUP, the diagnostics the terminal prints.
 //! - `browser`: the page in headless Chromium, driven by `scripts/preview-browser.py`.
@@ -16,6 +20,8 @@
 mod common;
 
 mod browser;
+mod fuzz;
 mod http;
 mod lifecycle;
 mod session;
+mod watch;

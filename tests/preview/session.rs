@@ -107,7 +107,12 @@ impl Preview {
 
     /// Starts `anim preview` on the last of `files` (name, text), written first.
     pub fn start_with(files: &[(&str, String)]) -> Preview {
-        let dir = tempfile::tempdir().unwrap();
+        Preview::start_in(tempfile::tempdir().unwrap(), files)
+    }
+
+    /// Starts `anim preview` in `dir` (which may hold other files) on the last of `files`
+    /// (name, text), written first.
+    pub fn start_in(dir: tempfile::TempDir, files: &[(&str, String)]) -> Preview {
         for (name, text) in files {
             std::fs::write(dir.path().join(name), text).unwrap();
         }
@@ -115,10 +120,42 @@ impl Preview {
         Preview::launch(dir, input)
     }
 
+    /// Starts `anim preview` on the last of `files` (name, text), written first, under the
+    /// shell's `ulimit` with `limit` (e.g. `-n 1024`).
+    pub fn start_limited(files: &[(&str, String)], limit: &str) -> Preview {
+        let dir = tempfile::tempdir().unwrap();
+        for (name, text) in files {
+            std::fs::write(dir.path().join(name), text).unwrap();
+        }
+        let input = files.last().unwrap().0;
+        Preview::launch_with(dir, input, Some(limit))
+    }
+
     fn launch(dir: tempfile::TempDir, input: &str) -> Preview {
+        Preview::launch_with(dir, input, None)
+    }
+
+    fn launch_with(dir: tempfile::TempDir, input: &str, limit: Option<&str>) -> Preview {
         std::fs::create_dir(dir.path().join("tmp")).unwrap();
-        let mut child = Command::new(env!("CARGO_BIN_EXE_anim"))
-            .args(["preview", input, "--port", "0"])
+        let mut command = match limit {
+            // `exec` keeps the pid, so Ctrl-C (SIGINT) still reaches the preview.
+            Some(limit) => {
+                let mut c = Command::new("sh");
+                c.arg("-c")
+                    .arg(format!(
+                        "ulimit {limit} && exec \"$0\" preview \"$1\" --port 0"
+                    ))
+                    .arg(env!("CARGO_BIN_EXE_anim"))
+                    .arg(input);
+                c
+            }
+            None => {
+                let mut c = Command::new(env!("CARGO_BIN_EXE_anim"));
+                c.args(["preview", input, "--port", "0"]);
+                c
+            }
+        };
+        let mut child = command
             .current_dir(dir.path())
             .env("TMPDIR", dir.path().join("tmp"))
             .stdin(Stdio::null())

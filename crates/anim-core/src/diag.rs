@@ -46,6 +46,37 @@ pub struct Diagnostic {
     pub width: u32,
     /// "did you mean `glass`?", the canonical form of a statement, ...
     pub help: Option<String>,
+    /// For the one diagnostic that says how many problems were left out (a file with a
+    /// million bad lines keeps only its first ones in memory): how many. `None` for others.
+    pub left_out: Option<LeftOut>,
+}
+
+/// How many problems were found but not kept, by severity.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LeftOut {
+    /// Errors left out.
+    pub errors: usize,
+    /// Warnings left out.
+    pub warnings: usize,
+}
+
+impl LeftOut {
+    /// Counts `d` as left out: itself, or what it stands for when it is a count already.
+    pub fn add(&mut self, d: &Diagnostic) {
+        match d.left_out {
+            Some(l) => {
+                self.errors += l.errors;
+                self.warnings += l.warnings;
+            }
+            None if d.is_error() => self.errors += 1,
+            None => self.warnings += 1,
+        }
+    }
+
+    /// Whether nothing was left out.
+    pub fn is_empty(&self) -> bool {
+        self.errors + self.warnings == 0
+    }
 }
 
 impl Diagnostic {
@@ -60,6 +91,7 @@ impl Diagnostic {
             source_start: 1,
             width: 1,
             help: None,
+            left_out: None,
         }
     }
 
@@ -84,6 +116,7 @@ impl Diagnostic {
             source_start: 1,
             width: 1,
             help: None,
+            left_out: None,
         }
     }
 
@@ -269,8 +302,9 @@ pub fn escape(text: &str) -> std::borrow::Cow<'_, str> {
     std::borrow::Cow::Owned(out)
 }
 
-/// `text` cut in the middle (with `…`) when longer than [`MAX_MESSAGE_CHARS`].
-fn shorten(text: &str) -> std::borrow::Cow<'_, str> {
+/// `text` cut in the middle (with `…`) when longer than a message shows (a thousand
+/// characters): what a message quoting a token of megabytes holds of it.
+pub fn shorten(text: &str) -> std::borrow::Cow<'_, str> {
     if text.len() <= MAX_MESSAGE_CHARS {
         return std::borrow::Cow::Borrowed(text);
     }

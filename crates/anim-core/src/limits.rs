@@ -32,6 +32,13 @@ pub const MAX_NESTING: usize = 256;
 /// How deep `include` lines may nest: the outermost file counts as the first.
 pub const MAX_INCLUDE_DEPTH: usize = 16;
 
+/// What the `include` lines of one scene may splice in again, counted in statements (shapes,
+/// diagnostics and names left out count alike) plus one per line: a file included a second
+/// time, by any file of the scene, costs what it holds again. Files that include a file ten
+/// times, each included ten times in turn, multiply without end in little text; what a
+/// scene repeats on purpose is a composite's work (`define shape composite`).
+pub const MAX_INCLUDE_REPEATS: u64 = 1 << 18;
+
 /// Frames per second of a keyframe spec.
 pub const FPS: RangeInclusive<u32> = 1..=1000;
 

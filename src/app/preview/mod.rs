@@ -2,10 +2,11 @@
 //! rendered, every frame small first and then in full, and follows every edit of its files.
 //!
 //! The parts, each importing only those after it: `server` (routes, the page, event
-//! streams) → `export` (ffmpeg) → `watch` (notify, builds again) → `render` (the workers)
+//! streams) → `http` (bounded connections) → `export` (ffmpeg) → `watch` (notify, builds again) → `render` (the workers)
 //! → `state` (what is shared) → `project` (the spec's frames, via the pipeline).
 
 mod export;
+mod http;
 mod project;
 mod render;
 mod server;
@@ -22,7 +23,7 @@ use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::{Arc, Barrier};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Everything `anim preview` was asked to do.
 #[derive(Clone, Debug)]
@@ -90,34 +91,46 @@ pub fn run(config: &PreviewConfig, pool: &ThreadPool) -> ExitCode {
                 render::worker(shared, load, settings);
             });
         }
-        let watcher = {
+        let (watcher_done, watcher_ended) = std::sync::mpsc::channel::<()>();
+        {
             let (project, shared) = (project.clone(), shared.clone());
-            std::thread::spawn(move || watch::follow(&project, &shared))
-        };
+            std::thread::spawn(move || {
+                watch::follow(&project, &shared);
+                drop(watcher_done);
+            });
+        }
         let code = match &config.export {
             Some(out) => export_only(&shared, &export, out),
             None => serve(config, &shared, export),
         };
         shared.stop();
-        let _ = watcher.join();
+        // A build under way ends at its next file; one stuck on a file is left behind, so
+        // that Ctrl-C always ends the preview.
+        let _ = watcher_ended.recv_timeout(WATCHER_STOP);
         code
     });
     drop(temp);
     code
 }
 
+/// How long a stop waits for the watcher to end.
+const WATCHER_STOP: Duration = Duration::from_secs(1);
+
 /// Serves the page until Ctrl-C.
 fn serve(config: &PreviewConfig, shared: &Arc<Shared>, export: Export) -> ExitCode {
-    let server = match tiny_http::Server::http(config.addr) {
-        Ok(s) => s,
+    let listener = match std::net::TcpListener::bind(config.addr) {
+        Ok(l) => l,
         Err(e) => {
             eprintln!("error: cannot listen on {}: {e}", config.addr);
             return ExitCode::FAILURE;
         }
     };
-    let Some(addr) = server.server_addr().to_ip() else {
-        eprintln!("error: the server has no IP address");
-        return ExitCode::FAILURE;
+    let addr = match listener.local_addr() {
+        Ok(addr) => addr,
+        Err(e) => {
+            eprintln!("error: the server has no address: {e}");
+            return ExitCode::FAILURE;
+        }
     };
     let url = format!("http://{addr}/");
     eprintln!("previewing {} at {url}", super::shown(&config.input));
@@ -132,15 +145,9 @@ fn serve(config: &PreviewConfig, shared: &Arc<Shared>, export: Export) -> ExitCo
         open_browser(&url);
     }
     let ctx = server::Context::new(shared.clone(), addr, export);
-    let result = server::serve(&server, &ctx);
+    server::serve(&listener, ctx);
     eprintln!("stopped");
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: the server failed: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    ExitCode::SUCCESS
 }
 
 /// `--export`: waits until every frame is drawn in full, then encodes them into `out`. The

@@ -55,7 +55,7 @@ impl Project {
             Some(self.input.clone())
         };
         if let Some(scene) = scene {
-            files.extend(referenced_files(&scene, self.load.max_input));
+            files.extend(referenced_files(&scene, &self.load));
             files.push(scene);
         }
         files.sort();
@@ -70,13 +70,14 @@ impl Project {
         let fingerprint = settings_fingerprint(&self.settings, &self.load);
         // A frame's key is what `anim render DIR` records for it: the spec is not part of it,
         // as the frame texts say all it means.
-        let key =
-            |path: &Path, bytes: &[u8]| frame_hash(bytes, path, &fingerprint, self.load.max_input);
+        let key = |path: &Path, bytes: &[u8]| frame_hash(bytes, path, &fingerprint, &self.load);
         if !self.is_spec() {
             // Checked here, so that an error shows as the build's, with the last good frame.
             let loaded = anim_core::load::load_file(&self.input, &self.load).map_err(text)?;
-            let bytes = std::fs::read(&self.input)
-                .map_err(|e| vec![format!("{}: error: {e}", self.input.display())])?;
+            // Read as the loader reads (bounded, never waiting on a pipe): the file may have
+            // been replaced since.
+            let bytes = anim_core::load::read_input(&self.input, self.load.max_input, "file")
+                .map_err(text)?;
             let key = key(&self.input, &bytes);
             return Ok(Built {
                 frames: vec![FrameSource {
@@ -100,7 +101,8 @@ impl Project {
         let frames = paths
             .into_iter()
             .map(|path| {
-                let key = key(&path, &std::fs::read(&path).unwrap_or_default());
+                let bytes = anim_core::load::read_input(&path, self.load.max_input, "file");
+                let key = key(&path, &bytes.unwrap_or_default());
                 FrameSource { path, key }
             })
             .collect();

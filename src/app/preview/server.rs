@@ -4,20 +4,21 @@
 //! and unless its `Host` header names the address the server bound (DNS rebinding).
 
 use super::export::{self, Export};
+use super::http::{self, Answer, Connection, Method, ReadError, Request};
 use super::state::Shared;
-use std::io::Write as _;
-use std::net::SocketAddr;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Arc;
-use std::time::Duration;
-use tiny_http::{Header, Method, Request, Response, Server};
+use std::collections::VecDeque;
+use std::io::Read as _;
+use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
 
 const INDEX: &str = include_str!("page/index.html");
 const SCRIPT: &str = include_str!("page/app.js");
 const STYLE: &str = include_str!("page/style.css");
 
-/// Event streams open at once; more are refused, so a page left open in many tabs cannot
-/// hold every thread.
+/// Event streams open at once: a newer one closes the oldest, so pages left open in many tabs
+/// (or a client holding streams) can neither hold every connection nor lock out a new page.
 const MAX_STREAMS: usize = 32;
 
 /// What a request asks for, once its path has been checked.
@@ -112,7 +113,17 @@ pub struct Context {
     pub shared: Arc<Shared>,
     pub bound: SocketAddr,
     pub export: Arc<Export>,
-    streams: Arc<AtomicUsize>,
+    /// The open event streams, oldest first: each with what closes it.
+    streams: Mutex<VecDeque<Stream>>,
+    next_stream: AtomicU64,
+}
+
+/// An open event stream, as the others see it.
+struct Stream {
+    id: u64,
+    /// Set when a newer page took its place; its thread then ends.
+    ended: Arc<AtomicBool>,
+    closer: Option<TcpStream>,
 }
 
 impl Context {
@@ -121,95 +132,105 @@ impl Context {
             shared,
             bound,
             export: Arc::new(export),
-            streams: Arc::default(),
+            streams: Mutex::default(),
+            next_stream: AtomicU64::new(0),
         }
+    }
+
+    fn streams(&self) -> std::sync::MutexGuard<'_, VecDeque<Stream>> {
+        self.streams.lock().unwrap_or_else(|e| e.into_inner())
     }
 }
 
-/// Answers requests until the preview stops.
-pub fn serve(server: &Server, ctx: &Context) -> std::io::Result<()> {
-    while !ctx.shared.lock().stop {
-        if let Some(request) = server.recv_timeout(Duration::from_millis(100))? {
-            handle(request, ctx);
-        }
-    }
-    Ok(())
-}
-
-/// `response` with `headers` (fixed ASCII strings of this file, which always make headers).
-fn with_headers<R: std::io::Read>(
-    mut response: Response<R>,
-    headers: &[(&str, &str)],
-) -> Response<R> {
-    for (name, value) in headers {
-        if let Ok(h) = Header::from_bytes(name.as_bytes(), value.as_bytes()) {
-            response.add_header(h);
-        }
-    }
-    response
-}
-
-fn respond(request: Request, status: u16, kind: &str, body: Vec<u8>) {
-    let response = with_headers(
-        Response::from_data(body).with_status_code(status),
-        &[
-            ("Content-Type", kind),
-            ("Cache-Control", "no-store"),
-            ("X-Content-Type-Options", "nosniff"),
-            (
-                "Content-Security-Policy",
-                "default-src 'self'; img-src 'self' blob:; media-src 'self'",
-            ),
-        ],
+/// Answers requests on `listener` until the preview stops.
+pub fn serve(listener: &TcpListener, ctx: Context) {
+    let ctx = Arc::new(ctx);
+    let pool = Arc::new(http::Pool::default());
+    let shared = ctx.shared.clone();
+    http::accept_loop(
+        listener,
+        &pool,
+        || shared.lock().stop,
+        move |connection| converse(connection, &ctx),
     );
-    // The browser may have gone away; there is no one to tell.
-    let _ = request.respond(response);
 }
 
-fn refuse(request: Request, status: u16, why: &str) {
-    respond(
-        request,
+/// What a request gets: an answer, the export file, or an event stream.
+enum Reply {
+    Answer(Answer),
+    File(std::fs::File),
+    Events,
+}
+
+/// Answers one client's requests, in order, until it goes away or an answer ends it.
+fn converse(mut connection: Connection, ctx: &Context) {
+    loop {
+        let request = match connection.next_request() {
+            Ok(request) => request,
+            Err(ReadError::Gone) => return,
+            Err(ReadError::Bad(status)) => {
+                connection.respond(None, &plain(status, "bad request"));
+                return;
+            }
+        };
+        let go_on = match handle(&request, ctx) {
+            Reply::Answer(answer) => connection.respond(Some(&request), &answer),
+            Reply::File(file) => send_file(&mut connection, &request, file),
+            Reply::Events => return stream(connection, ctx),
+        };
+        if !go_on {
+            return;
+        }
+    }
+}
+
+/// The headers every answer of this server carries, with `kind` as its type.
+fn answer(status: u16, kind: &str, body: Vec<u8>) -> Answer {
+    let headers = [
+        ("Content-Type", kind),
+        ("Cache-Control", "no-store"),
+        ("X-Content-Type-Options", "nosniff"),
+        (
+            "Content-Security-Policy",
+            "default-src 'self'; img-src 'self' blob:; media-src 'self'",
+        ),
+    ];
+    Answer {
         status,
-        "text/plain; charset=utf-8",
-        why.as_bytes().to_vec(),
-    );
-}
-
-/// The value of header `name`, if the request has it.
-fn header_value(request: &Request, name: &'static str) -> Option<String> {
-    request
-        .headers()
-        .iter()
-        .find(|h| h.field.equiv(name))
-        .map(|h| h.value.as_str().to_string())
-}
-
-fn handle(request: Request, ctx: &Context) {
-    let host = header_value(&request, "Host");
-    if !host_ok(host.as_deref(), ctx.bound) {
-        return refuse(request, 421, "unknown host");
+        headers: headers.iter().map(|(n, v)| (*n, v.to_string())).collect(),
+        body,
     }
-    let route = match route(request.method(), request.url()) {
+}
+
+fn plain(status: u16, why: &str) -> Answer {
+    answer(status, "text/plain; charset=utf-8", why.as_bytes().to_vec())
+}
+
+fn handle(request: &Request, ctx: &Context) -> Reply {
+    let host = request.header("Host");
+    if !host_ok(host, ctx.bound) {
+        return Reply::Answer(plain(421, "unknown host"));
+    }
+    let route = match route(&request.method, &request.url) {
         Ok(route) => route,
-        Err(status) => return refuse(request, status, "not served"),
+        Err(status) => return Reply::Answer(plain(status, "not served")),
     };
     // Another site's page may post to this address directly (its Host is then right): a
     // browser names that page's origin, which must be this one.
-    let foreign = header_value(&request, "Origin").is_some_and(|origin| {
-        host.as_deref()
-            .is_none_or(|h| !origin.eq_ignore_ascii_case(&format!("http://{}", h.trim())))
+    let foreign = request.header("Origin").is_some_and(|origin| {
+        host.is_none_or(|h| !origin.eq_ignore_ascii_case(&format!("http://{}", h.trim())))
     });
-    if *request.method() == Method::Post && foreign {
-        return refuse(request, 403, "posted from another site");
+    if request.method == Method::Post && foreign {
+        return Reply::Answer(plain(403, "posted from another site"));
     }
-    let text = |request, kind: &str, body: &str| respond(request, 200, kind, body.into());
+    let text = |kind: &str, body: &str| Reply::Answer(answer(200, kind, body.into()));
     match route {
-        Route::Page => text(request, "text/html; charset=utf-8", INDEX),
-        Route::Script => text(request, "text/javascript; charset=utf-8", SCRIPT),
-        Route::Style => text(request, "text/css; charset=utf-8", STYLE),
+        Route::Page => text("text/html; charset=utf-8", INDEX),
+        Route::Script => text("text/javascript; charset=utf-8", SCRIPT),
+        Route::Style => text("text/css; charset=utf-8", STYLE),
         Route::State => {
             let json = ctx.shared.lock().to_json();
-            text(request, "application/json", &json)
+            text("application/json", &json)
         }
         Route::Frame(i) => {
             let png = ctx
@@ -219,8 +240,8 @@ fn handle(request: Request, ctx: &Context) {
                 .get(i)
                 .and_then(|f| f.best().map(|(img, _)| img.png.clone()));
             match png {
-                Some(png) => respond(request, 200, "image/png", png.to_vec()),
-                None => refuse(request, 404, "no image yet"),
+                Some(png) => Reply::Answer(answer(200, "image/png", png.to_vec())),
+                None => Reply::Answer(plain(404, "no image yet")),
             }
         }
         Route::Focus(i) => {
@@ -228,70 +249,124 @@ fn handle(request: Request, ctx: &Context) {
             state.playhead = i.min(state.frames.len().saturating_sub(1));
             ctx.shared.work.notify_all();
             drop(state);
-            text(request, "application/json", "{}")
+            text("application/json", "{}")
         }
-        Route::Events => stream(request, ctx),
-        Route::Export => {
-            let (shared, export) = (ctx.shared.clone(), ctx.export.clone());
-            // Encoding takes seconds; the server goes on answering meanwhile.
-            std::thread::spawn(move || {
-                let json = export::run(&shared, &export);
-                respond(request, 200, "application/json", json.into_bytes());
-            });
-        }
+        Route::Events => Reply::Events,
+        // Encoding takes seconds: this connection waits, the others are answered meanwhile.
+        Route::Export => text("application/json", &export::run(&ctx.shared, &ctx.export)),
         Route::Download => match std::fs::File::open(ctx.export.video()) {
-            Ok(file) => {
-                let response = with_headers(
-                    Response::from_file(file),
-                    &[
-                        ("Content-Type", "video/mp4"),
-                        (
-                            "Content-Disposition",
-                            "attachment; filename=\"preview.mp4\"",
-                        ),
-                    ],
-                );
-                let _ = request.respond(response);
-            }
-            Err(_) => refuse(request, 404, "nothing exported yet"),
+            Ok(file) => Reply::File(file),
+            Err(_) => Reply::Answer(plain(404, "nothing exported yet")),
         },
     }
 }
 
-/// Server-Sent Events: the whole state each time it changes, at most ten times a second,
-/// on a thread of its own until the page goes away or the preview stops.
-fn stream(request: Request, ctx: &Context) {
-    if ctx.streams.fetch_add(1, Ordering::SeqCst) >= MAX_STREAMS {
-        ctx.streams.fetch_sub(1, Ordering::SeqCst);
-        return refuse(request, 503, "too many open pages");
+/// Sends the exported video, read as it is sent.
+fn send_file(connection: &mut Connection, request: &Request, mut file: std::fs::File) -> bool {
+    let len = file.metadata().map_or(0, |m| m.len());
+    let mut head = answer(200, "video/mp4", Vec::new());
+    head.headers.push((
+        "Content-Disposition",
+        "attachment; filename=\"preview.mp4\"".to_string(),
+    ));
+    if !connection.respond_head(Some(request), &head, len) {
+        return false;
     }
-    let shared = ctx.shared.clone();
-    let streams = ctx.streams.clone();
-    std::thread::spawn(move || {
-        let mut out = request.into_writer();
-        let head = "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\nConnection: close\r\n\r\n";
-        let mut seen = u64::MAX;
-        let mut ok = out.write_all(head.as_bytes()).is_ok();
-        while ok {
-            let mut state = shared.lock();
-            if state.version == seen && !state.stop {
-                state = shared.wait(&shared.changed, state, Duration::from_secs(15));
-            }
-            if state.stop {
-                break;
-            }
-            let message = if state.version == seen {
-                ": still here\n\n".to_string()
-            } else {
-                seen = state.version;
-                format!("data: {}\n\n", state.to_json())
-            };
-            drop(state);
-            ok = out.write_all(message.as_bytes()).is_ok() && out.flush().is_ok();
-            std::thread::sleep(Duration::from_millis(100));
+    let go_on = !request.close();
+    if request.method == Method::Head {
+        return go_on;
+    }
+    let mut chunk = vec![0u8; 64 << 10];
+    let mut left = len;
+    while left > 0 {
+        let n = match file.read(&mut chunk) {
+            Ok(0) | Err(_) => return false,
+            Ok(n) => n.min(usize::try_from(left).unwrap_or(usize::MAX)),
+        };
+        if !connection.write(&chunk[..n]) {
+            return false;
         }
-        streams.fetch_sub(1, Ordering::SeqCst);
-    });
+        left -= n as u64;
+    }
+    go_on
+}
+
+/// How often an idle event stream says it is still there.
+const STILL_HERE: Duration = Duration::from_secs(15);
+/// The shortest time between two events of a stream.
+const EVENT_GAP: Duration = Duration::from_millis(100);
+
+/// Server-Sent Events until the page goes away, a newer page takes its place or the preview
+/// stops: the whole state first, then, at most ten times a second, what changed (`event:
+/// delta`: the frames whose marks changed, the notes only when they did).
+fn stream(mut connection: Connection, ctx: &Context) {
+    let id = ctx.next_stream.fetch_add(1, Ordering::Relaxed);
+    let ended = Arc::new(AtomicBool::new(false));
+    {
+        let mut streams = ctx.streams();
+        // The newest page wins: pages left open, or a client holding streams, give way.
+        while streams.len() >= MAX_STREAMS {
+            let Some(oldest) = streams.pop_front() else {
+                break;
+            };
+            oldest.ended.store(true, Ordering::SeqCst);
+            if let Some(closer) = oldest.closer {
+                let _ = closer.shutdown(Shutdown::Both);
+            }
+        }
+        streams.push_back(Stream {
+            id,
+            ended: ended.clone(),
+            closer: connection.closer(),
+        });
+    }
+    let head = "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\nConnection: close\r\n\r\n";
+    if connection.write(head.as_bytes()) {
+        events(&mut connection, &ctx.shared, &ended);
+    }
+    ctx.streams().retain(|s| s.id != id);
+}
+
+fn events(connection: &mut Connection, shared: &Shared, ended: &AtomicBool) {
+    let mut seen = u64::MAX;
+    let mut marks: Vec<u64> = Vec::new();
+    let mut notes = 0;
+    let mut quiet = Instant::now();
+    while !ended.load(Ordering::SeqCst) {
+        let mut state = shared.lock();
+        if state.version == seen && !state.stop {
+            // Waits a little at a time, so that a stream another page replaced ends soon.
+            state = shared.wait(&shared.changed, state, Duration::from_secs(1));
+        }
+        if state.stop {
+            return;
+        }
+        let message = if state.version != seen {
+            let first = seen == u64::MAX;
+            seen = state.version;
+            let now = state.frame_marks();
+            let now_notes = state.notes_mark();
+            let delta = state
+                .delta_json(&marks, &now, now_notes != notes)
+                .filter(|_| !first);
+            marks = now;
+            notes = now_notes;
+            match delta {
+                Some(delta) => format!("event: delta\ndata: {delta}\n\n"),
+                None => format!("data: {}\n\n", state.to_json()),
+            }
+        } else if quiet.elapsed() >= STILL_HERE {
+            ": still here\n\n".to_string()
+        } else {
+            continue;
+        };
+        drop(state);
+        if !connection.write(message.as_bytes()) {
+            return;
+        }
+        quiet = Instant::now();
+        std::thread::sleep(EVENT_GAP);
+    }
 }
 
 #[cfg(test)]

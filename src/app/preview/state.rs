@@ -5,6 +5,7 @@
 
 use super::project::Built;
 use anim_core::diag::Diagnostic;
+use anim_core::util::Fnv64;
 use anim_pipeline::frames::distinct_warnings;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -74,6 +75,31 @@ impl Frame {
         self.busy.is_none()
             && self.error_key != Some(self.key)
             && image.as_ref().is_none_or(|i| i.key != self.key)
+    }
+
+    /// The frame as the page reads it (JSON; `error` only when there is one).
+    fn write_json(&self, out: &mut String) {
+        let _ = write!(
+            out,
+            "{{\"state\":\"{}\",\"v\":{},\"renders\":{}",
+            self.state(),
+            self.version,
+            self.renders
+        );
+        if let Some(e) = &self.error {
+            let _ = write!(out, ",\"error\":{}", json_string(e));
+        }
+        out.push('}');
+    }
+
+    /// Changes whenever what [`Frame::write_json`] writes does (its error changes only with
+    /// a render, which `renders` counts).
+    fn mark(&self) -> u64 {
+        let mut h = Fnv64::default();
+        h.write(self.state().as_bytes());
+        h.write(&self.version.to_le_bytes());
+        h.write(&self.renders.to_le_bytes());
+        h.finish()
     }
 
     fn state(&self) -> &'static str {
@@ -311,30 +337,80 @@ impl State {
 
     /// The state as the page reads it (JSON).
     pub fn to_json(&self) -> String {
-        let mut out = format!(
-            "{{\"version\":{},\"builds\":{},\"fps\":{},\"playhead\":{},\"keys\":[",
-            self.version,
-            self.builds,
-            json_number(self.fps),
-            self.playhead
-        );
-        let keys: Vec<String> = self.keys.iter().map(|&k| json_number(k)).collect();
-        out.push_str(&keys.join(","));
-        out.push_str("],\"frames\":[");
+        let mut out = self.head_json();
+        out.push_str(",\"keys\":");
+        out.push_str(&self.keys_json());
+        out.push_str(",\"frames\":[");
         for (i, f) in self.frames.iter().enumerate() {
             if i > 0 {
                 out.push(',');
             }
-            let _ = write!(
-                out,
-                "{{\"state\":\"{}\",\"v\":{},\"renders\":{},\"error\":{}}}",
-                f.state(),
-                f.version,
-                f.renders,
-                f.error.as_deref().map_or("null".to_string(), json_string)
-            );
+            f.write_json(&mut out);
         }
-        out.push_str("],\"diagnostics\":");
+        out.push(']');
+        out.push_str(&self.notes_json());
+        out.push('}');
+        out
+    }
+
+    /// What changed since a page was sent the state whose frames had `marks` (see
+    /// [`State::frame_marks`]): the small fields, `n` (the number of frames), `changed` (the
+    /// frames whose marks differ, by index), and the keys, diagnostics and warnings when
+    /// `with_notes`. `None` when the frames are not the same list (a full state is due).
+    pub fn delta_json(&self, marks: &[u64], now: &[u64], with_notes: bool) -> Option<String> {
+        if marks.len() != self.frames.len() || now.len() != self.frames.len() {
+            return None;
+        }
+        let mut out = self.head_json();
+        let _ = write!(out, ",\"n\":{},\"changed\":{{", self.frames.len());
+        let mut first = true;
+        for (i, f) in self.frames.iter().enumerate() {
+            if marks[i] != now[i] {
+                let _ = write!(out, "{}\"{i}\":", if first { "" } else { "," });
+                f.write_json(&mut out);
+                first = false;
+            }
+        }
+        out.push('}');
+        if with_notes {
+            out.push_str(",\"keys\":");
+            out.push_str(&self.keys_json());
+            out.push_str(&self.notes_json());
+        }
+        out.push('}');
+        Some(out)
+    }
+
+    /// A mark of what the page shows of each frame: equal marks, nothing to send.
+    pub fn frame_marks(&self) -> Vec<u64> {
+        self.frames.iter().map(Frame::mark).collect()
+    }
+
+    /// A mark of the keys, diagnostics and warnings, and the JSON that carries them.
+    pub fn notes_mark(&self) -> u64 {
+        let mut text = self.keys_json();
+        text.push_str(&self.notes_json());
+        Fnv64::of(text.as_bytes())
+    }
+
+    fn head_json(&self) -> String {
+        format!(
+            "{{\"version\":{},\"builds\":{},\"fps\":{},\"playhead\":{}",
+            self.version,
+            self.builds,
+            json_number(self.fps),
+            self.playhead
+        )
+    }
+
+    fn keys_json(&self) -> String {
+        let keys: Vec<String> = self.keys.iter().map(|&k| json_number(k)).collect();
+        format!("[{}]", keys.join(","))
+    }
+
+    /// `,"diagnostics":[...],"warnings":[...]`.
+    fn notes_json(&self) -> String {
+        let mut out = String::from(",\"diagnostics\":");
         out.push_str(&json_list(&self.diagnostics));
         out.push_str(",\"warnings\":");
         let warnings: Vec<String> = self
@@ -343,7 +419,6 @@ impl State {
             .map(|(w, count)| crate::app::render::in_frames(w, *count))
             .collect();
         out.push_str(&json_list(&warnings));
-        out.push('}');
         out
     }
 }

@@ -7,19 +7,20 @@ mod camera_sense;
 pub mod probe;
 
 pub use crate::input::read_input;
+pub use crate::sdf::not_shown;
 #[cfg(test)]
 mod scale_tests;
 #[cfg(test)]
 mod tests;
 
-use crate::diag::{Diagnostic, Severity};
+use crate::diag::{Diagnostic, LeftOut, Severity};
 use crate::limits::MAX_DIAGNOSTICS;
 use crate::scene::{build_jobs, RenderJob};
 use crate::sdf::ast::{Statement, StatementKind};
 use crate::sdf::{self, finish_diagnostics, LoadOptions, TransformOrder};
 use std::borrow::Cow;
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// A successfully loaded file: its images to render and the warnings met on the way.
 #[derive(Clone, Debug)]
@@ -70,8 +71,11 @@ pub fn build(
     conclude(
         jobs,
         finish_diagnostics(diagnostics, opts),
-        path,
-        opts.max_input,
+        Quoting {
+            path,
+            opts,
+            included: &[],
+        },
         || None,
     )
 }
@@ -111,13 +115,17 @@ fn finish_load<'t>(
     } else {
         opts
     };
-    let (mut jobs, mut built) = build_jobs(
-        &parsed.statements,
-        parsed.shapes,
-        path,
-        opts,
-        Some(&parsed.omissions),
-    );
+    let (mut jobs, mut built) = if parsed.omissions.abandoned {
+        (Vec::new(), Vec::new())
+    } else {
+        build_jobs(
+            &parsed.statements,
+            parsed.shapes,
+            path,
+            opts,
+            Some(&parsed.omissions),
+        )
+    };
     if may_need_another_reading(&parsed.statements, &jobs, &built, opts) {
         let (statements, omissions) = (&parsed.statements, &parsed.omissions);
         // The camera's sense first: over the public corpus it shows what the other order
@@ -138,13 +146,12 @@ fn finish_load<'t>(
     drop(parsed.statements);
     let mut diagnostics = parsed.diagnostics;
     diagnostics.extend(built);
-    conclude(
-        jobs,
-        finish_diagnostics(diagnostics, opts),
+    let quoting = Quoting {
         path,
-        opts.max_input,
-        text,
-    )
+        opts,
+        included: &parsed.included,
+    };
+    conclude(jobs, finish_diagnostics(diagnostics, opts), quoting, text)
 }
 
 /// Whether the file is worth reading another way (`--transform-order auto`,
@@ -271,6 +278,14 @@ fn read_in_other_order(
     Some((other_jobs, built))
 }
 
+/// Where the lines diagnostics quote come from: the scene file `path` and the files it
+/// included (`included`, read again only while they hold what was read).
+struct Quoting<'q> {
+    path: &'q Path,
+    opts: &'q LoadOptions,
+    included: &'q [sdf::FileRead],
+}
+
 /// `Err` with the diagnostics when one is an error. They are capped first, then the kept
 /// ones that lack their source line quote it from `text()` (the file's text, `None` for
 /// statements made by a program, asked for only when a line is to be quoted): quoting is
@@ -280,27 +295,19 @@ fn read_in_other_order(
 fn conclude<'t>(
     jobs: Vec<RenderJob>,
     diagnostics: Vec<Diagnostic>,
-    path: &Path,
-    max_input: u64,
+    quoting: Quoting<'_>,
     text: impl FnOnce() -> Option<Cow<'t, str>>,
 ) -> Result<Loaded, Vec<Diagnostic>> {
+    let path = quoting.path;
     let failed = diagnostics.iter().any(Diagnostic::is_error);
     let mut diagnostics = cap(diagnostics, path);
     quote_lines(&mut diagnostics, path, text);
-    // Lines of the files a scene includes are quoted from those files.
-    let mut others: Vec<&Path> = diagnostics
-        .iter()
-        .filter(|d| d.source_line.is_none())
-        .filter_map(|d| d.loc.as_ref().map(|l| &*l.file))
-        .filter(|&f| f != path)
-        .collect();
-    others.sort_unstable();
-    others.dedup();
-    let others: Vec<PathBuf> = others.into_iter().map(Path::to_path_buf).collect();
-    for file in others {
-        quote_lines(&mut diagnostics, &file, || {
-            read_input(&file, max_input, "file")
-                .ok()
+    // Lines of the files a scene includes are quoted from those files, confined as when
+    // they were included, and only while they hold the bytes that were read: a file swapped
+    // since (for a link to another file) is not quoted.
+    for file in quoting.included {
+        quote_lines(&mut diagnostics, file.shown(), || {
+            file.read_again(path, quoting.opts)
                 .map(|b| Cow::Owned(String::from_utf8_lossy(&b).into_owned()))
         });
     }
@@ -347,43 +354,28 @@ fn quote_lines<'t>(
     }
 }
 
-/// The first [`MAX_DIAGNOSTICS`] diagnostics and, if there were more, one saying how many
-/// were left out ([`not_shown`]).
-fn cap(mut diagnostics: Vec<Diagnostic>, path: &Path) -> Vec<Diagnostic> {
-    if diagnostics.len() <= MAX_DIAGNOSTICS {
-        return diagnostics;
-    }
-    let rest = diagnostics.split_off(MAX_DIAGNOSTICS);
-    let errors = rest.iter().filter(|d| d.is_error()).count();
-    diagnostics.push(not_shown(path, errors, rest.len() - errors));
-    diagnostics
-}
-
-/// The last diagnostic of a file with more problems than are listed: how many `errors` and
-/// `warnings` were left out after the first [`MAX_DIAGNOSTICS`].
-/// An error if any of those is one, so that the count is never mistaken for harmless.
-pub fn not_shown(path: &Path, errors: usize, warnings: usize) -> Diagnostic {
-    let plural = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
-    let kinds: Vec<String> = [(errors, "error"), (warnings, "warning")]
+/// The first [`MAX_DIAGNOSTICS`] diagnostics and, if there were more (kept, or left out
+/// while reading: `sdf::keep_shown`), one saying how many were left out ([`not_shown`]).
+fn cap(diagnostics: Vec<Diagnostic>, path: &Path) -> Vec<Diagnostic> {
+    let mut left = LeftOut::default();
+    let mut kept: Vec<Diagnostic> = diagnostics
         .into_iter()
-        .filter(|(n, _)| *n > 0)
-        .map(|(n, what)| plural(n, what))
+        .filter(|d| {
+            if d.left_out.is_some() {
+                left.add(d);
+            }
+            d.left_out.is_none()
+        })
         .collect();
-    let severity = if errors > 0 {
-        Severity::Error
-    } else {
-        Severity::Warning
-    };
-    Diagnostic::file_error(
-        path,
-        format!(
-            "and {} more ({}) not shown: only the first {} problems of a file are listed",
-            errors + warnings,
-            kinds.join(", "),
-            MAX_DIAGNOSTICS
-        ),
-    )
-    .with_severity(severity)
+    if kept.len() > MAX_DIAGNOSTICS {
+        for d in kept.split_off(MAX_DIAGNOSTICS) {
+            left.add(&d);
+        }
+    }
+    if !left.is_empty() {
+        kept.push(not_shown(path, left.errors, left.warnings));
+    }
+    kept
 }
 
 #[cfg(test)]

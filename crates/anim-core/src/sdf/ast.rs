@@ -75,7 +75,8 @@ const FLAT_CHUNK: usize = 1 << 14;
 /// statement, name and material are written.
 #[derive(Clone, Debug, Default)]
 pub struct FlatShapes {
-    file: Option<Arc<Path>>,
+    /// The files the shapes were read from (a file and those it includes), by id.
+    files: Vec<Arc<Path>>,
     chunks: Vec<Vec<FlatShape>>,
     len: usize,
     /// Every shape name, one after the other.
@@ -94,6 +95,7 @@ pub struct FlatShape {
     /// The primitive as its statement writes it, in object space.
     pub geometry: Geometry,
     name_start: u32,
+    /// The name's length in bytes, and above [`NAME_LEN_BITS`] the id of its file.
     name_len: u32,
     /// Material id; the top bit says whether the material was defined before this line.
     material: u32,
@@ -140,6 +142,11 @@ impl FlatShape {
 }
 
 const DEFINED_BEFORE: u32 = 1 << 31;
+/// Bits of `FlatShape::name_len` that hold the name's length; the rest hold the file's id.
+const NAME_LEN_BITS: u32 = 24;
+const NAME_LEN_MASK: u32 = (1 << NAME_LEN_BITS) - 1;
+/// How many files the shapes of one [`FlatShapes`] may come from.
+const MAX_FLAT_FILES: usize = 1 << (32 - NAME_LEN_BITS);
 const FIRST_WIDTH: u32 = "define".len() as u32;
 
 impl FlatShapes {
@@ -219,10 +226,73 @@ impl FlatShapes {
         let fits = |v: usize| u32::try_from(v).is_ok_and(|v| v < DEFINED_BEFORE);
         fits(self.names.len())
             && fits(pos)
-            && self.file.as_ref().is_none_or(|f| Arc::ptr_eq(f, file))
-            && fits(name.len())
+            && (self.file_id(file).is_some() || self.files.len() < MAX_FLAT_FILES)
+            && name.len() <= NAME_LEN_MASK as usize
             && name_width as usize == name.chars().count()
             && (self.materials.len() as u64) < u64::from(DEFINED_BEFORE)
+    }
+
+    /// The id of `file` among the files of the shapes, if any shape came from it.
+    fn file_id(&self, file: &Arc<Path>) -> Option<u32> {
+        // Shapes come file after file: the last is almost always the one.
+        self.files
+            .iter()
+            .rposition(|f| Arc::ptr_eq(f, file) || **f == **file)
+            .map(|i| i as u32)
+    }
+
+    /// Takes the shapes of an included file, spliced in after `before` statements (other
+    /// than these shapes) of the file including it, when their places fit the compact form
+    /// together with these; else gives them back. A material that file defined before the
+    /// include line counts as defined before each of the included shapes.
+    pub fn append(&mut self, other: FlatShapes, before: usize) -> Result<(), Box<FlatShapes>> {
+        let mut files = self.files.clone();
+        for f in &other.files {
+            if !files.iter().any(|g| Arc::ptr_eq(g, f) || **g == **f) {
+                files.push(f.clone());
+            }
+        }
+        let last_pos = other.iter().map(|s| s.pos as usize).max().unwrap_or(0);
+        let fits = |v: usize| u32::try_from(v).is_ok_and(|v| v < DEFINED_BEFORE);
+        let fit = files.len() <= MAX_FLAT_FILES
+            && fits(self.names.len() + other.names.len())
+            && fits(before + last_pos)
+            && fits(self.materials.len() + other.materials.len());
+        if !fit {
+            return Err(Box::new(other));
+        }
+        self.files = files;
+        let file_ids: Vec<u32> = other
+            .files
+            .iter()
+            .map(|f| self.file_id(f).unwrap_or(0))
+            .collect();
+        let material_ids: Vec<u32> = other
+            .materials
+            .iter()
+            .map(|name| self.material_id(name))
+            .collect();
+        let names_offset = self.names.len() as u32;
+        self.names.push_str(&other.names);
+        for s in other.chunks.into_iter().flatten() {
+            let id = material_ids[(s.material & !DEFINED_BEFORE) as usize];
+            let before_here =
+                s.material & DEFINED_BEFORE != 0 || self.material_defined[id as usize];
+            let file = file_ids[(s.name_len >> NAME_LEN_BITS) as usize];
+            self.push_record(FlatShape {
+                name_start: s.name_start + names_offset,
+                name_len: (s.name_len & NAME_LEN_MASK) | (file << NAME_LEN_BITS),
+                material: id | if before_here { DEFINED_BEFORE } else { 0 },
+                pos: s.pos + before as u32,
+                ..s
+            });
+        }
+        for (name, defined) in other.materials.iter().zip(&other.material_defined) {
+            if *defined {
+                self.define_material(name);
+            }
+        }
+        Ok(())
     }
 
     /// Takes a primitive shape written on one line, straight from the reader's tokens (no
@@ -236,20 +306,24 @@ impl FlatShapes {
         };
         let name_start = self.names.len() as u32;
         self.names.push_str(shape.name);
-        let record = FlatShape {
+        let file = self.file_id(shape.file).unwrap_or_else(|| {
+            self.files.push(shape.file.clone());
+            self.files.len() as u32 - 1
+        });
+        self.push_record(FlatShape {
             geometry: shape.geometry,
             name_start,
-            name_len: shape.name.len() as u32,
+            name_len: shape.name.len() as u32 | (file << NAME_LEN_BITS),
             material: id | before,
             line: shape.line,
             col: shape.col,
             name_col: shape.name_col,
             material_col: shape.material_col,
             pos: shape.pos as u32,
-        };
-        if self.file.is_none() {
-            self.file = Some(shape.file.clone());
-        }
+        });
+    }
+
+    fn push_record(&mut self, record: FlatShape) {
         match self.chunks.last_mut() {
             Some(chunk) if chunk.len() < FLAT_CHUNK => chunk.push(record),
             // The first chunk grows as a vector does (a small file holds no empty chunk); the
@@ -290,13 +364,18 @@ impl FlatShapes {
     pub fn name(&self, s: &FlatShape) -> &str {
         let start = s.name_start as usize;
         self.names
-            .get(start..start + s.name_len as usize)
+            .get(start..start + (s.name_len & NAME_LEN_MASK) as usize)
             .unwrap_or("")
     }
 
-    /// The file every shape was read from (`None` when there is no shape).
-    pub fn file(&self) -> Option<&Arc<Path>> {
-        self.file.as_ref()
+    /// The files the shapes were read from, by id (see [`FlatShapes::file_of`]).
+    pub fn files(&self) -> &[Arc<Path>] {
+        &self.files
+    }
+
+    /// The id of the file `s` was read from, an index into [`FlatShapes::files`].
+    pub fn file_of(&self, s: &FlatShape) -> usize {
+        (s.name_len >> NAME_LEN_BITS) as usize
     }
 
     /// Bytes of all the shapes' names together.
@@ -332,8 +411,9 @@ impl FlatShapes {
     fn loc_at(&self, s: &FlatShape, col: u32) -> Loc {
         Loc {
             file: self
-                .file
-                .clone()
+                .files
+                .get(self.file_of(s))
+                .cloned()
                 .unwrap_or_else(|| Arc::from(Path::new(""))),
             line: s.line,
             col,

@@ -11,9 +11,12 @@ mod parse;
 pub mod repair;
 
 pub use lexer::{image_names, raw_lines, scene_key, ImageName};
-pub use parse::{default_output, included_files, mesh_files, IncludeCache, Omissions, Parsed};
+pub use parse::{
+    default_output, mesh_files, references, FileRead, IncludeCache, Omissions, Parsed, Reference,
+};
 
-use crate::diag::{Diagnostic, Severity};
+use crate::diag::{Diagnostic, LeftOut, Severity};
+use crate::limits::MAX_DIAGNOSTICS;
 use crate::shape::MeshCache;
 use std::path::Path;
 
@@ -183,7 +186,7 @@ pub fn parse_source_whole(text: &str, path: &Path, opts: &LoadOptions) -> Parsed
 }
 
 fn read(text: &str, path: &Path, opts: &LoadOptions, flat: bool) -> Parsed {
-    let chain = parse::Chain::outermost(path, text);
+    let chain = parse::Chain::outermost(path, text, opts);
     if chain.generated {
         // Its includes are read with these options too (see `is_generated_frame`).
         parse::parse(text, path, &opts.without_inference(), flat, chain)
@@ -194,13 +197,12 @@ fn read(text: &str, path: &Path, opts: &LoadOptions, flat: bool) -> Parsed {
 
 /// Orders diagnostics by position (file-wide ones last) and applies `--strict`.
 pub fn finish_diagnostics(mut diagnostics: Vec<Diagnostic>, opts: &LoadOptions) -> Vec<Diagnostic> {
-    diagnostics.sort_by_key(|d| {
-        d.loc
-            .as_ref()
-            .map_or((u32::MAX, u32::MAX), |l| (l.line, l.col))
-    });
+    sort_by_place(&mut diagnostics);
     if opts.strict {
         for d in &mut diagnostics {
+            if let Some(left) = &mut d.left_out {
+                left.errors += std::mem::take(&mut left.warnings);
+            }
             if d.severity == Severity::Warning {
                 d.severity = Severity::Error;
                 if d.help.is_none() {
@@ -210,6 +212,73 @@ pub fn finish_diagnostics(mut diagnostics: Vec<Diagnostic>, opts: &LoadOptions) 
         }
     }
     diagnostics
+}
+
+/// Orders diagnostics by position, file-wide ones last; those at one place keep their order.
+fn sort_by_place(diagnostics: &mut [Diagnostic]) {
+    diagnostics.sort_by_key(|d| {
+        d.loc
+            .as_ref()
+            .map_or((u32::MAX, u32::MAX), |l| (l.line, l.col))
+    });
+}
+
+/// How many diagnostics a list may hold before [`keep_shown`] drops those no one will see.
+const KEEP_AT: usize = 4 * MAX_DIAGNOSTICS;
+
+/// Keeps a list of diagnostics of the file `path` as it grows no longer than what a file's
+/// report shows needs: once it holds `KEEP_AT`, only the first [`MAX_DIAGNOSTICS`] by place
+/// (as [`finish_diagnostics`] orders them) are kept, and one more says how many were left out
+/// ([`not_shown`]). Those shown are the same as if every one had been kept: any dropped has
+/// that many before it. A file with a million bad lines, or a million shapes of one name, so
+/// holds a few hundred diagnostics, not a million.
+pub fn keep_shown(diagnostics: &mut Vec<Diagnostic>, path: &Path) {
+    if diagnostics.len() < KEEP_AT {
+        return;
+    }
+    let mut left = LeftOut::default();
+    diagnostics.retain(|d| {
+        if d.left_out.is_some() {
+            left.add(d);
+        }
+        d.left_out.is_none()
+    });
+    sort_by_place(diagnostics);
+    for d in diagnostics.drain(MAX_DIAGNOSTICS.min(diagnostics.len())..) {
+        left.add(&d);
+    }
+    if !left.is_empty() {
+        diagnostics.push(not_shown(path, left.errors, left.warnings));
+    }
+}
+
+/// The last diagnostic of a file with more problems than are listed: how many `errors` and
+/// `warnings` were left out after the first [`MAX_DIAGNOSTICS`].
+/// An error if any of those is one, so that the count is never mistaken for harmless.
+pub fn not_shown(path: &Path, errors: usize, warnings: usize) -> Diagnostic {
+    let plural = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
+    let kinds: Vec<String> = [(errors, "error"), (warnings, "warning")]
+        .into_iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, what)| plural(n, what))
+        .collect();
+    let severity = if errors > 0 {
+        Severity::Error
+    } else {
+        Severity::Warning
+    };
+    let mut d = Diagnostic::file_error(
+        path,
+        format!(
+            "and {} more ({}) not shown: only the first {} problems of a file are listed",
+            errors + warnings,
+            kinds.join(", "),
+            MAX_DIAGNOSTICS
+        ),
+    )
+    .with_severity(severity);
+    d.left_out = Some(LeftOut { errors, warnings });
+    d
 }
 
 #[cfg(test)]

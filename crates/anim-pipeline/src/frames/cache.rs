@@ -13,7 +13,7 @@
 
 use super::output::Output;
 use anim_core::render::RenderSettings;
-use anim_core::sdf::LoadOptions;
+use anim_core::sdf::{LoadOptions, Reference};
 use anim_core::util::{write_atomically, Fnv64};
 use std::io::{Read as _, Write as _};
 use std::path::{Path, PathBuf};
@@ -42,18 +42,21 @@ pub fn settings_fingerprint(settings: &RenderSettings, load: &LoadOptions) -> St
 /// The hash a frame's record holds: of the settings, the frame's bytes (`sdf`, read from
 /// `path`), the bytes of every file it includes, so that a change to the static part of an
 /// animation renders its frames again, and the size and modification time of every mesh they
-/// name (see [`visit_referenced`]). The preview keys its frames by it too.
-pub fn frame_hash(sdf: &[u8], path: &Path, fingerprint: &str, max_input: u64) -> u64 {
+/// name. The files are found by the loader's own rules (`anim_core::sdf::references`:
+/// confined, never a pipe or a device, never round a cycle, each file once, within
+/// `--max-input`). The preview keys its frames by it too.
+pub fn frame_hash(sdf: &[u8], path: &Path, fingerprint: &str, load: &LoadOptions) -> u64 {
     let mut h = Fnv64::default();
     h.write(fingerprint.as_bytes());
     // A separator that cannot occur in the fingerprint keeps the two parts apart.
     h.write(&[0]);
     h.write(sdf);
-    visit_referenced(sdf, path, max_input, &mut |file, referenced| {
-        h.write_part(file.as_os_str().as_encoded_bytes());
-        match referenced {
-            Referenced::Mesh => {
-                if let Ok(meta) = std::fs::metadata(file) {
+    for reference in anim_core::sdf::references(sdf, path, load) {
+        match reference {
+            Reference::Mesh(file) => {
+                h.write_part(file.as_os_str().as_encoded_bytes());
+                // Metadata only: a mesh is not opened here (a pipe is refused by the loader).
+                if let Ok(meta) = std::fs::metadata(&file) {
                     h.write_part(&meta.len().to_le_bytes());
                     let since_epoch = meta
                         .modified()
@@ -62,77 +65,30 @@ pub fn frame_hash(sdf: &[u8], path: &Path, fingerprint: &str, max_input: u64) ->
                     h.write_part(&since_epoch.map_or(0, |d| d.as_nanos()).to_le_bytes());
                 }
             }
-            Referenced::Included(Some(bytes)) => h.write_part(bytes),
-            Referenced::Included(None) => {}
+            Reference::Included(file, bytes) => {
+                h.write_part(file.as_os_str().as_encoded_bytes());
+                if let Some(bytes) = bytes {
+                    h.write_part(&bytes);
+                }
+            }
         }
-    });
+    }
     h.finish()
 }
 
 /// The files whose edits change the pictures of scene file `path`: those it includes, to any
-/// depth, and the meshes they all name. Files that cannot be read are listed too, so that a
-/// watcher sees them made.
-pub fn referenced_files(path: &Path, max_input: u64) -> Vec<PathBuf> {
-    let Ok(sdf) = anim_core::load::read_input(path, max_input, "file") else {
+/// depth, and the meshes they all name, as [`frame_hash`] finds them. Files that cannot be
+/// read are listed too, so that a watcher sees them made.
+pub fn referenced_files(path: &Path, load: &LoadOptions) -> Vec<PathBuf> {
+    let Ok(sdf) = anim_core::load::read_input(path, load.max_input, "file") else {
         return Vec::new();
     };
-    let mut files = Vec::new();
-    visit_referenced(&sdf, path, max_input, &mut |file, _| {
-        files.push(file.to_path_buf());
-    });
-    files
-}
-
-/// What a scene file refers to, as [`visit_referenced`] meets it.
-enum Referenced<'a> {
-    /// An OBJ file a mesh statement names: never read (a mesh may be hundreds of megabytes,
-    /// which reading for every frame of a run would cost more than rendering some frames, and
-    /// editing it changes its time).
-    Mesh,
-    /// An included file, with its bytes when it can be read (else the frame fails to load and
-    /// is never vouched for).
-    Included(Option<&'a [u8]>),
-}
-
-/// Calls `visit` with what `sdf` (read from `path`) refers to: the OBJ files its mesh
-/// statements name, then each file it includes followed by what that refers to, as many files
-/// deep as the loader follows (deeper, it refuses the frame anyway).
-fn visit_referenced(
-    sdf: &[u8],
-    path: &Path,
-    max_input: u64,
-    visit: &mut dyn FnMut(&Path, Referenced),
-) {
-    visit_to_depth(
-        sdf,
-        path,
-        max_input,
-        anim_core::limits::MAX_INCLUDE_DEPTH,
-        visit,
-    );
-}
-
-fn visit_to_depth(
-    sdf: &[u8],
-    path: &Path,
-    max_input: u64,
-    depth: usize,
-    visit: &mut dyn FnMut(&Path, Referenced),
-) {
-    let text = String::from_utf8_lossy(sdf);
-    for mesh in anim_core::sdf::mesh_files(&text, path) {
-        visit(&mesh, Referenced::Mesh);
-    }
-    let Some(depth) = depth.checked_sub(1) else {
-        return;
-    };
-    for file in anim_core::sdf::included_files(&text, path) {
-        let bytes = anim_core::load::read_input(&file, max_input, "file").ok();
-        visit(&file, Referenced::Included(bytes.as_deref()));
-        if let Some(bytes) = bytes {
-            visit_to_depth(&bytes, &file, max_input, depth, visit);
-        }
-    }
+    anim_core::sdf::references(&sdf, path, load)
+        .into_iter()
+        .map(|reference| match reference {
+            Reference::Mesh(file) | Reference::Included(file, _) => file,
+        })
+        .collect()
 }
 
 /// Removes the records of frames whose `.sdf` file is gone from `frames_dir` (an animation
@@ -295,7 +251,7 @@ mod tests {
                 b"x",
                 Path::new("x.sdf"),
                 &settings_fingerprint(s, l),
-                u64::MAX,
+                &LoadOptions::default(),
             )
         };
         let unchanged = key(&base, &load);
@@ -308,7 +264,7 @@ mod tests {
                 b"y",
                 Path::new("y.sdf"),
                 &settings_fingerprint(&base, &load),
-                u64::MAX
+                &load
             )
         );
     }

@@ -181,14 +181,7 @@ pub fn render_dir(
         shard: options.shard,
         ..Summary::default()
     };
-    let todo = plan_frames(
-        &frames,
-        load.max_input,
-        &fingerprint,
-        &out_dir,
-        options,
-        &mut summary,
-    );
+    let todo = plan_frames(&frames, load, &fingerprint, &out_dir, options, &mut summary);
     observer.planned(todo.len(), summary.skipped.len());
     let outcomes = render_planned(&todo, &out_dir, settings, load, observer);
     observer.end();
@@ -212,7 +205,7 @@ struct Planned {
 /// go into `summary`; the others come back in natural order.
 fn plan_frames(
     frames: &[PathBuf],
-    max_input: u64,
+    load: &LoadOptions,
     fingerprint: &str,
     out_dir: &Path,
     options: &FrameOptions,
@@ -228,14 +221,14 @@ fn plan_frames(
         }
         let name = file_name(path);
         // Read as the loader reads it: a frame larger than `--max-input` is refused unread.
-        let bytes = match read_frame(path, max_input, &name, out_dir, &mut images) {
+        let bytes = match read_frame(path, load.max_input, &name, out_dir, &mut images) {
             Ok(bytes) => bytes,
             Err(diags) => {
                 summary.failed.push((name, diags));
                 continue;
             }
         };
-        let hash = frame_hash(&bytes, path, fingerprint, max_input);
+        let hash = frame_hash(&bytes, path, fingerprint, load);
         if !options.force && is_up_to_date(out_dir, &name, hash) {
             summary.skipped.push(name);
             continue;

@@ -100,6 +100,16 @@ function update(next) {
 function connect() {
   const events = new EventSource("/events");
   events.onmessage = (e) => update(JSON.parse(e.data));
+  // After the first state, only what changed: the frames by index, the notes when they did.
+  events.addEventListener("delta", (e) => {
+    const d = JSON.parse(e.data);
+    if (!state || state.frames.length !== d.n) return;
+    const frames = state.frames.slice();
+    for (const [i, f] of Object.entries(d.changed)) frames[Number(i)] = f;
+    delete d.changed;
+    delete d.n;
+    update(Object.assign({}, state, d, { frames }));
+  });
   events.onerror = () => { $("status").textContent = "connection lost; retrying…"; };
 }
 

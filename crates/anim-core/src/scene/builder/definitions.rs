@@ -297,25 +297,37 @@ impl Builder<'_> {
             &stmt.loc.file
         };
         let file = written_in.parent().unwrap_or(Path::new("")).join(&m.file);
-        let outside = file.canonicalize().is_ok_and(|resolved| {
-            !self.opts.allow_any_input && !crate::input::may_read(&resolved, self.path)
-        });
-        if outside {
-            let message = format!("mesh file `{}` {}", m.file, crate::input::OUTSIDE_ROOTS);
-            self.error(At::Statement(stmt), message, None);
-            return;
-        }
+        let opened = match crate::input::open_named(&file, self.path, self.opts.allow_any_input) {
+            Ok(opened) => opened,
+            Err(refusal) => {
+                use crate::input::{Refusal, OUTSIDE_ROOTS};
+                let why = match refusal {
+                    Refusal::Outside => OUTSIDE_ROOTS.to_string(),
+                    Refusal::Io(e) => format!("cannot be read: {e}"),
+                    Refusal::Changed => "was replaced while it was being opened".to_string(),
+                    Refusal::Folder | Refusal::NotRegular => {
+                        "cannot be read: it is not a regular file".to_string()
+                    }
+                };
+                let message = format!("mesh file `{}` {why}", m.file);
+                self.error(At::Statement(stmt), message, None);
+                return;
+            }
+        };
         let max_input = self.opts.max_input;
-        let loaded = self.opts.meshes.load(&file, max_input, |path| {
-            crate::shape::mesh::load(path, max_input).map(Arc::new)
-        });
+        let loaded = self
+            .opts
+            .meshes
+            .load(opened.file(), opened.real(), max_input, |f| {
+                crate::shape::mesh::load_open(f, &file, max_input).map(Arc::new)
+            });
         match loaded {
             Ok(mesh) => m.set(mesh),
             Err(d) if d.loc.is_none() => {
                 let message = format!("mesh file `{}` {}", m.file, d.message);
                 self.error(At::Statement(stmt), message, None);
             }
-            Err(d) => self.diagnostics.push(*d),
+            Err(d) => self.push(*d),
         }
     }
 

@@ -186,7 +186,7 @@ fn flat_instances(
     let mut names = Names::default();
     instances.reserve_exact(count);
     names.reserve(count, shapes.names_len());
-    let file = shapes.file().map(|f| names.file_id(f));
+    let files: Vec<_> = shapes.files().iter().map(|f| names.file_id(f)).collect();
     let mut k = 0;
     for chunk in shapes.take_chunks() {
         for s in chunk {
@@ -194,7 +194,8 @@ fn flat_instances(
             if state[k - 1] != DRAWABLE {
                 continue;
             }
-            let (Some(material), Some(file)) = (resolved[shapes.material_of(&s)], file) else {
+            let material = resolved[shapes.material_of(&s)];
+            let (Some(material), Some(&file)) = (material, files.get(shapes.file_of(&s))) else {
                 continue;
             };
             let object = names.add_object_in(shapes.name(&s), file, s.line(), s.col());

@@ -121,7 +121,7 @@ impl Builder<'_> {
                     )
                     .with_help("add e.g. `render <camera> image.png 800 600`");
                     w.severity = Severity::Warning;
-                    self.diagnostics.push(w);
+                    self.push(w);
                     RenderJob {
                         scene: self.scene(d, flat, snapshot, lines, &camera),
                         camera,

@@ -125,7 +125,13 @@ impl<'a> Builder<'a> {
         if let Some(h) = help {
             d = d.with_help(h);
         }
+        self.push(d);
+    }
+
+    /// Keeps `d`, and of a flood of diagnostics only those a report shows.
+    fn push(&mut self, d: Diagnostic) {
         self.diagnostics.push(d);
+        crate::sdf::keep_shown(&mut self.diagnostics, self.path);
     }
 
     fn warn(&mut self, at: At, message: String, help: Option<String>) {

@@ -1,12 +1,103 @@
 //! Spellings that other readers of the language take and the statements do not know, turned
 //! into the canonical tokens before a line is read (docs/scene-language.md §1, "Dialects"):
-//! numbers glued by a sign, the German `dreieck`, and template placeholders, which no reading
-//! can give a value.
+//! numbers glued by a sign, a number glued to the next statement's first word, the German
+//! `dreieck`, and template placeholders, which no reading can give a value.
 
 use super::{lenient_number, At, Parser};
 use crate::sdf::lexer::{parse_number, Line, Token};
 
+/// The words a statement starts with: where a number runs into one of them, a C++ stream
+/// reader (`file >> x`) has read the number and goes on with a new statement.
+const STATEMENT_STARTS: [&str; 10] = [
+    "define",
+    "transform",
+    "view",
+    "render",
+    "renderer",
+    "camera",
+    "ambient",
+    "background",
+    "motion",
+    "include",
+];
+
+/// The length of the number that token `t` starts with, when the rest of it is the first
+/// word of a statement (`0.70ambient`).
+fn glued_start(t: &Token) -> Option<usize> {
+    let b = t.text.as_bytes();
+    let could = b
+        .first()
+        .is_some_and(|c| c.is_ascii_digit() || matches!(c, b'.' | b'-' | b'+'))
+        && b.last().is_some_and(u8::is_ascii_lowercase);
+    if !could {
+        return None;
+    }
+    STATEMENT_STARTS.iter().find_map(|word| {
+        let number = t.text.strip_suffix(word)?;
+        (!number.is_empty() && parse_number(number).is_ok()).then_some(number.len())
+    })
+}
+
 impl Parser<'_> {
+    /// The statements of a line on which a number runs into the first word of the next
+    /// statement (`… 0.70ambient 0.2 …`), cut there as a C++ stream reader reads it: the
+    /// number ends one statement and the word starts the next, with a warning the first time.
+    /// `None` when no number does (almost every line: nothing is copied).
+    pub(super) fn split_statements<'t>(&mut self, line: &Line<'t>) -> Option<Vec<Line<'t>>> {
+        let glued = |tokens: &[Token], i: usize| {
+            (i > 0 && !is_name_position(tokens, i))
+                .then(|| glued_start(&tokens[i]))
+                .flatten()
+        };
+        let first = (0..line.tokens.len()).find(|&i| glued(&line.tokens, i).is_some())?;
+        let mut statements = Vec::new();
+        let mut current: Vec<Token<'t>> = Vec::new();
+        for (i, t) in line.tokens.iter().enumerate() {
+            let at = current.len();
+            current.push(*t);
+            let Some(len) = (i >= first).then(|| glued(&current, at)).flatten() else {
+                continue;
+            };
+            current[at] = Token {
+                text: &t.text[..len],
+                col: t.col,
+                width: len as u32,
+            };
+            if i == first {
+                self.variant(
+                    line,
+                    At::Tok(i),
+                    "glued statement",
+                    format!(
+                        "`{}` read as the number `{}` and then a new statement from `{}`, as a C++ stream reader reads it",
+                        t.text,
+                        &t.text[..len],
+                        &t.text[len..]
+                    ),
+                    "a number runs into the next statement's first word; start each statement on a line of its own"
+                        .into(),
+                );
+            }
+            let ended = std::mem::take(&mut current);
+            statements.push(Line {
+                number: line.number,
+                text: line.text,
+                tokens: ended,
+            });
+            current.push(Token {
+                text: &t.text[len..],
+                col: t.col + len as u32,
+                width: t.width - len as u32,
+            });
+        }
+        statements.push(Line {
+            number: line.number,
+            text: line.text,
+            tokens: current,
+        });
+        Some(statements)
+    }
+
     /// The line as the statement readers take it; `None` (with the error reported) when it
     /// cannot be read at all.
     pub(super) fn normalise<'t>(&mut self, line: &Line<'t>) -> Option<Line<'t>> {
@@ -55,32 +146,39 @@ impl Parser<'_> {
         }
         let mut glued = None;
         let mut tokens = Vec::with_capacity(out.tokens.len());
+        // Pieces of glued numbers count against the tokens a line may hold.
+        let mut room = crate::limits::MAX_TOKENS_PER_LINE.saturating_sub(out.tokens.len());
         for (i, t) in out.tokens.iter().enumerate() {
             let between_numbers = |j: Option<usize>| {
                 j.and_then(|j| out.tokens.get(j))
                     .is_some_and(|n| lenient_number(n.text).is_some())
             };
             let in_numbers = between_numbers(i.checked_sub(1)) || between_numbers(Some(i + 1));
-            match split_glued(t) {
-                Some(parts) if in_numbers && !is_name_position(&out.tokens, i) => {
+            let split = (in_numbers && !is_name_position(&out.tokens, i))
+                .then(|| split_glued(t, room + 1))
+                .flatten();
+            match split {
+                Some(parts) => {
+                    room -= parts.len() - 1;
                     if glued.is_none() {
-                        let texts: Vec<&str> = parts.iter().map(|p| p.text).collect();
-                        glued = Some((i, t.text, texts));
+                        let texts: Vec<&str> = parts.iter().take(8).map(|p| p.text).collect();
+                        glued = Some((i, t.text, parts.len(), texts));
                     }
                     tokens.extend(parts);
                 }
-                _ => tokens.push(*t),
+                None => tokens.push(*t),
             }
         }
-        if let Some((i, text, parts)) = glued {
+        if let Some((i, text, count, first)) = glued {
+            let more = if count > first.len() { " …" } else { "" };
             self.variant(
                 line,
                 At::Tok(i),
                 "glued numbers",
                 format!(
-                    "`{text}` read as {} numbers, `{}`, as a C++ stream reader reads it",
-                    parts.len(),
-                    parts.join("` `")
+                    "`{}` read as {count} numbers, `{}`{more}, as a C++ stream reader reads it",
+                    crate::diag::shorten(text),
+                    first.join("` `")
                 ),
                 "numbers run together where a sign starts the next one; put a space between them"
                     .into(),
@@ -157,38 +255,55 @@ fn is_name_position(tokens: &[Token], i: usize) -> bool {
 }
 
 /// `1000-300` as the tokens `1000` and `-300`: a word that is no number but whose pieces,
-/// cut before each sign that does not follow an exponent's `e`, all are. `None` otherwise.
-fn split_glued<'t>(t: &Token<'t>) -> Option<Vec<Token<'t>>> {
+/// cut before each sign that does not follow an exponent's `e`, all are. `None` otherwise,
+/// and when it would make more than `room` tokens (the line's token cap): the pieces are
+/// checked before any is kept, so a word of megabytes that is no run of numbers costs no
+/// memory, and one that is costs at most the cap.
+fn split_glued<'t>(t: &Token<'t>, room: usize) -> Option<Vec<Token<'t>>> {
     let text = t.text;
-    if lenient_number(text).is_some() || !text.is_ascii() {
+    if !text.is_ascii() || lenient_number(text).is_some() {
         return None;
     }
+    let mut count = 0usize;
+    for piece in glued_pieces(text) {
+        count += 1;
+        if count > room || parse_number(&text[piece]).is_err() {
+            return None;
+        }
+    }
+    (count > 1).then(|| {
+        glued_pieces(text)
+            .map(|piece| Token {
+                text: &text[piece.clone()],
+                col: t.col + piece.start as u32,
+                width: piece.len() as u32,
+            })
+            .collect()
+    })
+}
+
+/// The byte ranges of `text` (ASCII) cut before each sign that does not follow an
+/// exponent's `e`.
+fn glued_pieces(text: &str) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
     let bytes = text.as_bytes();
-    let mut cuts: Vec<usize> = (1..bytes.len())
-        .filter(|&j| matches!(bytes[j], b'+' | b'-') && !matches!(bytes[j - 1], b'e' | b'E'))
-        .collect();
-    if cuts.is_empty() {
-        return None;
-    }
-    cuts.insert(0, 0);
-    cuts.push(bytes.len());
-    let parts: Vec<Token<'t>> = cuts
-        .windows(2)
-        .map(|w| Token {
-            text: &text[w[0]..w[1]],
-            col: t.col + w[0] as u32,
-            width: (w[1] - w[0]) as u32,
-        })
-        .collect();
-    parts
-        .iter()
-        .all(|p| parse_number(p.text).is_ok())
-        .then_some(parts)
+    let mut start = 0;
+    std::iter::from_fn(move || {
+        if start >= bytes.len() {
+            return None;
+        }
+        let end = (start + 1..bytes.len())
+            .find(|&j| matches!(bytes[j], b'+' | b'-') && !matches!(bytes[j - 1], b'e' | b'E'))
+            .unwrap_or(bytes.len());
+        let piece = start..end;
+        start = end;
+        Some(piece)
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::Path;
 
     fn token(text: &str) -> Token<'_> {
         Token {
@@ -199,7 +314,8 @@ mod tests {
     }
 
     fn split(text: &str) -> Option<Vec<(String, u32)>> {
-        split_glued(&token(text)).map(|p| p.iter().map(|t| (t.text.to_string(), t.col)).collect())
+        split_glued(&token(text), usize::MAX)
+            .map(|p| p.iter().map(|t| (t.text.to_string(), t.col)).collect())
     }
 
     #[test]
@@ -228,6 +344,29 @@ mod tests {
         ] {
             assert!(!needs(no), "{no}");
         }
+    }
+
+    #[test]
+    fn a_number_runs_into_the_next_statement_only_where_a_statement_word_follows_it() {
+        let text = "define material m 1 0 0 1 0 0 1 0 0 10ambient 0.1 0.1 0.1background 0 0 1\n\
+                    define camera 2camera 60\n\
+                    define material 5define 1 0 0 1 0 0 1 0 0 10\n";
+        let opts = crate::sdf::LoadOptions::default();
+        let (statements, diagnostics) = crate::sdf::parse(text, Path::new("s.sdf"), &opts);
+        let kinds: Vec<String> = statements
+            .iter()
+            .map(|s| format!("{}:{}", s.loc.line, s.loc.col))
+            .collect();
+        // Material, ambient (just after `10`), background (just after the last `0.1`); the
+        // camera and the material named like a glued statement are names, left whole.
+        assert_eq!(
+            kinds,
+            ["1:1", "1:39", "1:58", "2:1", "3:1"],
+            "{diagnostics:?}"
+        );
+        let warned: Vec<&str> = diagnostics.iter().map(|d| d.message.as_str()).collect();
+        assert_eq!(warned.len(), 1, "{warned:?}");
+        assert!(warned[0].starts_with("`10ambient` read as the number `10`"));
     }
 
     #[test]

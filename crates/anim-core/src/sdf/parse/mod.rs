@@ -20,7 +20,7 @@ mod shape;
 mod transform;
 
 pub(super) use include::Chain;
-pub use include::{included_files, mesh_files, IncludeCache};
+pub use include::{mesh_files, references, FileRead, IncludeCache, Reference};
 pub use resolve::default_output;
 
 use super::ast::{FlatShapes, NameRef, Span, Statement, StatementKind, StatementSpans};
@@ -66,6 +66,9 @@ pub struct Parsed {
     /// Whether the file is a frame `anim generate` wrote (`sdf::is_generated_frame`): it was
     /// read, and is built, with every guess turned off.
     pub generated: bool,
+    /// The files the scene includes, to any depth, each once: where their lines are quoted
+    /// from, when still the same.
+    pub included: Vec<FileRead>,
 }
 
 /// What the reader left out of the statements that building must still account for: its
@@ -83,6 +86,9 @@ pub struct Omissions {
     pub cameras_rejected: bool,
     /// Names defined only in commented-out lines → the line (see `commented_definitions`).
     pub commented: HashMap<String, u32>,
+    /// Whether a limit of the reading as a whole stopped it (its includes repeat too much):
+    /// the statements are dropped, and nothing is built from them.
+    pub abandoned: bool,
 }
 
 /// An error has been reported; the statement is dropped.
@@ -178,7 +184,15 @@ pub(super) fn parse(
             ),
         ));
     }
+    crate::sdf::keep_shown(&mut p.diagnostics, path);
+    let included = p.chain.take_included();
+    let abandoned = p.chain.abandoned();
+    if abandoned {
+        p.statements = Vec::new();
+        p.shapes = FlatShapes::default();
+    }
     Parsed {
+        included,
         statements: p.statements,
         shapes: p.shapes,
         diagnostics: p.diagnostics,
@@ -190,6 +204,7 @@ pub(super) fn parse(
                 .into_iter()
                 .map(|(name, line)| (name.to_string(), line))
                 .collect(),
+            abandoned,
         },
         generated,
     }
@@ -475,7 +490,7 @@ impl Parser<'_> {
     // ----- numbers -----------------------------------------------------------------------
 
     fn bad_number(&mut self, line: &Line, i: usize, e: NumberError) -> Fail {
-        let text = line.tokens.get(i).map_or("", |t| t.text).to_string();
+        let text = crate::diag::shorten(line.tokens.get(i).map_or("", |t| t.text)).into_owned();
         let (message, help) = match e {
             NumberError::Malformed => {
                 let help = if text.contains(['O', 'o'])
@@ -557,6 +572,20 @@ impl Parser<'_> {
     // ----- dispatch ----------------------------------------------------------------------
 
     fn line(&mut self, written: &Line) {
+        // Between lines, where no line's problems are being gathered.
+        crate::sdf::keep_shown(&mut self.diagnostics, self.path);
+        match self.split_statements(written) {
+            Some(statements) => {
+                for statement in &statements {
+                    self.statement_line(statement);
+                }
+            }
+            None => self.statement_line(written),
+        }
+    }
+
+    /// One statement's tokens, as written on a line.
+    fn statement_line(&mut self, written: &Line) {
         let normalised;
         let line = if dialect::may_need_normalising(written) {
             match self.normalise(written) {

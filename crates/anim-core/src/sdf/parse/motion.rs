@@ -156,6 +156,7 @@ impl Parser<'_> {
             return;
         }
         let defined = self.defined_names();
+        let included = self.chain.is_included();
         let mut last: HashMap<&str, f64> = HashMap::new();
         // Motion of a thing whose definition was rejected (and reported) goes quietly.
         let mut drop = HashSet::new();
@@ -166,6 +167,11 @@ impl Parser<'_> {
             };
             let name = m.target.name.as_str();
             if !defined.contains(name) {
+                if included {
+                    // The file including this one may define it (as for a transform): it
+                    // checks the motion once this file is spliced in.
+                    continue;
+                }
                 if self.skipped.contains(name) {
                     drop.insert(k);
                 } else {
@@ -197,7 +203,9 @@ impl Parser<'_> {
         let lines: Vec<&str> = lexer::raw_lines(text).collect();
         for (k, message, help) in problems {
             let s = &self.statements[k];
-            let d = located(s, &lines, message);
+            // A line of an included file is quoted from that file, later (load/).
+            let own = *s.loc.file == *self.file;
+            let d = located(s, if own { &lines } else { &[] }, message);
             self.diagnostics.push(match help {
                 Some(h) => d.with_help(h),
                 None => d,
@@ -219,9 +227,13 @@ fn located(s: &Statement, lines: &[&str], message: String) -> Diagnostic {
         col: span.map_or(s.loc.col, |sp| sp.col),
         ..s.loc.clone()
     };
-    let d = Diagnostic::new(Severity::Error, loc, message);
+    let mut d = Diagnostic::new(Severity::Error, loc, message);
+    let width = span.map_or(1, |sp| sp.width);
     match lines.get((s.loc.line as usize).saturating_sub(1)) {
-        Some(text) => d.with_source(*text, span.map_or(1, |sp| sp.width)),
-        None => d,
+        Some(text) => d.with_source(*text, width),
+        None => {
+            d.width = width;
+            d
+        }
     }
 }

@@ -12,7 +12,8 @@ use crate::diag::Diagnostic;
 use crate::util::Fnv64;
 use std::collections::HashMap;
 use std::fmt;
-use std::io::Read;
+use std::fs::File;
+use std::io::{Read, Seek as _};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -35,24 +36,26 @@ pub struct MeshCache {
 }
 
 impl MeshCache {
-    /// The mesh of the OBJ file at `path`: from the cache when a file with the same canonical
-    /// path and the same bytes was loaded before, else read with `load` and kept. A file over
-    /// `max_bytes` is never read here: `load` refuses it.
+    /// The mesh of the open OBJ file `file`, found at the real path `real`: from the cache
+    /// when a file with the same real path and the same bytes was loaded before, else read
+    /// with `load` and kept. A file over `max_bytes` is never read here: `load` refuses it.
+    /// Both read the one open file, so what is kept is what was read.
     pub fn load(
         &self,
-        path: &Path,
+        file: &File,
+        real: &Path,
         max_bytes: u64,
-        load: impl FnOnce(&Path) -> Outcome,
+        load: impl FnOnce(&File) -> Outcome,
     ) -> Outcome {
-        let Some(key) = key_of(path, max_bytes) else {
+        let Some(key) = key_of(file, real, max_bytes) else {
             // Unreadable or refused here: `load` says why, at the statement.
-            return load(path);
+            return load(file);
         };
         let slot = {
             let mut entries = self.entries.lock().unwrap_or_else(|e| e.into_inner());
             entries.entry(key).or_default().clone()
         };
-        slot.get_or_init(|| load(path)).clone()
+        slot.get_or_init(|| load(file)).clone()
     }
 
     /// How many files the cache holds.
@@ -66,16 +69,15 @@ impl MeshCache {
     }
 }
 
-/// The canonical path, length and fingerprint of a regular text file of at most `max_bytes`;
-/// `None` when it cannot be read, is larger, holds a NUL byte, or is not a regular file (opening a pipe waits
-/// for a writer, and its bytes would be consumed).
-fn key_of(path: &Path, max_bytes: u64) -> Option<Key> {
-    let path = path.canonicalize().ok()?;
-    let meta = std::fs::metadata(&path).ok()?;
+/// The key of the open file `file` at `real`: its length and fingerprint, when it is a
+/// regular text file of at most `max_bytes`; `None` when it cannot be read, is larger or
+/// holds a NUL byte.
+fn key_of(mut file: &File, real: &Path, max_bytes: u64) -> Option<Key> {
+    let meta = file.metadata().ok()?;
     if !meta.is_file() || meta.len() > max_bytes {
         return None;
     }
-    let mut file = std::fs::File::open(&path).ok()?;
+    file.rewind().ok()?;
     let mut h = Fnv64::default();
     let mut buf = vec![0u8; 1 << 16];
     let mut len = 0u64;
@@ -92,7 +94,7 @@ fn key_of(path: &Path, max_bytes: u64) -> Option<Key> {
         len += n as u64;
     }
     Some(Key {
-        path,
+        path: real.to_path_buf(),
         len,
         fingerprint: h.finish(),
     })
@@ -122,9 +124,14 @@ mod tests {
 
     /// Loads through `cache`, counting the readings.
     fn load(cache: &MeshCache, path: &Path, reads: &AtomicUsize) -> Outcome {
-        cache.load(path, u64::MAX, |p| {
+        let Ok(file) = File::open(path) else {
             reads.fetch_add(1, Ordering::SeqCst);
-            super::super::load(p, u64::MAX).map(Arc::new)
+            return super::super::load(path, u64::MAX).map(Arc::new);
+        };
+        let real = path.canonicalize().unwrap();
+        cache.load(&file, &real, u64::MAX, |f| {
+            reads.fetch_add(1, Ordering::SeqCst);
+            super::super::load_open(f, path, u64::MAX).map(Arc::new)
         })
     }
 

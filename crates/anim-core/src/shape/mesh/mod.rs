@@ -12,7 +12,7 @@ mod cache;
 mod obj;
 
 pub use cache::MeshCache;
-pub use obj::load;
+pub use obj::{load, load_open};
 
 use super::triangle::RaySpace;
 use super::ShapeHit;

@@ -11,18 +11,36 @@ use crate::diag::{Diagnostic, Loc, Severity};
 use crate::limits::{MAX_MESH_TRIANGLES, MAX_OBJ_LINE_BYTES};
 use glam::Vec3;
 use std::fs::File;
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, BufReader, Read, Seek as _};
 use std::path::Path;
 use std::sync::Arc;
 
-/// Loads the mesh of an OBJ file. A problem on a line points at the OBJ file's own line and
-/// column; a problem with the whole file (it cannot be read, it holds no triangles) has no
-/// location and a message that follows the file's name ("… holds no triangles").
+/// Loads the mesh of the OBJ file at `path`, a file the user names (a scene's meshes are
+/// opened confined, by the scene builder, and read by [`load_open`]). What is not a regular
+/// file (a pipe would wait for a writer, a device could feed a line without end) is refused
+/// unread.
 pub fn load(path: &Path, max_input: u64) -> Result<Mesh, Box<Diagnostic>> {
+    let opened = crate::input::open_named(path, path, true).map_err(|refusal| {
+        let why = match refusal {
+            crate::input::Refusal::Io(e) => e.to_string(),
+            _ => "it is not a regular file".to_string(),
+        };
+        Box::new(Diagnostic::file_error(
+            path,
+            format!("cannot be read: {why}"),
+        ))
+    })?;
+    load_open(opened.file(), path, max_input)
+}
+
+/// Loads the mesh of the open OBJ file `file`, named `path` in messages: every reading of it
+/// (the check, `tobj`, a line quoted again) is of this one open file. A problem on a line
+/// points at the OBJ file's own line and column; a problem with the whole file (it cannot
+/// be read, it holds no triangles) has no location and a message that follows the file's
+/// name ("… holds no triangles").
+pub fn load_open(file: &File, path: &Path, max_input: u64) -> Result<Mesh, Box<Diagnostic>> {
     let cannot = |e: String| Box::new(Diagnostic::file_error(path, format!("cannot be read: {e}")));
-    // A device or pipe could feed a line without end (`/dev/zero`), and opening a pipe waits
-    // for a writer: what is not a regular file is refused before it is opened.
-    let meta = std::fs::metadata(path).map_err(|e| cannot(e.to_string()))?;
+    let meta = file.metadata().map_err(|e| cannot(e.to_string()))?;
     if !meta.is_file() {
         return Err(cannot("it is not a regular file".to_string()));
     }
@@ -30,11 +48,9 @@ pub fn load(path: &Path, max_input: u64) -> Result<Mesh, Box<Diagnostic>> {
         let size = format!("{} bytes", meta.len());
         return Err(Box::new(Diagnostic::too_large(path, &size, max_input)));
     }
-    let open = || -> Result<_, Box<Diagnostic>> {
-        let file = File::open(path).map_err(|e| cannot(e.to_string()))?;
-        Ok(obj_lines(file))
-    };
-    let scan = scan(open()?).map_err(|problem| Box::new(problem.diagnostic(path)))?;
+    let open =
+        || -> Result<_, Box<Diagnostic>> { obj_lines(file).map_err(|e| cannot(e.to_string())) };
+    let scan = scan(open()?).map_err(|problem| Box::new(problem.diagnostic(path, file)))?;
     if scan.triangles == 0 {
         return Err(Box::new(Diagnostic::file_error(
             path,
@@ -210,8 +226,10 @@ fn invalid(message: String) -> std::io::Error {
 }
 
 /// The lines of an OBJ file, as [`ObjLines`] gives them.
-fn obj_lines(file: File) -> ObjLines<BufReader<File>> {
-    ObjLines::new(BufReader::new(file))
+/// The lines of `file` from its start.
+fn obj_lines(mut file: &File) -> std::io::Result<ObjLines<BufReader<&File>>> {
+    file.rewind()?;
+    Ok(ObjLines::new(BufReader::new(file)))
 }
 
 /// A problem found on one line: byte range of the culprit and the message.
@@ -227,8 +245,8 @@ struct Problem {
 }
 
 impl Problem {
-    fn diagnostic(self, path: &Path) -> Diagnostic {
-        let text = self.text.or_else(|| nth_line(path, self.line));
+    fn diagnostic(self, path: &Path, file: &File) -> Diagnostic {
+        let text = self.text.or_else(|| nth_line(file, self.line));
         let text = text.unwrap_or_default();
         let start = self.start.min(text.len());
         let col = text[..start].chars().count() + 1;
@@ -245,9 +263,10 @@ impl Problem {
     }
 }
 
-/// The text of line `n` (from 1), read again for a problem found after the line had passed.
-fn nth_line(path: &Path, n: u64) -> Option<String> {
-    let mut reader = obj_lines(File::open(path).ok()?);
+/// The text of line `n` (from 1) of `file`, read again for a problem found after the line had
+/// passed.
+fn nth_line(file: &File, n: u64) -> Option<String> {
+    let mut reader = obj_lines(file).ok()?;
     let mut buf = Vec::new();
     for _ in 0..n {
         buf.clear();
@@ -282,6 +301,9 @@ struct Scan {
     counts: [u64; 3],
     triangles: usize,
     farthest: [Farthest; 3],
+    /// The first relative index of each kind met before the file defined any of that kind:
+    /// harmless if it never does (`tobj` ignores the kind), else it reaches before the first.
+    early: [Option<Farthest>; 3],
 }
 
 impl Scan {
@@ -334,6 +356,20 @@ fn scan(mut reader: impl BufRead) -> Result<Scan, Problem> {
         };
         scan_line(&mut s, line, line_no)
             .map_err(|(start, end, message)| at(start, end, message))?;
+    }
+    for (kind, early) in s.early.iter().enumerate() {
+        if let Some(early) = early.as_ref().filter(|_| s.counts[kind] > 0) {
+            return Err(Problem {
+                line: early.line,
+                start: early.start,
+                end: early.end,
+                message: format!(
+                    "relative {} index -{} reaches before the first one (0 defined so far)",
+                    KINDS[kind], early.index
+                ),
+                text: None,
+            });
+        }
     }
     for (kind, far) in s.farthest.iter().enumerate() {
         // Every index must name something the file defines: `tobj` ignores indices of kinds
@@ -544,6 +580,14 @@ fn face_vertex(s: &mut Scan, at: usize, word: &str, line_no: u64) -> Result<(), 
             ));
         }
         if index < 0 {
+            if defined == 0 && kind != 0 && s.early[kind].is_none() {
+                s.early[kind] = Some(Farthest {
+                    index: index.unsigned_abs(),
+                    line: line_no,
+                    start: span.0,
+                    end: span.1,
+                });
+            }
             if index.unsigned_abs() > defined && (kind == 0 || defined > 0) {
                 return Err((
                     span.0,
@@ -591,6 +635,23 @@ mod tests {
     fn relative_and_slashed_indices_are_accepted() {
         let s = scan_str("v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0 1\nf -3//1 -2//1 -1//-1\n").unwrap();
         assert_eq!(s.triangles, 1);
+    }
+
+    /// Found by the fuzz harness: a relative normal index before any normal, in a file that
+    /// defines one later, made `tobj` overflow (a panic where overflow is checked).
+    #[test]
+    fn a_relative_index_before_the_first_of_its_kind_is_refused_if_one_comes_later() {
+        let early = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3//-1 -2//-1 -1//-1\n";
+        assert!(
+            scan_str(early).is_ok(),
+            "no normal at all: the index is ignored"
+        );
+        let problem = scan_str(&format!("{early}vn 0 0 1\n")).unwrap_err();
+        assert_eq!((problem.line, problem.start, problem.end), (4, 6, 8));
+        assert_eq!(
+            problem.message,
+            "relative normal index -1 reaches before the first one (0 defined so far)"
+        );
     }
 
     #[test]
