@@ -27,7 +27,7 @@ pub(super) fn render(
         .enumerate()
         .map(|(i, band)| {
             let y0 = i as u32 * BLOCK_H;
-            let mut st = TraceState::default();
+            let mut st = frame.trace_state(false);
             if !render_band(frame, (y0, width), band, &offsets, &mut st) {
                 for (k, out) in band.iter_mut().enumerate() {
                     let (x, y) = (k as u32 % width, y0 + k as u32 / width);
@@ -40,6 +40,60 @@ pub(super) fn render(
         })
         .reduce(RayCounts::default, RayCounts::sum);
     (pixels, counts)
+}
+
+/// A frame of a shot: the pixels of `kept` (the shot's previous frame's, with per pixel the
+/// first later frame that changes what its rays met) where that frame is still to come, the
+/// others traced again, watched; and per pixel that frame anew. `at` is this frame's number
+/// in the shot; without `kept` every pixel is traced.
+pub(super) fn render_again(
+    frame: &Frame,
+    spp: u32,
+    at: u32,
+    kept: Option<(Vec<Vec3>, Vec<u32>)>,
+    on_pixels: &(dyn Fn(u64) + Sync),
+) -> Again {
+    let (w, h) = frame.size;
+    let offsets = sample_offsets(spp);
+    let (mut pixels, mut until) = kept.unwrap_or_else(|| (vec![Vec3::ZERO; w * h], vec![0; w * h]));
+    let (rays, retraced) = pixels
+        .par_chunks_mut(w.max(1))
+        .zip(until.par_chunks_mut(w.max(1)))
+        .enumerate()
+        .map(|(y, (row, until_row))| {
+            let mut st = frame.trace_state(false);
+            let mut retraced = 0;
+            for (x, (out, until)) in row.iter_mut().zip(until_row).enumerate() {
+                if *until > at {
+                    continue;
+                }
+                *out = uniform_pixel(frame, (x as u32, y as u32), &offsets, &mut st);
+                *until = st.scratch.take_footprint();
+                retraced += 1;
+            }
+            st.scratch.counts.primary += (retraced * offsets.len()) as u64;
+            on_pixels(row.len() as u64);
+            (st.scratch.counts, retraced as u64)
+        })
+        .reduce(
+            || (RayCounts::default(), 0),
+            |(a, n), (b, m)| (RayCounts::sum(a, b), n + m),
+        );
+    Again {
+        pixels,
+        until,
+        rays,
+        retraced,
+    }
+}
+
+/// What a frame of a shot traced again ([`render_again`]).
+pub(super) struct Again {
+    pub pixels: Vec<Vec3>,
+    pub until: Vec<u32>,
+    pub rays: RayCounts,
+    /// Pixels traced again.
+    pub retraced: u64,
 }
 
 /// Uniform sampling at `offsets` of the rows `y0..` of the image that `band` holds (whole
