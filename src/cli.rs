@@ -118,6 +118,11 @@ pub struct RenderArgs {
     /// Render only frames i (counting from 0 in natural order) with i mod N = K−1.
     #[arg(long, value_name = "K/N", value_parser = parse_shard)]
     pub shard: Option<Shard>,
+    /// Render every frame of a directory in full. By default, the frames of a shot (in order,
+    /// from a camera that holds still) trace again only the pixels whose rays may meet what
+    /// changed since the frame before; the images are the same either way.
+    #[arg(long)]
+    pub no_incremental: bool,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -425,6 +430,7 @@ impl RenderArgs {
             frames: FrameOptions {
                 force: self.force,
                 shard: self.shard,
+                no_incremental: self.no_incremental,
             },
             quiet: self.quiet,
         }

@@ -31,8 +31,8 @@ pub struct Shot {
     later: Vec<Changed>,
     /// The number of the next frame to render.
     next: u32,
-    /// What the last frame rendered keeps for the next.
-    kept: Option<Kept>,
+    /// What the last frame rendered keeps for the next, with its job and settings.
+    kept: Option<(Kept, RenderJob, RenderSettings)>,
 }
 
 /// One frame of a shot, rendered.
@@ -41,6 +41,9 @@ pub struct ShotFrame {
     pub rendered: Rendered,
     /// Pixels traced again (every pixel of the shot's first frame).
     pub retraced: u64,
+    /// Whether the frame was traced from the frame before (not the shot's first, nor one
+    /// traced in full because it did not follow as told).
+    pub follows: bool,
 }
 
 impl Shot {
@@ -55,7 +58,9 @@ impl Shot {
 
     /// Renders the shot's next frame (`prepared`: its job made ready), tracing again only
     /// what may differ from the frame before. `on_pixels(n)` is called as each band of `n`
-    /// pixels is done.
+    /// pixels is done. A frame that does not change from the one before what the shot was
+    /// told it changes (its file was edited since, say) is traced in full, and so is every
+    /// frame after a failed one.
     pub fn render(
         &mut self,
         prepared: &Prepared,
@@ -63,20 +68,32 @@ impl Shot {
         on_pixels: &(dyn Fn(u64) + Sync),
     ) -> Result<ShotFrame, CameraError> {
         let at = self.next;
+        self.next += 1;
+        let job = prepared.job();
+        let kept = self.kept.take().and_then(|(kept, before, was)| {
+            let told = at.checked_sub(1).and_then(|k| self.later.get(k as usize));
+            let follows = was == *settings
+                && told.is_some()
+                && changes(&before, job, settings).as_ref() == told;
+            follows.then_some(kept)
+        });
+        let follows = kept.is_some();
         let later = self.later.get(at as usize..).unwrap_or(&[]);
         let materials = prepared.scene().materials.len();
         let ahead = Ahead::new(at + 1, later, materials);
         let ahead = (!ahead.is_empty()).then(|| Arc::new(ahead));
-        let kept = self.kept.take();
         let (rendered, (kept, retraced)) =
             trace_frame(prepared, settings, ahead, |frame, sampling| {
                 let (sampled, kept, retraced) =
                     sampler::render_again(frame, sampling, at, kept, on_pixels);
                 (sampled, (kept, retraced))
             })?;
-        self.kept = Some(kept);
-        self.next += 1;
-        Ok(ShotFrame { rendered, retraced })
+        self.kept = Some((kept, job.clone(), settings.clone()));
+        Ok(ShotFrame {
+            rendered,
+            retraced,
+            follows,
+        })
     }
 }
 
