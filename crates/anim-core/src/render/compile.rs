@@ -425,12 +425,13 @@ impl RenderScene {
             ..
         } = scratch;
         let (ray, remaining) = (&shadow.ray, shadow.t_max);
-        if let Some(watch) = watch {
-            watch.segment(ray, remaining);
-        }
         let mut last = last_blockers.get_mut(shadow.light);
         if let Some(b) = last.as_deref().and_then(LastBlocker::guess) {
-            if geometry.hit(b, ray, remaining, moving).is_some() {
+            if let Some(t) = geometry.hit(b, ray, remaining, moving) {
+                // Blocked, whatever lies past the blocker: the ray's footprint ends there.
+                if let Some(watch) = watch {
+                    watch.segment(ray, t);
+                }
                 return 0.0;
             }
         }
@@ -438,7 +439,15 @@ impl RenderScene {
         // (packed primitives four at a time) says so, looking past glass for an opaque
         // blocker, which means no light whatever else the ray crosses.
         let hint = RayHint::Shadow(shadow.light);
-        match self.occlusion_in(ray, remaining, hint, moving) {
+        let seen = self.occlusion_in(ray, remaining, hint, moving);
+        if let Some(watch) = watch {
+            let end = match seen {
+                Occlusion::Blocked(first) => geometry.hit(first, ray, remaining, moving),
+                _ => None,
+            };
+            watch.segment(ray, end.unwrap_or(remaining));
+        }
+        match seen {
             Occlusion::Clear => {
                 if let Some(last) = last {
                     last.clear_run = last.clear_run.saturating_add(1);

@@ -102,8 +102,17 @@ impl Adaptive<'_> {
         };
         // Pass 2, into the pass-2 image (the final one without motion).
         let old2 = passes.refined.clone();
+        // A pixel whose centres around it changed decides its samples again, unless it
+        // decides them as before.
+        let decides_anew = |i: usize| {
+            near(&centred.changed, i)
+                && centred
+                    .before
+                    .as_ref()
+                    .is_none_or(|b| !first.decides_alike(b, i % w, i / w))
+        };
         let dirty2: Vec<bool> = (0..w * h)
-            .map(|i| until[i] <= at || near(&centred.changed, i))
+            .map(|i| until[i] <= at || decides_anew(i))
             .collect();
         let refining = Refining {
             pixels: if motion {

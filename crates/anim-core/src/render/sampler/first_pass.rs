@@ -67,8 +67,7 @@ impl<'f> FirstPass<'f> {
             tones: Vec::new(),
             sweeps: vec![Sweep::default(); if frame.shutter.is_some() { w * h } else { 0 }],
             not_clear: vec![u32::MAX; w * h],
-            known_of_still: frame.shutter.is_some_and(|s| !s.lights_move())
-                && frame.integrator.scene.plan().0.ask_moving,
+            known_of_still: known_of_still(frame),
         };
         let counts = match frame.shutter {
             None => pass.trace_still(),
@@ -86,7 +85,7 @@ impl<'f> FirstPass<'f> {
         frame: &'f Frame<'f>,
         kept: Option<KeptCentres>,
         at: u32,
-    ) -> (FirstPass<'f>, KeptChanges, RayCounts) {
+    ) -> (FirstPass<'f>, KeptChanges<'f>, RayCounts) {
         let (w, h) = frame.size;
         let fresh = kept.is_none();
         let kept = kept.unwrap_or_else(|| KeptCentres::fresh(w * h, frame.shutter.is_some()));
@@ -119,6 +118,14 @@ impl<'f> FirstPass<'f> {
             })
             .collect();
         let mut kept = kept;
+        let before = (!fresh).then(|| FirstPass {
+            frame,
+            centres: kept.centres.clone(),
+            tones: kept.centres.par_iter().map(|(c, _)| tone3(*c)).collect(),
+            sweeps: kept.sweeps.clone(),
+            not_clear: kept.not_clear.clone(),
+            known_of_still: known_of_still(frame),
+        });
         let mut changed = vec![fresh; w * h];
         let mut counts = RayCounts::default();
         let mut retraced = vec![false; w * h];
@@ -146,14 +153,14 @@ impl<'f> FirstPass<'f> {
             tones: Vec::new(),
             sweeps: kept.sweeps,
             not_clear: kept.not_clear,
-            known_of_still: frame.shutter.is_some_and(|s| !s.lights_move())
-                && frame.integrator.scene.plan().0.ask_moving,
+            known_of_still: known_of_still(frame),
         };
         pass.tones = pass.centres.par_iter().map(|(c, _)| tone3(*c)).collect();
         let changes = KeptChanges {
             changed,
             retraced,
             until: kept.until,
+            before,
         };
         (pass, changes, counts)
     }
@@ -301,6 +308,30 @@ impl<'f> FirstPass<'f> {
         }
     }
 
+    /// Whether pixel (x, y) decides its samples from this first pass as from `other` (of the
+    /// same frame's size): whether it is refined and from what contrast, what its samples
+    /// take as known of the lights, and, kept, its centre. Then its pixel is the same,
+    /// whatever changed around it, as long as its own samples' rays meet the same things.
+    pub fn decides_alike(&self, other: &FirstPass, x: usize, y: usize) -> bool {
+        let refinement = |p: &FirstPass| p.refinement(x, y).map(|(c, m)| (c.to_bits(), m));
+        let prior = |p: &FirstPass| {
+            let prior = p.prior(x, y);
+            let near = prior.near.map(|n| {
+                let span = n.seen_from.map(|(_, span)| span.map(f32::to_bits));
+                (n.depth.0.to_bits(), n.depth.1.to_bits(), span)
+            });
+            (prior.known_clear, near)
+        };
+        let centre = |p: &FirstPass| {
+            let (c, surface) = p.centres[y * p.frame.size.0 + x];
+            (c.to_array().map(f32::to_bits), surface)
+        };
+        let (mine, theirs) = (refinement(self), refinement(other));
+        mine == theirs
+            && prior(self) == prior(other)
+            && (mine.is_some() || centre(self) == centre(other))
+    }
+
     /// In a frame with motion whose centres kept their shadow rays' findings for the shapes
     /// that hold still: the range of distances of the hits of the centres around (x, y), and
     /// under a moving camera the span of those centres in the image. A sample whose hit lies
@@ -432,14 +463,23 @@ impl KeptCentres {
     }
 }
 
-/// What [`FirstPass::trace_again`] found, per pixel.
-pub(super) struct KeptChanges {
+/// What [`FirstPass::trace_again`] found, per pixel, and the first pass it started from.
+pub(super) struct KeptChanges<'f> {
     /// Whether the centre is not what it was (every centre, where nothing was kept).
     pub changed: Vec<bool>,
     /// Whether the centre was traced again.
     pub retraced: Vec<bool>,
     /// The first later frame that changes what the centre's rays met.
     pub until: Vec<u32>,
+    /// The first pass of the frame before (`None` where nothing was kept).
+    pub before: Option<FirstPass<'f>>,
+}
+
+/// Whether the centres of `frame` keep their shadow rays' findings as news of the shapes
+/// that hold still, with the depth of their hits (a frame with motion whose lights hold
+/// still and whose moving shapes are few enough to ask at each sample's instant).
+fn known_of_still(frame: &Frame) -> bool {
+    frame.shutter.is_some_and(|s| !s.lights_move()) && frame.integrator.scene.plan().0.ask_moving
 }
 
 /// A centre traced again, to be taken into the first pass.
