@@ -11,6 +11,8 @@
 //! - `bench`: `anim bench` at its tiny size, and the files it writes.
 //! - `animator`: aim, orientation keys, the inclusive end, curves kept in range, materials,
 //!   visibility, reuse, the early check of the base scene, and the example specs' frames.
+//! - `incremental`: frames traced from the frame before, to the byte the frames alone, whatever
+//!   the thread count.
 //! - `service`: the one way from a scene file to images in memory, which `anim render` and
 //!   `anim preview` share, and the files a frame's fingerprint follows.
 
@@ -21,6 +23,7 @@ mod animator;
 mod bench;
 mod frames;
 mod holds;
+mod incremental;
 mod keyframe_spec;
 mod service;
 mod split;
