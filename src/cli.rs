@@ -115,7 +115,8 @@ pub struct RenderArgs {
     /// Render frames even if their input and settings are unchanged since the last run.
     #[arg(long)]
     pub force: bool,
-    /// Render only frames i (counting from 0 in natural order) with i mod N = K−1.
+    /// Render only the K-th of N contiguous runs of frames (in natural order, as even as can
+    /// be): frames i of n (counting from 0) with ⌊i·N/n⌋ = K−1.
     #[arg(long, value_name = "K/N", value_parser = parse_shard)]
     pub shard: Option<Shard>,
     /// Render every frame of a directory in full. By default, the frames of a shot (in order,

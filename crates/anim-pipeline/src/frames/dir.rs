@@ -232,7 +232,7 @@ fn plan_frames(
     let mut first_of_scene: HashMap<u64, usize> = HashMap::new();
     let mut images: HashMap<PathBuf, String> = HashMap::new();
     for (i, path) in frames.iter().enumerate() {
-        if options.shard.is_some_and(|s| !s.contains(i)) {
+        if options.shard.is_some_and(|s| !s.contains(i, frames.len())) {
             continue;
         }
         let name = file_name(path);
