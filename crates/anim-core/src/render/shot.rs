@@ -17,7 +17,7 @@
 
 use super::footprint::{Ahead, Changed};
 use super::geometry::placed_bounds;
-use super::policy::MOVING_BLOCKS_MAX;
+use super::policy::{MOVING_BLOCKS_MAX, RETRACED_SHARE_MAX};
 use super::sampler::{self, Kept};
 use super::shading::max_radiance;
 use super::{rebased, trace_frame, Prepared, RenderSettings, Rendered};
@@ -33,6 +33,9 @@ pub struct Shot {
     next: u32,
     /// What the last frame rendered keeps for the next, with its job and settings.
     kept: Option<(Kept, RenderJob, RenderSettings)>,
+    /// The next frame is rendered as alone: the frame before traced again more than
+    /// `policy::RETRACED_SHARE_MAX` of its pixels.
+    alone_next: bool,
 }
 
 /// One frame of a shot, rendered.
@@ -53,6 +56,7 @@ impl Shot {
             later,
             next: 0,
             kept: None,
+            alone_next: false,
         }
     }
 
@@ -61,6 +65,11 @@ impl Shot {
     /// pixels is done. A frame that does not change from the one before what the shot was
     /// told it changes (its file was edited since, say) is traced in full, and so is every
     /// frame after a failed one.
+    ///
+    /// Where a frame traced again nearly all its pixels, watching its rays cost more than it
+    /// saved, and the next frame is likely to do the same: that one is rendered as alone,
+    /// without watching, and the one after it starts over, watching
+    /// (`policy::RETRACED_SHARE_MAX`).
     pub fn render(
         &mut self,
         prepared: &Prepared,
@@ -69,6 +78,16 @@ impl Shot {
     ) -> Result<ShotFrame, CameraError> {
         let at = self.next;
         self.next += 1;
+        if std::mem::take(&mut self.alone_next) {
+            self.kept = None;
+            let rendered = super::render_prepared(prepared, settings, on_pixels)?;
+            let retraced = rendered.image.pixels.len() as u64;
+            return Ok(ShotFrame {
+                rendered,
+                retraced,
+                follows: false,
+            });
+        }
         let job = prepared.job();
         let kept = self.kept.take().and_then(|(kept, before, was)| {
             let told = at.checked_sub(1).and_then(|k| self.later.get(k as usize));
@@ -89,6 +108,8 @@ impl Shot {
                 (sampled, (kept, retraced))
             })?;
         self.kept = Some((kept, job.clone(), settings.clone()));
+        let pixels = rendered.image.pixels.len() as f64;
+        self.alone_next = follows && retraced as f64 > RETRACED_SHARE_MAX * pixels;
         Ok(ShotFrame {
             rendered,
             retraced,
@@ -333,8 +354,9 @@ mod tests {
     }
 
     /// Renders `jobs` as a shot and alone; each frame's pixels must agree to the bit. Returns
-    /// the pixels each frame of the shot traced again.
-    fn shot_against_alone(jobs: &[RenderJob], settings: &RenderSettings) -> Vec<u64> {
+    /// the pixels each frame of the shot traced again, and whether it was traced from the
+    /// frame before.
+    fn shot_against_alone(jobs: &[RenderJob], settings: &RenderSettings) -> Vec<(u64, bool)> {
         let later: Vec<Changed> = jobs
             .windows(2)
             .map(|w| changes(&w[0], &w[1], settings).expect("a still camera"))
@@ -349,7 +371,7 @@ mod tests {
                 bits(&again.rendered.image) == bits(&alone),
                 "frame {k} differs"
             );
-            retraced.push(again.retraced);
+            retraced.push((again.retraced, again.follows));
         }
         retraced
     }
@@ -372,13 +394,42 @@ mod tests {
                 ..RenderSettings::default()
             },
         ] {
-            let retraced = shot_against_alone(&jobs, &settings);
+            let retraced: Vec<u64> = shot_against_alone(&jobs, &settings)
+                .into_iter()
+                .map(|(n, _)| n)
+                .collect();
             assert_eq!(retraced[0], pixels);
             // The ball moved: some pixels, not all; a frame like the one before: none.
             assert!(retraced[1] > 0 && retraced[1] < pixels / 2, "{retraced:?}");
             assert_eq!(retraced[2], 0, "{retraced:?}");
             assert!(retraced[4] > 0 && retraced[4] < pixels / 2, "{retraced:?}");
         }
+    }
+
+    /// The ambient light changes every frame: every pixel that sees a surface reads it, so a
+    /// frame traced from the one before traces nearly all of them again, and the frame after
+    /// it is rendered as alone; the one after that starts over.
+    #[test]
+    fn a_frame_that_traced_nearly_everything_again_is_followed_by_one_alone() {
+        let jobs: Vec<RenderJob> = (0..6)
+            .map(|k| {
+                let mut job = frame(-1.0, 0.8, 0.1);
+                job.scene.ambient = Vec3::splat(0.2 + 0.02 * k as f32);
+                job
+            })
+            .collect();
+        let frames = shot_against_alone(&jobs, &RenderSettings::default());
+        let follows: Vec<bool> = frames.iter().map(|&(_, f)| f).collect();
+        assert_eq!(
+            follows,
+            [false, true, false, false, true, false],
+            "{frames:?}"
+        );
+        let pixels = 64 * 40;
+        assert!(
+            frames[1].0 as f64 > RETRACED_SHARE_MAX * pixels as f64,
+            "{frames:?}"
+        );
     }
 
     #[test]
