@@ -276,7 +276,7 @@ impl RenderScene {
 
     /// The nearest surface along `ray` with `t < t_max`. Of equally close hits, an unbounded
     /// primitive's wins (the first of them), else the first in the flattened composite tree.
-    #[inline]
+    #[inline(always)]
     pub fn intersect(
         &self,
         ray: &Ray,
@@ -288,6 +288,24 @@ impl RenderScene {
             RayHint::Camera => self.view.camera(ray),
             _ => Candidates::All,
         };
+        if scratch.watch.is_some() {
+            return self.intersect_watched(ray, t_max, candidates, scratch);
+        }
+        self.geometry
+            .closest(ray, t_max, candidates, &mut scratch.moving)
+    }
+
+    /// [`RenderScene::intersect`] with a watch, which sees what the ray met. Out of line
+    /// and cold, so that the query without a watch stays what it was.
+    #[cold]
+    #[inline(never)]
+    fn intersect_watched(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        candidates: Candidates,
+        scratch: &mut Scratch,
+    ) -> Option<(PrimId, SurfaceHit)> {
         let hit = self
             .geometry
             .closest(ray, t_max, candidates, &mut scratch.moving);
@@ -387,6 +405,26 @@ impl RenderScene {
         seen
     }
 
+    /// A shadow ray whose any-hit query found `seen`, held against `watch`: up to its
+    /// blocker where an opaque one stops it (whatever lies past cannot change it), else to
+    /// its light. Out of line, as [`RenderScene::watch_closest`].
+    #[cold]
+    #[inline(never)]
+    fn watch_shadow(
+        &self,
+        watch: &mut Watch,
+        shadow: &ShadowRay,
+        seen: Occlusion,
+        moving: &mut MovingScratch,
+    ) {
+        let (ray, remaining) = (&shadow.ray, shadow.t_max);
+        let end = match seen {
+            Occlusion::Blocked(first) => self.geometry.hit(first, ray, remaining, moving),
+            _ => None,
+        };
+        watch.segment(ray, end.unwrap_or(remaining));
+    }
+
     /// Whether primitive `i`, which a shadow ray meets, ends the search: an opaque one does
     /// (`seen` becomes `Blocked`); a transparent one adds to what `seen` says, and the search
     /// goes on.
@@ -417,6 +455,28 @@ impl RenderScene {
     /// means no light whatever else the ray crosses, so the answer is the same as without it.
     #[inline]
     pub fn transmittance(&self, shadow: &ShadowRay, scratch: &mut Scratch) -> f32 {
+        if scratch.watch.is_some() {
+            return self.transmittance_watched(shadow, scratch);
+        }
+        self.transmittance_in::<false>(shadow, scratch)
+    }
+
+    /// [`RenderScene::transmittance`] with a watch: out of line and cold, as
+    /// [`RenderScene::intersect_watched`].
+    #[cold]
+    #[inline(never)]
+    fn transmittance_watched(&self, shadow: &ShadowRay, scratch: &mut Scratch) -> f32 {
+        self.transmittance_in::<true>(shadow, scratch)
+    }
+
+    /// [`RenderScene::transmittance`], the ray held against the scratch's watch if `WATCH`
+    /// (which compiles the watch out of the query without one).
+    #[inline(always)]
+    fn transmittance_in<const WATCH: bool>(
+        &self,
+        shadow: &ShadowRay,
+        scratch: &mut Scratch,
+    ) -> f32 {
         let geometry = &self.geometry;
         let Scratch {
             last_blockers,
@@ -429,7 +489,7 @@ impl RenderScene {
         if let Some(b) = last.as_deref().and_then(LastBlocker::guess) {
             if let Some(t) = geometry.hit(b, ray, remaining, moving) {
                 // Blocked, whatever lies past the blocker: the ray's footprint ends there.
-                if let Some(watch) = watch {
+                if let Some(watch) = watch.as_mut().filter(|_| WATCH) {
                     watch.segment(ray, t);
                 }
                 return 0.0;
@@ -440,12 +500,8 @@ impl RenderScene {
         // blocker, which means no light whatever else the ray crosses.
         let hint = RayHint::Shadow(shadow.light);
         let seen = self.occlusion_in(ray, remaining, hint, moving);
-        if let Some(watch) = watch {
-            let end = match seen {
-                Occlusion::Blocked(first) => geometry.hit(first, ray, remaining, moving),
-                _ => None,
-            };
-            watch.segment(ray, end.unwrap_or(remaining));
+        if let Some(watch) = watch.as_mut().filter(|_| WATCH) {
+            self.watch_shadow(watch, shadow, seen, moving);
         }
         match seen {
             Occlusion::Clear => {

@@ -205,14 +205,19 @@ impl Watch {
     }
 
     /// A ray from its origin to `t_end` (infinite: it goes on past everything).
-    #[inline]
+    ///
+    /// The watch's methods are out of line and cold: a render without a watch only checks
+    /// that there is none, and the facade's queries stay as small as they were.
+    #[cold]
+    #[inline(never)]
     pub fn segment(&mut self, ray: &Ray, t_end: f32) {
         self.until = self.ahead.first_met(ray, t_end, self.until);
     }
 
     /// A ray that hit a surface of material `material` `t` along it: its segment, and what
     /// shading the surface reads.
-    #[inline]
+    #[cold]
+    #[inline(never)]
     pub fn hit(&mut self, ray: &Ray, t: f32, material: u32) {
         self.segment(ray, t);
         let ahead = &self.ahead;
@@ -221,7 +226,8 @@ impl Watch {
     }
 
     /// A ray that met nothing: it sees the background.
-    #[inline]
+    #[cold]
+    #[inline(never)]
     pub fn missed(&mut self, ray: &Ray) {
         self.segment(ray, f32::INFINITY);
         self.until = self.until.min(self.ahead.background);

@@ -148,6 +148,7 @@ fn render_band(
 /// Pixel (`x`, `y`) ray by ray: the mean of its samples at `offsets` (in a frame with
 /// motion, at the instants `uniform_time` gives them), added in that order, as the camera
 /// packets add theirs. Does not count the camera rays.
+#[inline(always)]
 pub(super) fn uniform_pixel(
     frame: &Frame,
     (x, y): (u32, u32),
