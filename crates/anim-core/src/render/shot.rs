@@ -33,9 +33,10 @@ pub struct Shot {
     next: u32,
     /// What the last frame rendered keeps for the next, with its job and settings.
     kept: Option<(Kept, RenderJob, RenderSettings)>,
-    /// The next frame is rendered as alone: the frame before traced again more than
-    /// `policy::RETRACED_SHARE_MAX` of its pixels.
-    alone_next: bool,
+    /// How many of the next frames are rendered as alone, and how many the next time a
+    /// frame traces again more than `policy::RETRACED_SHARE_MAX` of its pixels (doubling
+    /// while frames do, one again when a frame does not).
+    alone: (u32, u32),
 }
 
 /// One frame of a shot, rendered.
@@ -56,7 +57,7 @@ impl Shot {
             later,
             next: 0,
             kept: None,
-            alone_next: false,
+            alone: (0, 1),
         }
     }
 
@@ -67,9 +68,12 @@ impl Shot {
     /// frame after a failed one.
     ///
     /// Where a frame traced again nearly all its pixels, watching its rays cost more than it
-    /// saved, and the next frame is likely to do the same: that one is rendered as alone,
-    /// without watching, and the one after it starts over, watching
-    /// (`policy::RETRACED_SHARE_MAX`).
+    /// saved, and the next frames are likely to do the same: they are rendered as alone,
+    /// without watching, and the one after them starts over, watching
+    /// (`policy::RETRACED_SHARE_MAX`). One frame the first time, twice as many each time
+    /// the frame that starts over does the same again: a shot whose every frame changes
+    /// nearly everything pays for watching a few frames only, one that changed much for a
+    /// moment soon traces only what changed again.
     pub fn render(
         &mut self,
         prepared: &Prepared,
@@ -78,7 +82,8 @@ impl Shot {
     ) -> Result<ShotFrame, CameraError> {
         let at = self.next;
         self.next += 1;
-        if std::mem::take(&mut self.alone_next) {
+        if self.alone.0 > 0 {
+            self.alone.0 -= 1;
             self.kept = None;
             let rendered = super::render_prepared(prepared, settings, on_pixels)?;
             let retraced = rendered.image.pixels.len() as u64;
@@ -109,7 +114,13 @@ impl Shot {
             })?;
         self.kept = Some((kept, job.clone(), settings.clone()));
         let pixels = rendered.image.pixels.len() as f64;
-        self.alone_next = follows && retraced as f64 > RETRACED_SHARE_MAX * pixels;
+        if follows {
+            self.alone = if retraced as f64 > RETRACED_SHARE_MAX * pixels {
+                (self.alone.1, self.alone.1.saturating_mul(2))
+            } else {
+                (0, 1)
+            };
+        }
         Ok(ShotFrame {
             rendered,
             retraced,
@@ -408,10 +419,11 @@ mod tests {
 
     /// The ambient light changes every frame: every pixel that sees a surface reads it, so a
     /// frame traced from the one before traces nearly all of them again, and the frame after
-    /// it is rendered as alone; the one after that starts over.
+    /// it is rendered as alone; the one after that starts over, and when it does the same,
+    /// two frames are rendered alone.
     #[test]
-    fn a_frame_that_traced_nearly_everything_again_is_followed_by_one_alone() {
-        let jobs: Vec<RenderJob> = (0..6)
+    fn frames_that_trace_nearly_everything_again_are_followed_by_frames_alone() {
+        let jobs: Vec<RenderJob> = (0..9)
             .map(|k| {
                 let mut job = frame(-1.0, 0.8, 0.1);
                 job.scene.ambient = Vec3::splat(0.2 + 0.02 * k as f32);
@@ -420,11 +432,8 @@ mod tests {
             .collect();
         let frames = shot_against_alone(&jobs, &RenderSettings::default());
         let follows: Vec<bool> = frames.iter().map(|&(_, f)| f).collect();
-        assert_eq!(
-            follows,
-            [false, true, false, false, true, false],
-            "{frames:?}"
-        );
+        let expected = [false, true, false, false, true, false, false, false, true];
+        assert_eq!(follows, expected, "{frames:?}");
         let pixels = 64 * 40;
         assert!(
             frames[1].0 as f64 > RETRACED_SHARE_MAX * pixels as f64,
