@@ -147,9 +147,10 @@ for k in 1 2 3; do
   log=$tmp/out/first-$k.out
   grep -o 'rendered frame_[0-9]*\.sdf' "$log" | sed 's/^rendered //' >"$tmp/task-$k.txt" || true
   cat "$tmp/task-$k.txt" >>"$all"
-  # Task k must have rendered exactly the frames i with i mod 3 = k-1.
+  # Task k must have rendered exactly the k-th of 3 contiguous runs: frames i of n with
+  # floor(i*3/n) = k-1.
   expected=$(find "$frames" -maxdepth 1 -name 'frame_*.sdf' -printf '%f\n' | sort |
-    awk -v k="$k" '(NR - 1) % 3 == k - 1')
+    awk -v k="$k" -v n="$total" 'int((NR - 1) * 3 / n) == k - 1')
   if [ "$(sort "$tmp/task-$k.txt")" != "$expected" ]; then
     echo "error: task $k did not render exactly its shard" >&2
     failed=1

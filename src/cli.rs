@@ -130,7 +130,8 @@ pub struct RenderArgs {
     /// Render frames even if their input and settings are unchanged since the last run.
     #[arg(long)]
     pub force: bool,
-    /// Render only frames i (counting from 0 in natural order) with i mod N = K−1.
+    /// Render only the K-th of N contiguous runs of frames (in natural order, as even as can
+    /// be): frames i of n (counting from 0) with ⌊i·N/n⌋ = K−1.
     #[arg(long, value_name = "K/N", value_parser = parse_shard)]
     pub shard: Option<Shard>,
     /// Render only frames A to B of a directory, both included, counting from 0 in natural
@@ -138,6 +139,11 @@ pub struct RenderArgs {
     /// end), `..19`, or one frame `12`.
     #[arg(long, value_name = "A..B", value_parser = parse_frame_range)]
     pub frames: Option<(usize, usize)>,
+    /// Render every frame of a directory in full. By default, the frames of a shot (in order,
+    /// from a camera that holds still) trace again only the pixels whose rays may meet what
+    /// changed since the frame before; the images are the same either way.
+    #[arg(long)]
+    pub no_incremental: bool,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -487,6 +493,7 @@ impl RenderArgs {
                 force: self.force,
                 shard: self.shard,
                 range: self.frames,
+                no_incremental: self.no_incremental,
             },
             quiet: self.quiet,
         }

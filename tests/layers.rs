@@ -53,19 +53,28 @@ const CRATES: &[(&str, &[&[&str]])] = &[
 ];
 
 /// The render core (`crates/anim-core/src/render`), top to bottom: a file may import only
-/// modules of lower groups (or files of its own module). `mod` is the entry
-/// (`render/mod.rs`); then the samplers; the exposure (`motion`) and the integrator; the
+/// modules of lower groups (or files of its own module). `shot` renders the frames of a shot
+/// through the entry, `mod` (`render/mod.rs`); then the samplers; the exposure (`motion`) and the integrator; the
 /// facade (`compile`); the view and the geometry it asks (the view's lookups are built
 /// over the geometry's bounds, so it sits above it); the policy and the leaves every layer
 /// may read.
 const RENDER_ORDER: &[&[&str]] = &[
+    &["shot"],
     &["mod"],
     &["sampler"],
     &["motion", "integrator"],
     &["compile"],
     &["view"],
     &["geometry"],
-    &["policy", "shading", "camera", "film", "settings", "counts"],
+    &[
+        "policy",
+        "shading",
+        "camera",
+        "film",
+        "settings",
+        "counts",
+        "footprint",
+    ],
 ];
 
 /// The render modules that ask the compiled scene only through its facade: they name

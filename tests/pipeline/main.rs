@@ -22,6 +22,8 @@
 //! - `rigs`: paths at constant speed, `orient: AlongPath`, parents.
 //! - `tangents`: a key's `in` and `out` sides, and the clamped spline `Auto`.
 //! - `shots`: the example shots of round two (candle, rig, flythrough) do what they show.
+//! - `incremental`: frames traced from the frame before, to the byte the frames alone, whatever
+//!   the thread count.
 //! - `service`: the one way from a scene file to images in memory, which `anim render` and
 //!   `anim preview` share, and the files a frame's fingerprint follows.
 
@@ -35,6 +37,7 @@ mod expressions;
 mod frames;
 mod generated_frames;
 mod holds;
+mod incremental;
 mod keyframe_spec;
 mod layering;
 mod rigs;

@@ -14,6 +14,7 @@
 //! are re-exported here.
 
 use super::counts::RayCounts;
+use super::footprint::{Ahead, Watch, NEVER};
 use super::geometry::{Aggregate, Candidates, Dropped, MovingScratch};
 use super::policy::{GeometryPlan, ViewPlan};
 use super::shading::{ShadeMaterial, Shading};
@@ -101,12 +102,15 @@ impl LastBlocker {
 /// its ray counts, per light the opaque primitive that last blocked a shadow ray (tried
 /// first by the next, [`RenderScene::transmittance`]), and what the geometry keeps between
 /// rays (the moving shapes placed at the current instant). The caches only save work, never
-/// change a value, so images do not depend on which worker traced which pixel.
+/// change a value, so images do not depend on which worker traced which pixel. In a frame
+/// of a shot it also holds the watch over the footprint of the pixel being traced
+/// (`super::footprint`); a render without one asks nothing more.
 pub struct Scratch {
     /// Rays traced so far, counted by whoever asks them.
     pub counts: RayCounts,
     last_blockers: [LastBlocker; CACHED_LIGHTS],
     moving: MovingScratch,
+    watch: Option<Watch>,
 }
 
 impl Default for Scratch {
@@ -115,11 +119,35 @@ impl Default for Scratch {
             counts: RayCounts::default(),
             last_blockers: [LastBlocker::NONE; CACHED_LIGHTS],
             moving: MovingScratch::default(),
+            watch: None,
         }
     }
 }
 
 impl Scratch {
+    /// A scratch whose queries watch every ray against what `ahead` says the later frames
+    /// of the shot change ([`Scratch::take_footprint`]).
+    pub fn watching(ahead: Option<Arc<Ahead>>) -> Scratch {
+        Scratch {
+            watch: ahead.map(Watch::new),
+            ..Scratch::default()
+        }
+    }
+
+    /// Whether the queries watch their rays.
+    #[inline]
+    pub fn is_watching(&self) -> bool {
+        self.watch.is_some()
+    }
+
+    /// The first later frame of the shot that changes what the rays asked since the last
+    /// call met ([`super::footprint::NEVER`] for none, and without a watch); the next rays
+    /// start afresh.
+    #[inline]
+    pub fn take_footprint(&mut self) -> u32 {
+        self.watch.as_mut().map_or(NEVER, Watch::take)
+    }
+
     /// Starts measuring the largest angle, as the eye sees it, swept by the moving shapes
     /// the queries given this scratch may meet ([`Scratch::take_sweep`]).
     #[inline]
@@ -222,6 +250,18 @@ impl RenderScene {
         &self.shading.materials[self.geometry.material_of(prim) as usize]
     }
 
+    /// A number naming the surface of primitive `prim` (a hit's) in this scene and in every
+    /// scene that differs from it only elsewhere, as the frames of a shot do: adaptive
+    /// sampling compares the surfaces of neighbouring pixels by it, some of them traced in
+    /// an earlier frame. [`NO_HIT`] stays itself.
+    #[inline]
+    pub fn surface_key(&self, prim: PrimId) -> u32 {
+        if prim == NO_HIT {
+            return NO_HIT;
+        }
+        self.geometry.surface_key(prim)
+    }
+
     /// The compiled primitive table itself, for tools and tests that look at it rather than
     /// ask rays (the blank-image probe, `tests/geometry`, the bench's re-hit count). The
     /// renderer's integrator and samplers never do.
@@ -236,7 +276,7 @@ impl RenderScene {
 
     /// The nearest surface along `ray` with `t < t_max`. Of equally close hits, an unbounded
     /// primitive's wins (the first of them), else the first in the flattened composite tree.
-    #[inline]
+    #[inline(always)]
     pub fn intersect(
         &self,
         ray: &Ray,
@@ -248,8 +288,35 @@ impl RenderScene {
             RayHint::Camera => self.view.camera(ray),
             _ => Candidates::All,
         };
+        if scratch.watch.is_some() {
+            return self.intersect_watched(ray, t_max, candidates, scratch);
+        }
         self.geometry
             .closest(ray, t_max, candidates, &mut scratch.moving)
+    }
+
+    /// [`RenderScene::intersect`] with a watch, which sees what the ray met. Out of line
+    /// and cold, so that the query without a watch stays what it was.
+    #[cold]
+    #[inline(never)]
+    fn intersect_watched(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        candidates: Candidates,
+        scratch: &mut Scratch,
+    ) -> Option<(PrimId, SurfaceHit)> {
+        let hit = self
+            .geometry
+            .closest(ray, t_max, candidates, &mut scratch.moving);
+        if let Some(watch) = &mut scratch.watch {
+            match &hit {
+                Some((prim, h)) => watch.hit(ray, h.t, self.geometry.material_of(*prim)),
+                None if t_max == f32::INFINITY => watch.missed(ray),
+                None => watch.segment(ray, t_max),
+            }
+        }
+        hit
     }
 
     /// The hit of primitive `prim` alone along `ray` with `0 < t < t_max` (a shape of an
@@ -261,19 +328,28 @@ impl RenderScene {
         t_max: f32,
         scratch: &mut Scratch,
     ) -> Option<SurfaceHit> {
+        if let Some(watch) = &mut scratch.watch {
+            watch.segment(ray, t_max);
+        }
         self.geometry
             .intersect(prim, ray, t_max, &mut scratch.moving)
     }
 
     /// [`RenderScene::intersect`] of each of a packet of camera rays without limit, which
     /// lie on the image within the rectangle that the first and the last span (a block of
-    /// pixels, or a run of a row).
+    /// pixels, or a run of a row). A watching scratch sees them one by one (what they met
+    /// is taken for the packet as a whole).
     pub fn intersect_camera_packet<const N: usize>(
         &self,
         rays: &[Ray; N],
         scratch: &mut Scratch,
     ) -> [Option<(PrimId, SurfaceHit)>; N] {
         let geometry = &self.geometry;
+        if scratch.watch.is_some() {
+            return std::array::from_fn(|r| {
+                self.intersect(&rays[r], f32::INFINITY, RayHint::Camera, scratch)
+            });
+        }
         let Some(tiles) = self.view.eye_tiles() else {
             return geometry.closest_packet(rays, f32::INFINITY, &mut scratch.moving);
         };
@@ -304,6 +380,9 @@ impl RenderScene {
         hint: RayHint,
         scratch: &mut Scratch,
     ) -> Occlusion {
+        if let Some(watch) = &mut scratch.watch {
+            watch.segment(ray, t_max);
+        }
         self.occlusion_in(ray, t_max, hint, &mut scratch.moving)
     }
 
@@ -324,6 +403,26 @@ impl RenderScene {
         let stop = |i| self.stops_shadow(i, &mut seen);
         self.geometry.any(ray, t_max, candidates, scratch, stop);
         seen
+    }
+
+    /// A shadow ray whose any-hit query found `seen`, held against `watch`: up to its
+    /// blocker where an opaque one stops it (whatever lies past cannot change it), else to
+    /// its light. Out of line, as [`RenderScene::watch_closest`].
+    #[cold]
+    #[inline(never)]
+    fn watch_shadow(
+        &self,
+        watch: &mut Watch,
+        shadow: &ShadowRay,
+        seen: Occlusion,
+        moving: &mut MovingScratch,
+    ) {
+        let (ray, remaining) = (&shadow.ray, shadow.t_max);
+        let end = match seen {
+            Occlusion::Blocked(first) => self.geometry.hit(first, ray, remaining, moving),
+            _ => None,
+        };
+        watch.segment(ray, end.unwrap_or(remaining));
     }
 
     /// Whether primitive `i`, which a shadow ray meets, ends the search: an opaque one does
@@ -356,16 +455,43 @@ impl RenderScene {
     /// means no light whatever else the ray crosses, so the answer is the same as without it.
     #[inline]
     pub fn transmittance(&self, shadow: &ShadowRay, scratch: &mut Scratch) -> f32 {
+        if scratch.watch.is_some() {
+            return self.transmittance_watched(shadow, scratch);
+        }
+        self.transmittance_in::<false>(shadow, scratch)
+    }
+
+    /// [`RenderScene::transmittance`] with a watch: out of line and cold, as
+    /// [`RenderScene::intersect_watched`].
+    #[cold]
+    #[inline(never)]
+    fn transmittance_watched(&self, shadow: &ShadowRay, scratch: &mut Scratch) -> f32 {
+        self.transmittance_in::<true>(shadow, scratch)
+    }
+
+    /// [`RenderScene::transmittance`], the ray held against the scratch's watch if `WATCH`
+    /// (which compiles the watch out of the query without one).
+    #[inline(always)]
+    fn transmittance_in<const WATCH: bool>(
+        &self,
+        shadow: &ShadowRay,
+        scratch: &mut Scratch,
+    ) -> f32 {
         let geometry = &self.geometry;
         let Scratch {
             last_blockers,
             moving,
+            watch,
             ..
         } = scratch;
         let (ray, remaining) = (&shadow.ray, shadow.t_max);
         let mut last = last_blockers.get_mut(shadow.light);
         if let Some(b) = last.as_deref().and_then(LastBlocker::guess) {
-            if geometry.hit(b, ray, remaining, moving).is_some() {
+            if let Some(t) = geometry.hit(b, ray, remaining, moving) {
+                // Blocked, whatever lies past the blocker: the ray's footprint ends there.
+                if let Some(watch) = watch.as_mut().filter(|_| WATCH) {
+                    watch.segment(ray, t);
+                }
                 return 0.0;
             }
         }
@@ -373,7 +499,11 @@ impl RenderScene {
         // (packed primitives four at a time) says so, looking past glass for an opaque
         // blocker, which means no light whatever else the ray crosses.
         let hint = RayHint::Shadow(shadow.light);
-        match self.occlusion_in(ray, remaining, hint, moving) {
+        let seen = self.occlusion_in(ray, remaining, hint, moving);
+        if let Some(watch) = watch.as_mut().filter(|_| WATCH) {
+            self.watch_shadow(watch, shadow, seen, moving);
+        }
+        match seen {
             Occlusion::Clear => {
                 if let Some(last) = last {
                     last.clear_run = last.clear_run.saturating_add(1);
@@ -456,6 +586,9 @@ impl RenderScene {
     ) -> MovingShadow {
         let from = self.geometry.moving_entry(leaving);
         let (ray, t_max) = (&shadow.ray, shadow.t_max);
+        if let Some(watch) = &mut scratch.watch {
+            watch.segment(ray, t_max);
+        }
         self.geometry
             .moving_blocks(ray, t_max, from, &mut scratch.moving)
     }

@@ -22,6 +22,7 @@ pub mod camera;
 pub mod compile;
 mod counts;
 pub mod film;
+pub mod footprint;
 pub mod geometry;
 pub mod integrator;
 pub mod motion;
@@ -29,6 +30,7 @@ pub mod policy;
 pub mod sampler;
 mod settings;
 pub mod shading;
+pub mod shot;
 pub mod view;
 
 pub use counts::RayCounts;
@@ -90,20 +92,7 @@ pub struct Prepared<'j> {
 impl<'j> Prepared<'j> {
     /// Moves `job` camera-relative and builds its geometry.
     pub fn new(job: &'j RenderJob) -> Prepared<'j> {
-        let rebased = (job.camera.eye != DVec3::ZERO).then(|| {
-            let eye = job.camera.eye;
-            // The instances are shared, not copied: only the table of transforms is.
-            let mut scene = job.scene.clone();
-            scene.transform_all(&Transform::translate(-eye));
-            for light in &mut scene.lights {
-                light.position -= eye;
-            }
-            let camera = Camera {
-                eye: DVec3::ZERO,
-                ..job.camera.clone()
-            };
-            (scene, camera)
-        });
+        let rebased = rebased(job);
         let scene = rebased.as_ref().map_or(&job.scene, |(s, _)| s);
         let (geometry, dropped) = Aggregate::build(scene);
         Prepared {
@@ -135,6 +124,25 @@ impl<'j> Prepared<'j> {
     }
 }
 
+/// `job`'s scene and camera moved (in f64) so that the eye sits at the origin, or `None` when
+/// it does already.
+fn rebased(job: &RenderJob) -> Option<(Scene, Camera)> {
+    (job.camera.eye != DVec3::ZERO).then(|| {
+        let eye = job.camera.eye;
+        // The instances are shared, not copied: only the table of transforms is.
+        let mut scene = job.scene.clone();
+        scene.transform_all(&Transform::translate(-eye));
+        for light in &mut scene.lights {
+            light.position -= eye;
+        }
+        let camera = Camera {
+            eye: DVec3::ZERO,
+            ..job.camera.clone()
+        };
+        (scene, camera)
+    })
+}
+
 /// Renders one job to an HDR image. `on_pixels(n)` is called as each band of `n` pixels
 /// finishes.
 pub fn render_job(
@@ -151,6 +159,20 @@ pub fn render_prepared(
     settings: &RenderSettings,
     on_pixels: &(dyn Fn(u64) + Sync),
 ) -> Result<Rendered, CameraError> {
+    let (rendered, ()) = trace_frame(prepared, settings, None, |frame, sampling| {
+        (sampler::render(frame, sampling, on_pixels), ())
+    })?;
+    Ok(rendered)
+}
+
+/// The frame of `prepared` as `sample` samples it (with what else it returns), its rays
+/// watched against `ahead` in a frame of a shot.
+fn trace_frame<T>(
+    prepared: &Prepared,
+    settings: &RenderSettings,
+    ahead: Option<Arc<footprint::Ahead>>,
+    sample: impl FnOnce(&sampler::Frame, Sampling) -> (sampler::Sampled, T),
+) -> Result<(Rendered, T), CameraError> {
     let job = prepared.job();
     let (width, height, _) = settings.resolve(job);
     let (scene, camera) = (prepared.scene(), prepared.camera());
@@ -176,10 +198,11 @@ pub fn render_prepared(
         shutter: shutter.as_ref(),
         integrator: &integrator,
         size: (width as usize, height as usize),
+        ahead,
     };
-    let sampled = sampler::render(&frame, sampling, on_pixels);
+    let (sampled, extra) = sample(&frame, sampling);
     let counts = sampled.rays;
-    Ok(Rendered {
+    let rendered = Rendered {
         image: HdrImage {
             width,
             height,
@@ -190,7 +213,8 @@ pub fn render_prepared(
         rays: counts,
         dropped: prepared.dropped.clone(),
         error_estimates: sampled.error_estimates,
-    })
+    };
+    Ok((rendered, extra))
 }
 
 #[cfg(test)]

@@ -27,6 +27,13 @@ pub const PACKET_MIN_NODES: usize = 16;
 /// fully are taken as seen past what holds still.
 pub const MOVING_BLOCKS_MAX: usize = 16;
 
+/// Largest share of its pixels a frame of a shot may trace again for the next frame to be
+/// traced from it too (`super::shot::Shot::render`): above it, the next is rendered as alone.
+/// Where every pixel is traced again, watching the rays costs more than rendering the frame
+/// alone, and the frames of a shot pay one plain cost per frame plus their share traced again;
+/// this is where the two meet (BENCHMARKS.md, "Animations").
+pub const RETRACED_SHARE_MAX: f64 = 0.9;
+
 /// How a geometry's rays meet its primitives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct GeometryPlan {

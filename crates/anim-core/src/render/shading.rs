@@ -95,17 +95,7 @@ impl Shading {
             .iter()
             .zip(used)
             .any(|(m, &used)| m.is_transparent() && used);
-        // Every shaded colour is a convex combination of local colours and the background
-        // (the weights in docs/shading.md §3 sum to 1), so the largest local colour bounds them all.
-        let total_light: Vec3A = lights.iter().map(|l| l.intensity.max(Vec3A::ZERO)).sum();
-        let max_local = materials
-            .iter()
-            .map(|m| {
-                (m.ka * ambient + total_light * (m.kd.max(Vec3A::ZERO) + m.ks.max(Vec3A::ZERO)))
-                    .max_element()
-            })
-            .fold(0.0f32, f32::max);
-        let max_radiance = max_local.max(background.max_element());
+        let max_radiance = bound_radiance(&materials, &lights, ambient, background);
         let light_motion = scene
             .motion
             .as_ref()
@@ -135,6 +125,46 @@ impl Shading {
             Some(m) => light_at(m, k, time),
         }
     }
+}
+
+/// [`Shading::max_radiance`] of `scene`.
+pub fn max_radiance(scene: &Scene) -> f32 {
+    let materials: Vec<ShadeMaterial> = scene.materials.iter().map(ShadeMaterial::from).collect();
+    let lights: Vec<PointLight> = scene
+        .lights
+        .iter()
+        .map(|l| PointLight {
+            position: Vec3A::ZERO,
+            intensity: l.intensity.into(),
+        })
+        .collect();
+    bound_radiance(
+        &materials,
+        &lights,
+        scene.ambient.into(),
+        scene.background.into(),
+    )
+}
+
+/// An upper bound of the radiance any ray can carry under `materials`, `lights`, `ambient`
+/// and `background`. Every shaded colour is a convex combination of local colours and the
+/// background (the weights in docs/shading.md §3 sum to 1), so the largest local colour
+/// bounds them all.
+fn bound_radiance(
+    materials: &[ShadeMaterial],
+    lights: &[PointLight],
+    ambient: Vec3A,
+    background: Vec3A,
+) -> f32 {
+    let total_light: Vec3A = lights.iter().map(|l| l.intensity.max(Vec3A::ZERO)).sum();
+    let max_local = materials
+        .iter()
+        .map(|m| {
+            (m.ka * ambient + total_light * (m.kd.max(Vec3A::ZERO) + m.ks.max(Vec3A::ZERO)))
+                .max_element()
+        })
+        .fold(0.0f32, f32::max);
+    max_local.max(background.max_element())
 }
 
 /// Where light `k` of `positions`, moved by `motion`, is at `time`.

@@ -143,6 +143,28 @@ fn read_record(path: &Path) -> Option<String> {
 /// How a record names the frame its images were copied from.
 const COPIED_FROM: &str = "from ";
 
+/// How a record says that its frame was traced from the frame before it in its shot:
+/// `incremental <pixels traced again> <all pixels> <frame before>`.
+const INCREMENTAL: &str = "incremental ";
+
+/// How a frame's images were made, as its record tells: copied from frame `from`, or traced
+/// from frame `traced.2` before it in its shot, again in `traced.0` of `traced.1` pixels.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Made<'a> {
+    pub from: Option<&'a str>,
+    pub traced: Option<(u64, u64, &'a str)>,
+}
+
+impl<'a> Made<'a> {
+    /// Copied from frame `from`.
+    pub fn copied(from: &'a str) -> Made<'a> {
+        Made {
+            from: Some(from),
+            traced: None,
+        }
+    }
+}
+
 /// An image line of a record: `image <len> <hash> <path relative to the images>`.
 struct RecordedImage<'a> {
     len: u64,
@@ -173,12 +195,16 @@ impl RecordedImage<'_> {
     }
 }
 
-/// The record's text: a header, the hash, the frame its images were copied from (when they
-/// were: `from <name>`), and each image with its length and byte hash.
-fn record_text(hash: u64, from: Option<&str>, out_dir: &Path, outputs: &[Output]) -> String {
+/// The record's text: a header, the hash, how its images were made (copied: `from <name>`;
+/// traced from the frame before: `incremental ...`), and each image with its length and
+/// byte hash.
+fn record_text(hash: u64, made: Made, out_dir: &Path, outputs: &[Output]) -> String {
     let mut text = format!("anim-render-record {RECORD_VERSION}\nhash {hash:016x}\n");
-    if let Some(from) = from {
+    if let Some(from) = made.from {
         text.push_str(&format!("{COPIED_FROM}{from}\n"));
+    }
+    if let Some((again, of, before)) = made.traced {
+        text.push_str(&format!("{INCREMENTAL}{again} {of} {before}\n"));
     }
     for out in outputs {
         let rel = out.path.strip_prefix(out_dir).unwrap_or(&out.path);
@@ -196,13 +222,13 @@ pub(super) fn write_record(
     record: &Path,
     out_dir: &Path,
     hash: u64,
-    from: Option<&str>,
+    made: Made,
     outputs: &[Output],
 ) -> std::io::Result<()> {
     if let Some(parent) = record.parent() {
         std::fs::create_dir_all(parent)?;
     }
-    let text = record_text(hash, from, out_dir, outputs);
+    let text = record_text(hash, made, out_dir, outputs);
     write_atomically(record, |w| w.write_all(text.as_bytes()))
 }
 
@@ -220,7 +246,7 @@ pub(super) fn is_up_to_date(out_dir: &Path, name: &str, hash: u64) -> bool {
         return false;
     }
     let mut images = 0;
-    for line in lines.skip_while(|l| l.starts_with(COPIED_FROM)) {
+    for line in lines.skip_while(|l| l.starts_with(COPIED_FROM) || l.starts_with(INCREMENTAL)) {
         let Some(image) = RecordedImage::parse(line) else {
             return false;
         };

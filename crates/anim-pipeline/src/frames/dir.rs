@@ -4,12 +4,13 @@
 
 use super::cache::{
     frame_hash, is_up_to_date, prune_orphan_records, record_path, settings_fingerprint,
-    write_record, CACHE_DIR,
+    write_record, Made, CACHE_DIR,
 };
-use super::scene_file::{copy_scene_file, render_scene_file, FileOutcome, NoProgress};
-use super::Shard;
+use super::scene_file::{copy_scene_file, render_scene_file_in, FileOutcome, NoProgress};
+use super::{shots, Shard};
 use anim_core::diag::{Diagnostic, Loc, Severity};
 use anim_core::load::read_input;
+use anim_core::render::shot::Shot;
 use anim_core::render::RenderSettings;
 use anim_core::sdf::{image_names, scene_key, LoadOptions};
 use anim_core::util::remove_stale_temp_files;
@@ -22,7 +23,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-/// Which frames of a directory to render.
+/// Which frames of a directory to render, and how.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FrameOptions {
     /// Render frames even when their record says they are up to date.
@@ -33,6 +34,8 @@ pub struct FrameOptions {
     /// natural order as shards do (`--frames A..B`; for generated frames, the numbers in
     /// their names).
     pub range: Option<(usize, usize)>,
+    /// Render every frame in full, none traced from the frame before it in its shot.
+    pub no_incremental: bool,
 }
 
 /// What happened to the frames of one directory.
@@ -51,6 +54,9 @@ pub struct Summary {
     /// Warnings, one per distinct message, with the number of frames that had it.
     pub warnings: Vec<(Diagnostic, usize)>,
     pub rays: u64,
+    /// Of the frames rendered: how many were traced from the frame before them in their
+    /// shot, the pixels those traced again, and all their pixels.
+    pub incremental: (usize, u64, u64),
     pub wall: Duration,
     pub shard: Option<Shard>,
 }
@@ -67,6 +73,8 @@ pub enum FrameOutcome {
     Rendered {
         rays: u64,
         warnings: Vec<Diagnostic>,
+        /// Traced from the frame before it in its shot: the pixels traced again, of all.
+        retraced: Option<(u64, u64)>,
     },
     /// Its images are copies of those of frame `from`, whose scene is the same.
     Copied {
@@ -183,7 +191,13 @@ pub fn render_dir(
     };
     let todo = plan_frames(&frames, load, &fingerprint, &out_dir, options, &mut summary);
     observer.planned(todo.len(), summary.skipped.len());
-    let outcomes = render_planned(&todo, &out_dir, settings, load, observer);
+    let run = Run {
+        out_dir: &out_dir,
+        settings,
+        load,
+        observer,
+    };
+    let outcomes = render_planned(&todo, &run, options);
     observer.end();
 
     summary.add_outcomes(outcomes);
@@ -216,7 +230,7 @@ fn plan_frames(
     let mut images: HashMap<PathBuf, String> = HashMap::new();
     for (i, path) in frames.iter().enumerate() {
         let in_range = options.range.is_none_or(|(a, b)| (a..=b).contains(&i));
-        if !in_range || options.shard.is_some_and(|s| !s.contains(i)) {
+        if !in_range || options.shard.is_some_and(|s| !s.contains(i, frames.len())) {
             continue;
         }
         let name = file_name(path);
@@ -300,36 +314,58 @@ fn read_frame(
     }
 }
 
+/// What every frame of a run renders with.
+struct Run<'a> {
+    out_dir: &'a Path,
+    settings: &'a RenderSettings,
+    load: &'a LoadOptions,
+    observer: &'a dyn FrameObserver,
+}
+
 /// Renders the planned frames on the current rayon pool: first every frame whose scene is not
 /// an earlier one's, then the copies of those (a copy whose original failed is rendered).
-/// Frames are taken in natural order as threads free up (rather than rayon splitting the
-/// list in halves), so an interrupted run leaves a playable prefix behind.
+/// The first are cut into shots (`super::shots`; each frame alone under `--no-incremental`),
+/// and shots are taken in natural order as threads free up (rather than rayon splitting the
+/// list in halves), each rendering its frames in order, so an interrupted run leaves a
+/// playable prefix behind.
 fn render_planned(
     todo: &[Planned],
-    out_dir: &Path,
-    settings: &RenderSettings,
-    load: &LoadOptions,
-    observer: &dyn FrameObserver,
+    run: &Run,
+    options: &FrameOptions,
 ) -> Vec<(String, FrameOutcome)> {
+    let (out_dir, settings, load) = (run.out_dir, run.settings, run.load);
     let results: Mutex<Vec<(String, FrameOutcome)>> = Mutex::new(Vec::new());
     let originals: HashSet<usize> = todo.iter().filter_map(|f| f.same_as).collect();
     let rendered: Mutex<HashMap<usize, FileOutcome>> = Mutex::new(HashMap::new());
     let finish = |frame: &Planned, outcome: FrameOutcome, t0: Instant| {
-        observer.finished(&frame.name, &outcome, t0.elapsed());
+        run.observer.finished(&frame.name, &outcome, t0.elapsed());
         if let Ok(mut r) = results.lock() {
             r.push((frame.name.clone(), outcome));
         }
     };
-    let first = todo.iter().enumerate().filter(|(_, f)| f.same_as.is_none());
-    first.par_bridge().for_each(|(i, frame)| {
-        let t0 = Instant::now();
-        let (outcome, file) = render_frame(frame, out_dir, settings, load);
-        if let (Some(file), true) = (file, originals.contains(&i)) {
-            if let Ok(mut r) = rendered.lock() {
-                r.insert(i, file);
+    let first: Vec<usize> = (0..todo.len())
+        .filter(|&i| todo[i].same_as.is_none())
+        .collect();
+    let shots = if options.no_incremental {
+        shots::alone(first.len())
+    } else {
+        let paths: Vec<PathBuf> = first.iter().map(|&i| todo[i].path.clone()).collect();
+        shots::plan_shots(&paths, settings, load)
+    };
+    shots.iter().par_bridge().for_each(|plan| {
+        let mut shot = plan.shot();
+        let mut before: Option<&str> = None;
+        for &i in plan.frames.iter().map(|&k| &first[k]) {
+            let (t0, frame) = (Instant::now(), &todo[i]);
+            let (outcome, file) = render_frame(frame, run, shot.as_mut(), before);
+            if let (Some(file), true) = (file, originals.contains(&i)) {
+                if let Ok(mut r) = rendered.lock() {
+                    r.insert(i, file);
+                }
             }
+            finish(frame, outcome, t0);
+            before = Some(&frame.name);
         }
-        finish(frame, outcome, t0);
     });
     let rendered = rendered.into_inner().unwrap_or_else(|e| e.into_inner());
     let copies = todo.iter().filter_map(|f| f.same_as.map(|i| (f, i)));
@@ -338,7 +374,7 @@ fn render_planned(
         let copied = rendered.get(&original).and_then(|source| {
             copy_frame(frame, &todo[original].name, source, out_dir, settings, load)
         });
-        let outcome = copied.unwrap_or_else(|| render_frame(frame, out_dir, settings, load).0);
+        let outcome = copied.unwrap_or_else(|| render_frame(frame, run, None, None).0);
         finish(frame, outcome, t0);
     });
     results.into_inner().unwrap_or_else(|e| e.into_inner())
@@ -358,8 +394,13 @@ fn copy_frame(
     let _ = std::fs::remove_file(&record);
     Some(
         match copy_scene_file(&frame.path, source, load, settings)? {
-            Ok(file) => match write_record(&record, out_dir, frame.hash, Some(from), &file.outputs)
-            {
+            Ok(file) => match write_record(
+                &record,
+                out_dir,
+                frame.hash,
+                Made::copied(from),
+                &file.outputs,
+            ) {
                 Ok(()) => FrameOutcome::Copied {
                     from: from.to_string(),
                     warnings: file.warnings,
@@ -374,34 +415,44 @@ fn copy_frame(
     )
 }
 
-/// Renders frame `frame` and records it under `out_dir`; the file's outcome comes back too
-/// when it rendered, for frames of the same scene to copy.
+/// Renders frame `frame` (the next frame of `shot`, if any, after frame `before`) and
+/// records it under the run's output folder; the file's outcome comes back too when it
+/// rendered, for frames of the same scene to copy.
 fn render_frame(
     frame: &Planned,
-    out_dir: &Path,
-    settings: &RenderSettings,
-    load: &LoadOptions,
+    run: &Run,
+    shot: Option<&mut Shot>,
+    before: Option<&str>,
 ) -> (FrameOutcome, Option<FileOutcome>) {
-    let record = record_path(out_dir, &frame.name);
+    let record = record_path(run.out_dir, &frame.name);
     // A stale record must not outlive an attempt to replace its images.
     let _ = std::fs::remove_file(&record);
-    match render_scene_file(&frame.path, load, settings, &NoProgress) {
-        Ok(file) => match write_record(&record, out_dir, frame.hash, None, &file.outputs) {
-            Ok(()) => (
-                FrameOutcome::Rendered {
-                    rays: file.rays.total(),
-                    warnings: file.warnings.clone(),
-                },
-                Some(file),
-            ),
-            Err(e) => (
-                FrameOutcome::Failed(vec![Diagnostic::file_error(
-                    &record,
-                    format!("rendered, but cannot record it: {e}"),
-                )]),
-                None,
-            ),
-        },
+    let file = render_scene_file_in(&frame.path, run.load, run.settings, &NoProgress, shot);
+    match file {
+        Ok(file) => {
+            let traced = file.retraced.zip(before);
+            let made = Made {
+                from: None,
+                traced: traced.map(|((again, of), before)| (again, of, before)),
+            };
+            match write_record(&record, run.out_dir, frame.hash, made, &file.outputs) {
+                Ok(()) => (
+                    FrameOutcome::Rendered {
+                        rays: file.rays.total(),
+                        warnings: file.warnings.clone(),
+                        retraced: file.retraced,
+                    },
+                    Some(file),
+                ),
+                Err(e) => (
+                    FrameOutcome::Failed(vec![Diagnostic::file_error(
+                        &record,
+                        format!("rendered, but cannot record it: {e}"),
+                    )]),
+                    None,
+                ),
+            }
+        }
         Err(diags) => (FrameOutcome::Failed(diags), None),
     }
 }
@@ -414,9 +465,17 @@ impl Summary {
         let mut warnings = Vec::new();
         for (name, outcome) in results {
             let frame_warnings = match outcome {
-                FrameOutcome::Rendered { rays, warnings } => {
+                FrameOutcome::Rendered {
+                    rays,
+                    warnings,
+                    retraced,
+                } => {
                     self.rays += rays;
                     self.rendered.push(name);
+                    if let Some((again, of)) = retraced {
+                        let (n, a, o) = self.incremental;
+                        self.incremental = (n + 1, a + again, o + of);
+                    }
                     warnings
                 }
                 FrameOutcome::Copied { from, warnings } => {

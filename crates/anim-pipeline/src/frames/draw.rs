@@ -9,6 +9,7 @@ use anim_core::limits;
 use anim_core::load::probe;
 use anim_core::render::camera::CameraError;
 use anim_core::render::film::{self, Coverage, Encoding, ImageFormat};
+use anim_core::render::shot::Shot;
 use anim_core::render::{render_prepared, Prepared, RayCounts, RenderSettings, Rendered};
 use anim_core::scene::RenderJob;
 use anim_core::sdf::LoadOptions;
@@ -70,6 +71,9 @@ pub trait ImageSink {
 pub struct Drawn {
     pub warnings: Vec<Diagnostic>,
     pub rays: RayCounts,
+    /// For a frame of a shot whose frame before it followed (`Shot::render`): the pixels it
+    /// traced again, of all its pixels.
+    pub retraced: Option<(u64, u64)>,
 }
 
 /// An image that passed every check, to render.
@@ -90,6 +94,19 @@ pub fn render_to_memory<S: ImageSink>(
     load: &LoadOptions,
     sink: &mut S,
     progress: &dyn ImageProgress,
+) -> Result<Drawn, Vec<Diagnostic>> {
+    render_to_memory_in(path, load, sink, progress, None)
+}
+
+/// [`render_to_memory`] of a file that is the next frame of `shot` (when there is one and
+/// the file has one image): it traces again only what may differ from the shot's frame
+/// before.
+pub fn render_to_memory_in<S: ImageSink>(
+    path: &Path,
+    load: &LoadOptions,
+    sink: &mut S,
+    progress: &dyn ImageProgress,
+    shot: Option<&mut Shot>,
 ) -> Result<Drawn, Vec<Diagnostic>> {
     let loaded = anim_core::load::load_file(path, load)?;
     let mut warnings = loaded.diagnostics;
@@ -114,11 +131,22 @@ pub fn render_to_memory<S: ImageSink>(
             .sum(),
     );
     let mut blanks = Vec::new();
-    let result = render_planned(path, planned, sink, progress, (&mut blanks, &mut warnings));
+    let shot = shot.filter(|_| planned.len() == 1);
+    let mut retraced = None;
+    let told = Told {
+        blanks: &mut blanks,
+        diagnostics: &mut warnings,
+        retraced: &mut retraced,
+    };
+    let result = render_planned(path, planned, sink, progress, told, shot);
     progress.end();
     warnings.splice(blank_at..blank_at, blanks);
     match result {
-        Ok(rays) => Ok(Drawn { warnings, rays }),
+        Ok(rays) => Ok(Drawn {
+            warnings,
+            rays,
+            retraced,
+        }),
         Err(()) => Err(warnings),
     }
 }
@@ -230,15 +258,29 @@ pub(super) fn job_error(path: &Path, job: &RenderJob, message: String) -> Diagno
     }
 }
 
-/// Renders, encodes and hands over each planned image; the warnings that an image shows
-/// nothing go to `blanks`, other problems to `diagnostics`, and an error stops the file.
+/// What rendering a file's images tells besides the images: the warnings that an image shows
+/// nothing, the other problems, and what a frame of a shot traced again.
+struct Told<'a> {
+    blanks: &'a mut Vec<Diagnostic>,
+    diagnostics: &'a mut Vec<Diagnostic>,
+    retraced: &'a mut Option<(u64, u64)>,
+}
+
+/// Renders, encodes and hands over each planned image (through `shot`, the one image of a
+/// frame of a shot); what else it finds goes to `told`, and an error stops the file.
 fn render_planned<S: ImageSink>(
     path: &Path,
     planned: Vec<Planned<'_, S::Target>>,
     sink: &mut S,
     progress: &dyn ImageProgress,
-    (blanks, diagnostics): (&mut Vec<Diagnostic>, &mut Vec<Diagnostic>),
+    told: Told,
+    mut shot: Option<&mut Shot>,
 ) -> Result<RayCounts, ()> {
+    let Told {
+        blanks,
+        diagnostics,
+        retraced,
+    } = told;
     let mut rays = RayCounts::default();
     for p in planned {
         let job = p.job;
@@ -253,13 +295,22 @@ fn render_planned<S: ImageSink>(
         if let Some(blank) = &blank {
             blanks.push(probe::blank_warning(job, blank, path));
         }
+        let on_pixels = |n| progress.advance(n);
+        let rendered = match shot.as_deref_mut() {
+            Some(shot) => shot.render(&prepared, &p.settings, &on_pixels).map(|f| {
+                let pixels = f.rendered.image.pixels.len() as u64;
+                *retraced = f.follows.then_some((f.retraced, pixels));
+                f.rendered
+            }),
+            None => render_prepared(&prepared, &p.settings, &on_pixels),
+        };
         let Rendered {
             image,
             coverage,
             rays: counts,
             dropped,
             ..
-        } = match render_prepared(&prepared, &p.settings, &|n| progress.advance(n)) {
+        } = match rendered {
             Ok(r) => r,
             Err(e) => {
                 diagnostics.push(job_error(path, job, camera_problem(job, e)));

@@ -12,6 +12,7 @@ mod hdr;
 mod output;
 mod scene_file;
 mod shard;
+mod shots;
 
 pub use cache::{frame_hash, record_path, referenced_files, settings_fingerprint, CACHE_DIR};
 pub use dir::{

@@ -2,13 +2,14 @@
 //! into memory by `draw`, each written atomically (a reader never sees a half-written image)
 //! to where its render line says, confined to the scene's folder.
 
-use super::draw::{blank_warnings, job_error, plan, render_to_memory, Encoded, ImageSink};
+use super::draw::{blank_warnings, job_error, plan, render_to_memory_in, Encoded, ImageSink};
 pub use super::draw::{ImageProgress, NoProgress};
 use super::hdr;
 pub use super::output::Output;
 use anim_core::diag::{Diagnostic, Severity};
 use anim_core::limits;
 use anim_core::render::film::{self, ImageFormat};
+use anim_core::render::shot::Shot;
 use anim_core::render::{RayCounts, RenderSettings};
 use anim_core::scene::RenderJob;
 use anim_core::sdf::LoadOptions;
@@ -22,6 +23,9 @@ pub struct FileOutcome {
     pub outputs: Vec<Output>,
     pub warnings: Vec<Diagnostic>,
     pub rays: RayCounts,
+    /// For a frame traced from the frame before in a shot: the pixels it traced again, of all
+    /// its pixels.
+    pub retraced: Option<(u64, u64)>,
 }
 
 /// Where a job's image goes: relative paths are taken against `--out` or the scene's folder.
@@ -99,12 +103,25 @@ pub fn render_scene_file(
     settings: &RenderSettings,
     progress: &dyn ImageProgress,
 ) -> Result<FileOutcome, Vec<Diagnostic>> {
+    render_scene_file_in(path, load, settings, progress, None)
+}
+
+/// [`render_scene_file`] of a file that is the next frame of `shot`, if any
+/// (`draw::render_to_memory_in`).
+pub(super) fn render_scene_file_in(
+    path: &Path,
+    load: &LoadOptions,
+    settings: &RenderSettings,
+    progress: &dyn ImageProgress,
+    shot: Option<&mut Shot>,
+) -> Result<FileOutcome, Vec<Diagnostic>> {
     let mut sink = ImageFiles::new(path, settings, load.strict);
-    let drawn = render_to_memory(path, load, &mut sink, progress)?;
+    let drawn = render_to_memory_in(path, load, &mut sink, progress, shot)?;
     Ok(FileOutcome {
         outputs: sink.outputs,
         warnings: drawn.warnings,
         rays: drawn.rays,
+        retraced: drawn.retraced,
     })
 }
 
@@ -175,6 +192,7 @@ pub fn copy_scene_file(
         outputs,
         warnings,
         rays: RayCounts::default(),
+        retraced: None,
     }))
 }
 

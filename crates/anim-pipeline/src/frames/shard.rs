@@ -1,4 +1,6 @@
 //! One shard of an animation's frames, for spreading a render over machines or job arrays.
+//! A shard is a contiguous run of frames, so that the frames of a shot (`super::shots`) stay
+//! together and each is traced from the frame before it.
 
 use std::fmt;
 use std::str::FromStr;
@@ -11,9 +13,11 @@ pub struct Shard {
 }
 
 impl Shard {
-    /// Whether frame `i` (counting from 0) belongs to this shard.
-    pub fn contains(&self, i: usize) -> bool {
-        i % self.count as usize == (self.index - 1) as usize
+    /// Whether frame `i` (counting from 0) of `n` belongs to this shard: the K-th of N
+    /// contiguous runs, of as many frames as can be (⌊i·N/n⌋ = K − 1).
+    pub fn contains(&self, i: usize, n: usize) -> bool {
+        let (i, n, count) = (i as u128, n.max(1) as u128, self.count as u128);
+        i * count / n == (self.index - 1) as u128
     }
 }
 
@@ -49,10 +53,23 @@ mod tests {
     use super::*;
 
     #[test]
-    fn shards_partition_the_frames() {
+    fn shards_partition_the_frames_into_contiguous_runs() {
         let shards: Vec<Shard> = (1..=3).map(|k| format!("{k}/3").parse().unwrap()).collect();
-        for i in 0..10 {
-            assert_eq!(shards.iter().filter(|s| s.contains(i)).count(), 1);
+        for n in [1, 2, 3, 10, 100] {
+            let mut last = 0;
+            for i in 0..n {
+                let of: Vec<u32> = shards
+                    .iter()
+                    .filter(|s| s.contains(i, n))
+                    .map(|s| s.index)
+                    .collect();
+                assert_eq!(of.len(), 1, "frame {i} of {n}");
+                // In order, and no run longer than one more than another: ⌈n/3⌉ frames at most.
+                assert!(of[0] >= last, "frame {i} of {n}");
+                last = of[0];
+                let run = (0..n).filter(|&j| shards[of[0] as usize - 1].contains(j, n));
+                assert!(run.count() <= n.div_ceil(3), "frame {i} of {n}");
+            }
         }
         for bad in ["0/3", "4/3", "1/0", "x/2", "3"] {
             assert!(bad.parse::<Shard>().is_err(), "{bad}");

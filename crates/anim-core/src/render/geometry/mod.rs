@@ -339,6 +339,18 @@ impl Aggregate {
         self.key.get(i as usize).copied()
     }
 
+    /// The number naming the surface of primitive `i` (not a use of a composite) whatever the
+    /// hierarchy: its depth-first number in the flattened composite tree, which instanced
+    /// shapes' ids carry past `len()`. The same surface of a scene that changes elsewhere
+    /// keeps it.
+    #[inline]
+    pub(crate) fn surface_key(&self, i: PrimId) -> u32 {
+        match self.key.get(i as usize) {
+            Some(&k) => k,
+            None => i - self.len() as u32,
+        }
+    }
+
     /// The object-space shape of primitive `i`, or `None` for a packed world-space sphere
     /// (for tools that report by kind of shape).
     pub fn object_shape(&self, i: PrimId) -> Option<&Shape> {
@@ -534,6 +546,22 @@ impl Aggregate {
                 .map_or(0, |inst| inst.memory_bytes())
             + self.moving.as_ref().map_or(0, |m| m.memory_bytes())
     }
+}
+
+/// The world bounds of instance `index` of `scene` as [`Aggregate::build`] places it (over
+/// the exposure, where it moves); `None` where it is left out as degenerate. For what the
+/// frames of a shot change (`crate::render::shot`).
+pub(crate) fn placed_bounds(scene: &Scene, index: usize) -> Option<Aabb> {
+    let inst = scene.instances.get(index)?;
+    if let Some(mut moving) = Moving::new(scene).filter(|m| m.moves(inst)) {
+        return Some(moving.add(index).1);
+    }
+    let p = Primitive::new(
+        &inst.geometry,
+        scene.transform_of(inst),
+        inst.material as u32,
+    );
+    p.ok().map(|p| p.bounds)
 }
 
 /// The table's bounds in the hierarchy's `order`, each with its kind's tag in `w` and padded

@@ -27,9 +27,9 @@
 //! goes on with those whose samples all agreed but whose neighbours show otherwise
 //! (docs/scene-language.md §10).
 
-use super::first_pass::{around, FirstPass};
+use super::first_pass::{around, FirstPass, KeptCentres};
 use super::pattern::{self, tone3, Moments, PixelPattern, MOTION_MIN_SAMPLES, PRIOR_SAMPLES};
-use super::{coverage, Frame, Sampled};
+use super::{coverage, Frame, Kept, Sampled};
 use crate::render::compile::NO_HIT;
 use crate::render::counts::RayCounts;
 use crate::render::integrator::{PixelPrior, TraceState};
@@ -83,6 +83,184 @@ impl Adaptive<'_> {
         }
     }
 
+    /// A frame of a shot, from what the shot's previous frame kept (`kept`; nothing: every
+    /// pixel traced). A centre is traced again where what its rays met changes at this frame
+    /// or earlier (`at`: its number in the shot), a pixel's added samples where theirs do or
+    /// where a centre around it came out different, and in a frame with motion pass 3 where
+    /// a pixel's pass 2 or one around it did: everything else is kept as it was, which is
+    /// what tracing it would give. What this frame keeps comes back with the pixels traced
+    /// again.
+    pub fn render_again(
+        &self,
+        at: u32,
+        kept: Option<Kept>,
+        on_pixels: &(dyn Fn(u64) + Sync),
+    ) -> (Sampled, Kept, u64) {
+        let (w, h) = self.frame.size;
+        let motion = self.frame.shutter.is_some() && self.max_spp > 1;
+        let kept = kept.filter(|k| {
+            k.passes.as_ref().is_some_and(|p| {
+                p.centres.fits(w * h, self.frame.shutter.is_some())
+                    && p.rest.refined.len() == if motion { w * h } else { 0 }
+            })
+        });
+        let fresh = kept.is_none();
+        let Kept {
+            mut pixels,
+            mut coverage,
+            mut until,
+            mut error_estimates,
+            passes,
+        } = kept.unwrap_or_else(|| Kept::fresh(w * h));
+        let (centres, mut passes) = match passes {
+            Some(p) => (Some(p.centres), p.rest),
+            None => (None, PassesRest::fresh(w * h, motion)),
+        };
+        let (first, centred, mut counts) = FirstPass::trace_again(self.frame, centres, at);
+        let near = |changed: &[bool], i: usize| {
+            around(i % w, i / w, (w, h)).any(|r| changed[r].iter().any(|&c| c))
+        };
+        // Pass 2, into the pass-2 image (the final one without motion).
+        let old2 = passes.refined.clone();
+        // A pixel whose centres around it changed decides its samples again, unless it
+        // decides them as before.
+        let decides_anew = |i: usize| {
+            near(&centred.changed, i)
+                && centred
+                    .before
+                    .as_ref()
+                    .is_none_or(|b| !first.decides_alike(b, i % w, i / w))
+        };
+        let dirty2: Vec<bool> = (0..w * h)
+            .map(|i| until[i] <= at || decides_anew(i))
+            .collect();
+        let (pixels2, coverage2) = if motion {
+            (&mut passes.refined, &mut passes.refined_coverage)
+        } else {
+            (&mut pixels, &mut coverage)
+        };
+        let refining = Refining {
+            pixels: pixels2,
+            coverage: coverage2,
+            taken: &mut passes.taken,
+            estimates: &mut error_estimates,
+            until: &mut until,
+        };
+        counts += self.refine_again(&first, &dirty2, refining, on_pixels);
+        let mut dirty3 = dirty2.clone();
+        if motion {
+            let bits = |v: &Vec3| v.to_array().map(f32::to_bits);
+            let changed2: Vec<bool> = (0..w * h)
+                .map(|i| fresh || (dirty2[i] && bits(&passes.refined[i]) != bits(&old2[i])))
+                .collect();
+            for (i, d) in dirty3.iter_mut().enumerate() {
+                *d |= passes.recheck_until[i] <= at || near(&changed2, i);
+            }
+            let out = (&mut pixels[..], &mut coverage[..]);
+            counts += self.recheck_again(&first, &dirty3, &mut passes, out);
+        }
+        let retraced = (0..w * h)
+            .filter(|&i| centred.retraced[i] || dirty3[i])
+            .count() as u64;
+        let sampled = Sampled {
+            pixels: pixels.clone(),
+            coverage: coverage.clone(),
+            rays: counts,
+            error_estimates: error_estimates.clone(),
+        };
+        let kept = Kept {
+            pixels,
+            coverage,
+            until,
+            error_estimates,
+            passes: Some(KeptPasses {
+                centres: first.keep(centred.until),
+                rest: passes,
+            }),
+        };
+        (sampled, kept, retraced)
+    }
+
+    /// Pass 2 of a frame of a shot, for the pixels `dirty` marks, into `out`, watched.
+    fn refine_again(
+        &self,
+        first: &FirstPass,
+        dirty: &[bool],
+        out: Refining,
+        on_pixels: &(dyn Fn(u64) + Sync),
+    ) -> RayCounts {
+        let w = self.frame.size.0;
+        out.pixels
+            .par_chunks_mut(w)
+            .zip(out.coverage.par_chunks_mut(w))
+            .zip(out.taken.par_chunks_mut(w))
+            .zip(out.estimates.par_chunks_mut(w))
+            .zip(out.until.par_chunks_mut(w))
+            .enumerate()
+            .map(
+                |(y, ((((row, coverage_row), taken_row), estimate_row), until_row))| {
+                    let mut st = self.frame.trace_state(true);
+                    let cells = row.iter_mut().zip(coverage_row).zip(taken_row);
+                    for (x, (((out, cov), taken), estimate)) in cells.zip(estimate_row).enumerate()
+                    {
+                        if dirty[y * w + x] {
+                            let p = self.refine_pixel(first, (x, y), &mut st);
+                            (*out, *cov, *taken, *estimate) =
+                                (p.mean, p.coverage, p.taken, p.estimate);
+                            until_row[x] = st.scratch.take_footprint();
+                        }
+                    }
+                    on_pixels(row.len() as u64);
+                    st.scratch.counts
+                },
+            )
+            .reduce(RayCounts::default, RayCounts::sum)
+    }
+
+    /// Pass 3 of a frame of a shot, for the pixels `dirty` marks: from pass 2's image and
+    /// samples (in `passes`), into `pixels` and their coverage, watched into
+    /// `passes.recheck_until`.
+    fn recheck_again(
+        &self,
+        first: &FirstPass,
+        dirty: &[bool],
+        passes: &mut PassesRest,
+        (pixels, coverage): (&mut [Vec3], &mut [f32]),
+    ) -> RayCounts {
+        let w = self.frame.size.0;
+        let PassesRest {
+            refined,
+            refined_coverage,
+            taken,
+            recheck_until,
+        } = passes;
+        let tones: Vec<Vec3A> = refined.par_iter().map(|c| tone3(Vec3A::from(*c))).collect();
+        pixels
+            .par_chunks_mut(w)
+            .zip(coverage.par_chunks_mut(w))
+            .zip(recheck_until.par_chunks_mut(w))
+            .enumerate()
+            .map(|(y, ((row, coverage_row), until_row))| {
+                let mut st = self.frame.trace_state(true);
+                let cells = row.iter_mut().zip(coverage_row).zip(until_row);
+                for (x, ((out, cov), until)) in cells.enumerate() {
+                    let i = y * w + x;
+                    if !dirty[i] {
+                        continue;
+                    }
+                    let n = taken[i] as u32;
+                    (*out, *cov) = (refined[i], refined_coverage[i]);
+                    if self.rechecks(first, &tones, (x, y), n) {
+                        let prior = first.prior(x, y);
+                        (*out, *cov) = self.resume((*out, *cov), n, (x, y), prior, &mut st);
+                    }
+                    *until = st.scratch.take_footprint();
+                }
+                st.scratch.counts
+            })
+            .reduce(RayCounts::default, RayCounts::sum)
+    }
+
     /// Sample `i` of pixel (x, y)'s own pattern: its radiance, and whether it hit a surface.
     /// The first `PRIOR_SAMPLES` take what `prior` knows of the lights; the others trace
     /// every shadow ray.
@@ -124,7 +302,7 @@ impl Adaptive<'_> {
             .zip(estimates.par_chunks_mut(w))
             .enumerate()
             .map(|(y, (((row, coverage_row), taken_row), estimate_row))| {
-                let mut st = TraceState::refining();
+                let mut st = self.frame.trace_state(true);
                 let cells = row.iter_mut().zip(coverage_row).zip(taken_row);
                 for (x, (((out, cov), taken), estimate)) in cells.zip(estimate_row).enumerate() {
                     let p = self.refine_pixel(first, (x, y), &mut st);
@@ -204,7 +382,7 @@ impl Adaptive<'_> {
             .zip(refined.coverage.par_chunks_mut(w))
             .enumerate()
             .map(|(y, (row, coverage_row))| {
-                let mut st = TraceState::refining();
+                let mut st = self.frame.trace_state(true);
                 for (x, (out, cov)) in row.iter_mut().zip(coverage_row).enumerate() {
                     let n = taken[y * w + x] as u32;
                     if self.rechecks(first, &tones, (x, y), n) {
@@ -262,5 +440,44 @@ impl Adaptive<'_> {
         }
         st.scratch.counts.primary += (m.n - n) as u64;
         (Vec3::from(m.mean()), coverage(hits, m.n))
+    }
+}
+
+/// Where pass 2 of a frame of a shot writes: per pixel its value, its coverage, the samples
+/// it took, the estimate of its error and the first later frame that changes what its samples met.
+struct Refining<'a> {
+    pixels: &'a mut [Vec3],
+    coverage: &'a mut [f32],
+    taken: &'a mut [u8],
+    estimates: &'a mut [f32],
+    until: &'a mut [u32],
+}
+
+/// What adaptive sampling keeps of a frame of a shot for the next, besides its pixels: its
+/// first pass and the rest of its passes.
+pub(super) struct KeptPasses {
+    centres: KeptCentres,
+    rest: PassesRest,
+}
+
+/// Per pixel, the samples pass 2 took; in a frame with motion also pass 2's image and
+/// coverage, which pass 3 goes on from, and the first later frame that changes what pass 3's samples met.
+struct PassesRest {
+    refined: Vec<Vec3>,
+    refined_coverage: Vec<f32>,
+    taken: Vec<u8>,
+    recheck_until: Vec<u32>,
+}
+
+impl PassesRest {
+    /// Nothing kept, for `pixels` pixels (with motion: pass 3 too).
+    fn fresh(pixels: usize, motion: bool) -> PassesRest {
+        let with_motion = if motion { pixels } else { 0 };
+        PassesRest {
+            refined: vec![Vec3::ZERO; with_motion],
+            refined_coverage: vec![0.0; with_motion],
+            taken: vec![0; pixels],
+            recheck_until: vec![0; with_motion],
+        }
     }
 }

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 /// How a pixel's centre ray saw the motion of a frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Sweep {
+pub(super) struct Sweep {
     /// Its rays may meet a moving shape (`Moving::met_by`), and it changes during the exposure
     /// (`MotionProbe::changes`).
     touched: bool,
@@ -67,8 +67,7 @@ impl<'f> FirstPass<'f> {
             tones: Vec::new(),
             sweeps: vec![Sweep::default(); if frame.shutter.is_some() { w * h } else { 0 }],
             not_clear: vec![u32::MAX; w * h],
-            known_of_still: frame.shutter.is_some_and(|s| !s.lights_move())
-                && frame.integrator.scene.plan().0.ask_moving,
+            known_of_still: known_of_still(frame),
         };
         let counts = match frame.shutter {
             None => pass.trace_still(),
@@ -76,6 +75,105 @@ impl<'f> FirstPass<'f> {
         };
         pass.tones = pass.centres.par_iter().map(|(c, _)| tone3(*c)).collect();
         (pass, counts)
+    }
+
+    /// The first pass of a frame of a shot: the centres of `kept` (the shot's previous
+    /// frame's) whose rays meet nothing that has changed since (their `until` is still to
+    /// come), the others traced again, watched. Also says which centres changed (all of them
+    /// without `kept`): a pixel whose neighbourhood of centres is as before decides as before.
+    pub fn trace_again(
+        frame: &'f Frame<'f>,
+        kept: Option<KeptCentres>,
+        at: u32,
+    ) -> (FirstPass<'f>, KeptChanges<'f>, RayCounts) {
+        let (w, h) = frame.size;
+        let fresh = kept.is_none();
+        let kept = kept.unwrap_or_else(|| KeptCentres::fresh(w * h, frame.shutter.is_some()));
+        let moving = frame.shutter.map(|s| MovingCentre::new(frame, s));
+        let until = &kept.until;
+        // Traced row by row in parallel, taken in afterwards: a centre's trace reads no other.
+        let rows: Vec<(Vec<Retraced>, RayCounts)> = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                let mut st = frame.trace_state(false);
+                let mut row = Vec::new();
+                for x in (0..w).filter(|&x| until[y * w + x] <= at) {
+                    let (centre, sweep, not_clear) = match &moving {
+                        None => {
+                            let (centre, not_clear) = centre_still(frame, (x, y), &mut st);
+                            (centre, Sweep::default(), not_clear)
+                        }
+                        Some(m) => m.trace((x, y), &mut st),
+                    };
+                    row.push(Retraced {
+                        at: y * w + x,
+                        centre,
+                        sweep,
+                        not_clear,
+                        until: st.scratch.take_footprint(),
+                    });
+                }
+                st.scratch.counts.primary += row.len() as u64;
+                (row, st.scratch.counts)
+            })
+            .collect();
+        let mut kept = kept;
+        let before = (!fresh).then(|| FirstPass {
+            frame,
+            centres: kept.centres.clone(),
+            tones: kept.centres.par_iter().map(|(c, _)| tone3(*c)).collect(),
+            sweeps: kept.sweeps.clone(),
+            not_clear: kept.not_clear.clone(),
+            known_of_still: known_of_still(frame),
+        });
+        let mut changed = vec![fresh; w * h];
+        let mut counts = RayCounts::default();
+        let mut retraced = vec![false; w * h];
+        for (row, c) in rows {
+            counts += c;
+            for r in row {
+                let i = r.at;
+                let sweep_now = kept.sweeps.get(i).copied().unwrap_or_default();
+                let same = same_centre(kept.centres[i], r.centre)
+                    && kept.not_clear[i] == r.not_clear
+                    && same_sweep(&sweep_now, &r.sweep);
+                changed[i] |= !same;
+                retraced[i] = true;
+                kept.centres[i] = r.centre;
+                kept.not_clear[i] = r.not_clear;
+                if let Some(s) = kept.sweeps.get_mut(i) {
+                    *s = r.sweep;
+                }
+                kept.until[i] = r.until;
+            }
+        }
+        let mut pass = FirstPass {
+            frame,
+            centres: kept.centres,
+            tones: Vec::new(),
+            sweeps: kept.sweeps,
+            not_clear: kept.not_clear,
+            known_of_still: known_of_still(frame),
+        };
+        pass.tones = pass.centres.par_iter().map(|(c, _)| tone3(*c)).collect();
+        let changes = KeptChanges {
+            changed,
+            retraced,
+            until: kept.until,
+            before,
+        };
+        (pass, changes, counts)
+    }
+
+    /// What this first pass keeps for the shot's next frame, with the footprints of its
+    /// centres.
+    pub fn keep(self, until: Vec<u32>) -> KeptCentres {
+        KeptCentres {
+            centres: self.centres,
+            not_clear: self.not_clear,
+            sweeps: self.sweeps,
+            until,
+        }
     }
 
     /// The centres of a frame in which nothing moves, a row at a time (in packets where the
@@ -88,17 +186,12 @@ impl<'f> FirstPass<'f> {
             .zip(self.not_clear.par_chunks_mut(w))
             .enumerate()
             .map(|(y, (row, not_clear_row))| {
-                let mut st = TraceState::default();
+                let mut st = frame.trace_state(false);
                 if packet::trace_centres(frame, y, row, not_clear_row, &mut st) {
                     return st.scratch.counts;
                 }
                 for (x, (px, nc)) in row.iter_mut().zip(not_clear_row).enumerate() {
-                    let ray = frame.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
-                    let sample = frame
-                        .integrator
-                        .camera_sample(&ray, &PixelPrior::NONE, &mut st);
-                    *px = (sample.radiance, sample.prim);
-                    *nc = sample.not_clear;
+                    (*px, *nc) = centre_still(frame, (x, y), &mut st);
                 }
                 st.scratch.counts.primary += row.len() as u64;
                 st.scratch.counts
@@ -111,42 +204,17 @@ impl<'f> FirstPass<'f> {
     fn trace_moving(&mut self, shutter: &Shutter) -> RayCounts {
         let frame = self.frame;
         let w = frame.size.0;
-        // A light a centre's shadow rays saw fully stays so only while it holds still.
-        // Then, where the moving shapes are few enough to ask at each sample's instant, what
-        // they saw is kept as news of the shapes that hold still, with how far the centre's
-        // hit is (see `KnownNear`); otherwise, only while the camera holds still too (so
-        // that the refined samples hit near the centres), for centres none of whose rays may
-        // meet anything moving.
-        let of_still = frame.integrator.scene.plan().0.ask_moving;
-        let probe = MotionProbe::new(frame, shutter);
-        let shadows_hold = !shutter.lights_move() && (of_still || !shutter.camera_moves());
+        let moving = MovingCentre::new(frame, shutter);
         self.centres
             .par_chunks_mut(w)
             .zip(self.sweeps.par_chunks_mut(w))
             .zip(self.not_clear.par_chunks_mut(w))
             .enumerate()
             .map(|(y, ((row, sweep_row), not_clear_row))| {
-                let mut st = TraceState::default();
+                let mut st = frame.trace_state(false);
                 let pixels = row.iter_mut().zip(sweep_row).zip(not_clear_row);
                 for (x, ((px, sw), nc)) in pixels.enumerate() {
-                    let (x, y) = (x as u32, y as u32);
-                    let ray = frame.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
-                    let sample =
-                        frame
-                            .integrator
-                            .camera_sample_swept(&ray, &PixelPrior::NONE, &mut st);
-                    *px = (sample.radiance, sample.prim);
-                    let swept = sample.swept;
-                    if shadows_hold && (of_still || swept == 0.0) {
-                        *nc = sample.not_clear;
-                        if of_still {
-                            sw.depth = sample.t.unwrap_or(f32::NAN);
-                        }
-                    }
-                    sw.touched = swept > 0.0 && probe.changes((x, y), *px, swept, &mut st);
-                    if shutter.camera_moves() {
-                        sw.streak = probe.camera_sweep(x, y, sample.t);
-                    }
+                    (*px, *sw, *nc) = moving.trace((x, y), &mut st);
                 }
                 st.scratch.counts.primary += row.len() as u64;
                 st.scratch.counts
@@ -240,6 +308,30 @@ impl<'f> FirstPass<'f> {
         }
     }
 
+    /// Whether pixel (x, y) decides its samples from this first pass as from `other` (of the
+    /// same frame's size): whether it is refined and from what contrast, what its samples
+    /// take as known of the lights, and, kept, its centre. Then its pixel is the same,
+    /// whatever changed around it, as long as its own samples' rays meet the same things.
+    pub fn decides_alike(&self, other: &FirstPass, x: usize, y: usize) -> bool {
+        let refinement = |p: &FirstPass| p.refinement(x, y).map(|(c, m)| (c.to_bits(), m));
+        let prior = |p: &FirstPass| {
+            let prior = p.prior(x, y);
+            let near = prior.near.map(|n| {
+                let span = n.seen_from.map(|(_, span)| span.map(f32::to_bits));
+                (n.depth.0.to_bits(), n.depth.1.to_bits(), span)
+            });
+            (prior.known_clear, near)
+        };
+        let centre = |p: &FirstPass| {
+            let (c, surface) = p.centres[y * p.frame.size.0 + x];
+            (c.to_array().map(f32::to_bits), surface)
+        };
+        let (mine, theirs) = (refinement(self), refinement(other));
+        mine == theirs
+            && prior(self) == prior(other)
+            && (mine.is_some() || centre(self) == centre(other))
+    }
+
     /// In a frame with motion whose centres kept their shadow rays' findings for the shapes
     /// that hold still: the range of distances of the hits of the centres around (x, y), and
     /// under a moving camera the span of those centres in the image. A sample whose hit lies
@@ -265,6 +357,152 @@ impl<'f> FirstPass<'f> {
         });
         Some(KnownNear { depth, seen_from })
     }
+}
+
+/// The centre sample of pixel (`x`, `y`) of a frame in which nothing moves, ray by ray: its
+/// radiance and the surface it hit (`RenderScene::surface_key`), and the lights its tree did
+/// not see fully.
+pub(super) fn centre_still(
+    frame: &Frame,
+    (x, y): (usize, usize),
+    st: &mut TraceState,
+) -> ((Vec3A, u32), u32) {
+    let ray = frame.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
+    let integrator = frame.integrator;
+    let sample = integrator.camera_sample(&ray, &PixelPrior::NONE, st);
+    let surface = integrator.scene.surface_key(sample.prim);
+    ((sample.radiance, surface), sample.not_clear)
+}
+
+/// How the centres of a frame with motion are traced: what the first pass keeps of their
+/// shadow rays, and the probe that asks whether a pixel changes during the exposure.
+pub(super) struct MovingCentre<'f> {
+    frame: &'f Frame<'f>,
+    shutter: &'f Shutter,
+    probe: MotionProbe<'f>,
+    /// The centres' shadow findings are kept for the shapes that hold still.
+    of_still: bool,
+    /// The centres' shadow findings are kept at all.
+    shadows_hold: bool,
+}
+
+impl<'f> MovingCentre<'f> {
+    pub(super) fn new(frame: &'f Frame<'f>, shutter: &'f Shutter) -> Self {
+        // A light a centre's shadow rays saw fully stays so only while it holds still.
+        // Then, where the moving shapes are few enough to ask at each sample's instant, what
+        // they saw is kept as news of the shapes that hold still, with how far the centre's
+        // hit is (see `KnownNear`); otherwise, only while the camera holds still too (so
+        // that the refined samples hit near the centres), for centres none of whose rays may
+        // meet anything moving.
+        let of_still = frame.integrator.scene.plan().0.ask_moving;
+        MovingCentre {
+            frame,
+            shutter,
+            probe: MotionProbe::new(frame, shutter),
+            of_still,
+            shadows_hold: !shutter.lights_move() && (of_still || !shutter.camera_moves()),
+        }
+    }
+
+    /// The centre of pixel (`x`, `y`) at the middle of the exposure, watched for the moving
+    /// shapes its rays may meet: its radiance and surface, how it saw the motion, and the
+    /// lights its tree did not see fully (all of them where that is not kept). Counts the
+    /// probe's camera rays, not the centre's.
+    pub(super) fn trace(
+        &self,
+        (x, y): (usize, usize),
+        st: &mut TraceState,
+    ) -> ((Vec3A, u32), Sweep, u32) {
+        let frame = self.frame;
+        let ray = frame.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
+        let integrator = frame.integrator;
+        let sample = integrator.camera_sample_swept(&ray, &PixelPrior::NONE, st);
+        let px = (sample.radiance, integrator.scene.surface_key(sample.prim));
+        let mut sw = Sweep::default();
+        let mut nc = u32::MAX;
+        let swept = sample.swept;
+        if self.shadows_hold && (self.of_still || swept == 0.0) {
+            nc = sample.not_clear;
+            if self.of_still {
+                sw.depth = sample.t.unwrap_or(f32::NAN);
+            }
+        }
+        let (x, y) = (x as u32, y as u32);
+        sw.touched = swept > 0.0 && self.probe.changes((x, y), px, swept, st);
+        if self.shutter.camera_moves() {
+            sw.streak = self.probe.camera_sweep(x, y, sample.t);
+        }
+        (px, sw, nc)
+    }
+}
+
+/// What the first pass of a frame of a shot keeps for the next: per pixel its centre, the
+/// lights its tree did not see fully, how it saw the motion (in a frame with motion), and
+/// the first later frame that changes what its rays met.
+pub(super) struct KeptCentres {
+    centres: Vec<(Vec3A, u32)>,
+    not_clear: Vec<u32>,
+    sweeps: Vec<Sweep>,
+    until: Vec<u32>,
+}
+
+impl KeptCentres {
+    /// Nothing kept: every centre is traced (its `until` is frame 0).
+    fn fresh(pixels: usize, motion: bool) -> KeptCentres {
+        KeptCentres {
+            centres: vec![(Vec3A::ZERO, 0); pixels],
+            not_clear: vec![u32::MAX; pixels],
+            sweeps: vec![Sweep::default(); if motion { pixels } else { 0 }],
+            until: vec![0; pixels],
+        }
+    }
+
+    /// Whether these are the centres of a frame of `pixels` pixels, with motion or without.
+    pub(super) fn fits(&self, pixels: usize, motion: bool) -> bool {
+        self.centres.len() == pixels && (self.sweeps.len() == pixels) == motion
+    }
+}
+
+/// What [`FirstPass::trace_again`] found, per pixel, and the first pass it started from.
+pub(super) struct KeptChanges<'f> {
+    /// Whether the centre is not what it was (every centre, where nothing was kept).
+    pub changed: Vec<bool>,
+    /// Whether the centre was traced again.
+    pub retraced: Vec<bool>,
+    /// The first later frame that changes what the centre's rays met.
+    pub until: Vec<u32>,
+    /// The first pass of the frame before (`None` where nothing was kept).
+    pub before: Option<FirstPass<'f>>,
+}
+
+/// Whether the centres of `frame` keep their shadow rays' findings as news of the shapes
+/// that hold still, with the depth of their hits (a frame with motion whose lights hold
+/// still and whose moving shapes are few enough to ask at each sample's instant).
+fn known_of_still(frame: &Frame) -> bool {
+    frame.shutter.is_some_and(|s| !s.lights_move()) && frame.integrator.scene.plan().0.ask_moving
+}
+
+/// A centre traced again, to be taken into the first pass.
+struct Retraced {
+    at: usize,
+    centre: (Vec3A, u32),
+    sweep: Sweep,
+    not_clear: u32,
+    until: u32,
+}
+
+/// Whether two centres are the same to the bit.
+fn same_centre(a: (Vec3A, u32), b: (Vec3A, u32)) -> bool {
+    a.1 == b.1 && a.0.to_array().map(f32::to_bits) == b.0.to_array().map(f32::to_bits)
+}
+
+/// Whether two centres saw the motion the same, to the bit.
+fn same_sweep(a: &Sweep, b: &Sweep) -> bool {
+    let bits = |s: &Sweep| {
+        let ends = s.streak.map(|e| e.map(|(x, y)| (x.to_bits(), y.to_bits())));
+        (s.touched, ends, s.depth.to_bits())
+    };
+    bits(a) == bits(b)
 }
 
 /// What the pixels along a streak show ([`FirstPass::streak`]), in tone-mapped units.

@@ -19,11 +19,14 @@ mod uniform;
 pub use uniform::sample_offsets;
 
 use super::camera::PinholeCamera;
+use super::compile::Scratch;
 use super::counts::RayCounts;
-use super::integrator::Integrator;
+use super::footprint::Ahead;
+use super::integrator::{Integrator, TraceState};
 use super::motion::Shutter;
 use super::settings::Sampling;
 use glam::Vec3;
+use std::sync::Arc;
 
 /// One frame as a sampler sees it.
 pub(super) struct Frame<'a> {
@@ -34,6 +37,25 @@ pub(super) struct Frame<'a> {
     pub integrator: &'a Integrator<'a>,
     /// Width and height in pixels.
     pub size: (usize, usize),
+    /// In a frame of a shot, what the later frames change: every pixel's rays are watched
+    /// against it (`crate::render::footprint`), one pixel at a time.
+    pub ahead: Option<Arc<Ahead>>,
+}
+
+impl Frame<'_> {
+    /// A worker's state for tracing this frame's camera samples (`refining`: adaptive
+    /// sampling's added samples, `TraceState::refining`), watching in a frame of a shot.
+    fn trace_state(&self, refining: bool) -> TraceState {
+        let mut st = if refining {
+            TraceState::refining()
+        } else {
+            TraceState::default()
+        };
+        if self.ahead.is_some() {
+            st.scratch = Scratch::watching(self.ahead.clone());
+        }
+        st
+    }
 }
 
 /// What a sampler made of a frame.
@@ -71,4 +93,69 @@ pub(super) fn render(
 /// where none or all did.
 fn coverage(hits: u32, n: u32) -> f32 {
     hits as f32 / n as f32
+}
+
+/// What a frame of a shot keeps for the next: its pixels and their coverage, per pixel the
+/// first later frame of the shot that changes what the rays of its samples met (adaptive
+/// sampling: the samples it added to its centre), and adaptive sampling's passes.
+pub(super) struct Kept {
+    pixels: Vec<Vec3>,
+    coverage: Vec<f32>,
+    until: Vec<u32>,
+    error_estimates: Vec<f32>,
+    passes: Option<adaptive::KeptPasses>,
+}
+
+impl Kept {
+    /// Nothing kept, for `pixels` pixels: every one is traced (its `until` is frame 0).
+    fn fresh(pixels: usize) -> Kept {
+        Kept {
+            pixels: vec![Vec3::ZERO; pixels],
+            coverage: vec![0.0; pixels],
+            until: vec![0; pixels],
+            error_estimates: vec![f32::NAN; pixels],
+            passes: None,
+        }
+    }
+}
+
+/// Frame `at` of a shot, sampled as `sampling` says, from what the shot's previous frame
+/// kept (`None`: every pixel traced); what it keeps for the next frame, and how many pixels
+/// it traced again. The pixels are those of a render of the frame alone, to the bit.
+pub(super) fn render_again(
+    frame: &Frame,
+    sampling: Sampling,
+    at: u32,
+    kept: Option<Kept>,
+    on_pixels: &(dyn Fn(u64) + Sync),
+) -> (Sampled, Kept, u64) {
+    let pixels = frame.size.0 * frame.size.1;
+    let kept = kept.filter(|k| k.pixels.len() == pixels);
+    match sampling {
+        Sampling::Uniform(spp) => {
+            let kept = kept.filter(|k| k.passes.is_none());
+            let kept = kept.map(|k| (k.pixels, k.coverage, k.until));
+            let again = uniform::render_again(frame, spp, at, kept, on_pixels);
+            let sampled = Sampled {
+                pixels: again.pixels.clone(),
+                coverage: again.coverage.clone(),
+                rays: again.rays,
+                error_estimates: Vec::new(),
+            };
+            let kept = Kept {
+                pixels: again.pixels,
+                coverage: again.coverage,
+                until: again.until,
+                error_estimates: Vec::new(),
+                passes: None,
+            };
+            (sampled, kept, again.retraced)
+        }
+        Sampling::Adaptive { error, max_spp } => adaptive::Adaptive {
+            frame,
+            error,
+            max_spp,
+        }
+        .render_again(at, kept, on_pixels),
+    }
 }

@@ -149,7 +149,8 @@ impl<'f> MotionProbe<'f> {
                 .frame
                 .integrator
                 .camera_sample(&ray, &PixelPrior::NONE, st);
-            let (c, prim) = (sample.radiance, sample.prim);
+            let prim = self.frame.integrator.scene.surface_key(sample.prim);
+            let c = sample.radiance;
             st.scratch.counts.primary += 1;
             if prim != centre.1 || 255.0 * (tone3(c) - tone).abs().max_element() > FLAT_CONTRAST {
                 return true;

@@ -25,9 +25,12 @@ pub(super) const BLOCK: usize = (BLOCK_W * BLOCK_H) as usize;
 const ROW_RUN: usize = 8;
 
 /// Whether the camera rays of `frame` are traced in packets (the scene's plan says whether
-/// its hierarchy is deep enough for it to pay).
+/// its hierarchy is deep enough for it to pay). Not in a frame of a shot, whose rays are
+/// watched pixel by pixel.
 pub(super) fn packets_apply(frame: &Frame) -> bool {
-    frame.shutter.is_none() && frame.integrator.scene.plan().1.camera_packets
+    frame.shutter.is_none()
+        && frame.ahead.is_none()
+        && frame.integrator.scene.plan().1.camera_packets
 }
 
 /// Each camera ray's radiance and primitive, and in `not_clear` the lights some shadow ray
@@ -52,7 +55,7 @@ pub(super) fn trace_primaries<const N: usize>(
 }
 
 /// Adaptive sampling's first pass over row `y`: one ray through every pixel centre, its
-/// radiance and hit primitive into `row`, the lights its tree did not see fully into
+/// radiance and the surface it hit (`RenderScene::surface_key`) into `row`, the lights its tree did not see fully into
 /// `not_clear` (as the ray-by-ray pass records them, so that refinement does not depend on
 /// which pass traced the row). False (and nothing traced) when packets do not
 /// apply. Counts the camera rays in `st`.
@@ -67,6 +70,7 @@ pub fn trace_centres(
         return false;
     }
     let ray = |x: usize| frame.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
+    let scene = frame.integrator.scene;
     let done = row.len() - row.len() % ROW_RUN;
     let runs = row[..done]
         .chunks_exact_mut(ROW_RUN)
@@ -75,12 +79,15 @@ pub fn trace_centres(
         let rays: [_; ROW_RUN] = std::array::from_fn(|k| ray(c * ROW_RUN + k));
         let nc: &mut [u32; ROW_RUN] = nc.try_into().expect("a run of ROW_RUN");
         chunk.copy_from_slice(&trace_primaries(frame, &rays, st, nc));
+        for px in chunk {
+            px.1 = scene.surface_key(px.1);
+        }
     }
     for (x, (px, nc)) in row.iter_mut().zip(not_clear).enumerate().skip(done) {
         let sample = frame
             .integrator
             .camera_sample(&ray(x), &PixelPrior::NONE, st);
-        *px = (sample.radiance, sample.prim);
+        *px = (sample.radiance, scene.surface_key(sample.prim));
         *nc = sample.not_clear;
     }
     st.scratch.counts.primary += row.len() as u64;

@@ -29,7 +29,7 @@ pub(super) fn render(frame: &Frame, spp: u32, on_pixels: &(dyn Fn(u64) + Sync)) 
         .enumerate()
         .map(|(i, (band, covered))| {
             let y0 = i as u32 * BLOCK_H;
-            let mut st = TraceState::default();
+            let mut st = frame.trace_state(false);
             if !render_band(frame, (y0, width), (band, covered), &offsets, &mut st) {
                 for (k, (out, cov)) in band.iter_mut().zip(covered.iter_mut()).enumerate() {
                     let (x, y) = (k as u32 % width, y0 + k as u32 / width);
@@ -47,6 +47,66 @@ pub(super) fn render(frame: &Frame, spp: u32, on_pixels: &(dyn Fn(u64) + Sync)) 
         rays: counts,
         error_estimates: Vec::new(),
     }
+}
+
+/// A frame of a shot: the pixels of `kept` (the shot's previous frame's, with per pixel the
+/// first later frame that changes what its rays met) where that frame is still to come, the
+/// others traced again, watched; and per pixel that frame anew. `at` is this frame's number
+/// in the shot; without `kept` every pixel is traced.
+pub(super) fn render_again(
+    frame: &Frame,
+    spp: u32,
+    at: u32,
+    kept: Option<(Vec<Vec3>, Vec<f32>, Vec<u32>)>,
+    on_pixels: &(dyn Fn(u64) + Sync),
+) -> Again {
+    let (w, h) = frame.size;
+    let offsets = sample_offsets(spp);
+    let (mut pixels, mut coverage, mut until) =
+        kept.unwrap_or_else(|| (vec![Vec3::ZERO; w * h], vec![0.0; w * h], vec![0; w * h]));
+    let (rays, retraced) = pixels
+        .par_chunks_mut(w.max(1))
+        .zip(coverage.par_chunks_mut(w.max(1)))
+        .zip(until.par_chunks_mut(w.max(1)))
+        .enumerate()
+        .map(|(y, ((row, coverage_row), until_row))| {
+            let mut st = frame.trace_state(false);
+            let mut retraced = 0;
+            let cells = row.iter_mut().zip(coverage_row).zip(until_row);
+            for (x, ((out, cov), until)) in cells.enumerate() {
+                if *until > at {
+                    continue;
+                }
+                let at_pixel = (x as u32, y as u32);
+                (*out, *cov) = uniform_pixel(frame, at_pixel, &offsets, &mut st);
+                *until = st.scratch.take_footprint();
+                retraced += 1;
+            }
+            st.scratch.counts.primary += (retraced * offsets.len()) as u64;
+            on_pixels(row.len() as u64);
+            (st.scratch.counts, retraced as u64)
+        })
+        .reduce(
+            || (RayCounts::default(), 0),
+            |(a, n), (b, m)| (RayCounts::sum(a, b), n + m),
+        );
+    Again {
+        pixels,
+        coverage,
+        until,
+        rays,
+        retraced,
+    }
+}
+
+/// What a frame of a shot traced again ([`render_again`]).
+pub(super) struct Again {
+    pub pixels: Vec<Vec3>,
+    pub coverage: Vec<f32>,
+    pub until: Vec<u32>,
+    pub rays: RayCounts,
+    /// Pixels traced again.
+    pub retraced: u64,
 }
 
 /// Uniform sampling at `offsets` of the rows `y0..` of the image that `band` holds (whole
@@ -110,6 +170,7 @@ fn render_band(
 /// Pixel (`x`, `y`) ray by ray: the mean of its samples at `offsets` (in a frame with
 /// motion, at the instants `uniform_time` gives them), added in that order, as the camera
 /// packets add theirs, and its coverage. Does not count the camera rays.
+#[inline(always)]
 pub(super) fn uniform_pixel(
     frame: &Frame,
     (x, y): (u32, u32),
