@@ -125,6 +125,8 @@ fn white_lights(positions: &[DVec3]) -> Vec<anim_core::scene::Light> {
             name: "l".into(),
             position,
             intensity: Vec3::ONE,
+            radius: 0.0,
+            spot: None,
         })
         .collect()
 }

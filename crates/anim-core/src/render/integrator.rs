@@ -477,6 +477,8 @@ mod tests {
                 name: "top".into(),
                 position: DVec3::new(0.0, 5.0, 0.0),
                 intensity: Vec3::ONE,
+                radius: 0.0,
+                spot: None,
             }],
             ambient: Vec3::splat(0.2),
             ..Scene::default()
