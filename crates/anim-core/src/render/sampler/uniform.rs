@@ -3,7 +3,7 @@
 //! with motion, at instants of the exposure stratified per pixel (`pattern::uniform_time`).
 
 use super::packet::{self, BLOCK, BLOCK_H, BLOCK_W};
-use super::pattern::uniform_time;
+use super::pattern::{uniform_time, PixelPattern};
 use super::Frame;
 use crate::render::counts::RayCounts;
 use crate::render::integrator::{PixelPrior, TraceState};
@@ -93,13 +93,19 @@ fn render_band(
 
 /// Pixel (`x`, `y`) ray by ray: the mean of its samples at `offsets` (in a frame with
 /// motion, at the instants `uniform_time` gives them), added in that order, as the camera
-/// packets add theirs. Does not count the camera rays.
+/// packets add theirs. Does not count the camera rays. Always inlined: its two callers are
+/// the hot loops of uniform sampling, and the drawing path beside it would otherwise tip the
+/// compiler into a call per pixel.
+#[inline(always)]
 pub(super) fn uniform_pixel(
     frame: &Frame,
     (x, y): (u32, u32),
     offsets: &[(f32, f32)],
     st: &mut TraceState,
 ) -> Vec3 {
+    if frame.draws.any() {
+        return drawing_pixel(frame, (x, y), offsets, st);
+    }
     let mut sum = Vec3A::ZERO;
     for (i, &(dx, dy)) in offsets.iter().enumerate() {
         let (px, py) = (x as f32 + dx, y as f32 + dy);
@@ -114,6 +120,27 @@ pub(super) fn uniform_pixel(
             .integrator
             .camera_sample(&ray, &PixelPrior::NONE, st)
             .radiance;
+    }
+    Vec3::from(sum * (1.0 / offsets.len() as f32))
+}
+
+/// [`uniform_pixel`] of a frame whose samples draw lens and light points: sample `i` draws
+/// them as the pixel's pattern gives them by index. Apart, and not inlined, so that frames
+/// that draw none keep the loop above as small as it was.
+#[inline(never)]
+fn drawing_pixel(
+    frame: &Frame,
+    (x, y): (u32, u32),
+    offsets: &[(f32, f32)],
+    st: &mut TraceState,
+) -> Vec3 {
+    let mut sum = Vec3A::ZERO;
+    let n = offsets.len() as u32;
+    let pattern = PixelPattern::new(x, y);
+    for (i, &(dx, dy)) in (0..).zip(offsets) {
+        let (px, py) = (x as f32 + dx, y as f32 + dy);
+        let time = frame.shutter.map(|_| uniform_time(x, y, i, n));
+        sum += frame.trace_drawing((px, py), time, (&pattern, i), &PixelPrior::NONE, st);
     }
     Vec3::from(sum * (1.0 / offsets.len() as f32))
 }
