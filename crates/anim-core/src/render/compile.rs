@@ -390,7 +390,9 @@ impl RenderScene {
     /// The opaque primitive that last blocked a shadow ray towards this light (kept in the
     /// worker's `scratch`) is tried first while it is likely to block again; an opaque hit
     /// means no light whatever else the ray crosses, so the answer is the same as without it.
-    #[inline]
+    // Always inlined: the integrator's hot loop over point lights calls it, and its second
+    // caller (spots and spherical lights, out of line) would otherwise make it a call there.
+    #[inline(always)]
     pub fn transmittance(&self, shadow: &ShadowRay, scratch: &mut Scratch) -> f32 {
         let geometry = &self.geometry;
         let Scratch {

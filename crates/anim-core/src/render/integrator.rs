@@ -436,83 +436,91 @@ impl Integrator<'_> {
         let specular = mat.ks != Vec3A::ZERO || mat.m < 0.0 || mat.m.is_nan();
         for (k, light) in shading.lights.iter().enumerate() {
             let centre = shading.light_position(k, light, time);
-            let to_light = centre - hit.point;
-            let dist = to_light.length();
-            if dist == 0.0 {
+            if !light.plain {
+                c += self.extended_light(mat, at, (n, specular), (k, light, centre), context, st);
                 continue;
             }
-            let l = to_light / dist;
-            let n_dot_l = n.dot(l);
-            if n_dot_l <= 0.0 {
+            let Some((l, dist, unshadowed)) = phong_share(mat, hit, (n, v), specular, centre)
+            else {
+                continue;
+            };
+            let lit = light.intensity * unshadowed;
+            let shadow = || ShadowRay::new(hit, l, dist, time, k);
+            if self.taken_as_lit(lit, weight, known, k, shadow, st) {
+                c += lit;
                 continue;
             }
-            // A spot sends its intensity scaled by the direction to the point.
-            let intensity = match &light.spot {
-                None => light.intensity,
-                Some(spot) => match spot.factor(-l) {
-                    f if f > 0.0 => light.intensity * f,
-                    _ => continue,
-                },
-            };
-            let spec = if specular {
-                let r_dot_v = reflect(-l, n).dot(v);
-                // powf(0, m) is 0 for every positive m: no call for the unlit half.
-                if r_dot_v > 0.0 || mat.m <= 0.0 {
-                    r_dot_v.max(0.0).powf(mat.m)
-                } else {
-                    0.0
-                }
-            } else {
-                0.0
-            };
-            let unshadowed = mat.kd * n_dot_l + mat.ks * spec;
-            // Nothing to shadow (glass has no diffuse term, so only its highlights count):
-            // adding zero changes no value, so the shadow ray is not traced.
-            if unshadowed == Vec3A::ZERO {
-                continue;
-            }
-            let lit = intensity * unshadowed;
-            // One call of the glass walk for both kinds of light, as the point light had it.
-            let shadow = if light.radius == 0.0 {
-                let shadow = || ShadowRay::new(hit, l, dist, time, k);
-                if self.taken_as_lit(lit, weight, known, k, shadow, st) {
-                    c += lit;
-                    continue;
-                }
-                shadow()
-            } else {
-                let sight = LightSight {
-                    hit,
-                    leaving: at.prim,
-                    normal: n,
-                    light: k,
-                    centre,
-                    radius: light.radius,
-                    time,
-                };
-                match self.sphere_sight(&sight, l, light, (lit, weight, known), st) {
-                    SphereSight::Lit => {
-                        c += lit;
-                        continue;
-                    }
-                    SphereSight::Hidden => {
-                        st.not_clear |= 1 << k.min(31);
-                        continue;
-                    }
-                    SphereSight::Ray(shadow) => shadow,
-                }
-            };
             st.scratch.counts.shadow += 1;
-            let vis = self.scene.transmittance(&shadow, &mut st.scratch);
+            let vis = self.scene.transmittance(&shadow(), &mut st.scratch);
             if vis < 1.0 {
                 st.not_clear |= 1 << k.min(31);
             }
             if vis == 0.0 {
                 continue;
             }
-            c += intensity * vis * unshadowed;
+            c += light.intensity * vis * unshadowed;
         }
         c
+    }
+
+    /// The term of `local` of light `k` (`light`, its centre at `centre`) where it is a spot
+    /// or a sphere (docs/shading.md §2.1, §2.2). Apart, and not inlined, so that the loop of
+    /// `local` over point lights stays as small as it was.
+    #[inline(never)]
+    fn extended_light(
+        &self,
+        mat: &ShadeMaterial,
+        at: &SurfacePoint,
+        (n, specular): (Vec3A, bool),
+        (k, light, centre): (usize, &PointLight, Vec3A),
+        context: ShadeContext,
+        st: &mut TraceState,
+    ) -> Vec3A {
+        let (hit, v, time) = (at.hit, -at.ray.dir, at.ray.time);
+        let ShadeContext { weight, known, .. } = context;
+        let Some((l, dist, unshadowed)) = phong_share(mat, hit, (n, v), specular, centre) else {
+            return Vec3A::ZERO;
+        };
+        // A spot sends its intensity scaled by the direction to the point.
+        let intensity = match &light.spot {
+            None => light.intensity,
+            Some(spot) => match spot.factor(-l) {
+                f if f > 0.0 => light.intensity * f,
+                _ => return Vec3A::ZERO,
+            },
+        };
+        let lit = intensity * unshadowed;
+        let shadow = if light.radius == 0.0 {
+            let shadow = || ShadowRay::new(hit, l, dist, time, k);
+            if self.taken_as_lit(lit, weight, known, k, shadow, st) {
+                return lit;
+            }
+            shadow()
+        } else {
+            let sight = LightSight {
+                hit,
+                leaving: at.prim,
+                normal: n,
+                light: k,
+                centre,
+                radius: light.radius,
+                time,
+            };
+            match self.sphere_sight(&sight, l, light, (lit, weight, known), st) {
+                SphereSight::Lit => return lit,
+                SphereSight::Hidden => {
+                    st.not_clear |= 1 << k.min(31);
+                    return Vec3A::ZERO;
+                }
+                SphereSight::Ray(shadow) => shadow,
+            }
+        };
+        st.scratch.counts.shadow += 1;
+        let vis = self.scene.transmittance(&shadow, &mut st.scratch);
+        if vis < 1.0 {
+            st.not_clear |= 1 << k.min(31);
+        }
+        intensity * vis * unshadowed
     }
 
     /// What one camera sample finds of spherical light `light` (number `sight.light`, seen
@@ -607,6 +615,44 @@ impl Integrator<'_> {
         let dist = d.length();
         ShadowRay::new(hit, d / dist, dist, time, k)
     }
+}
+
+/// A light at `centre` seen from `hit` with shading normal `n` and view direction `v`: the
+/// unit direction to it, its distance, and its unshadowed term `Kd·(N·L) + Ks·max(R·V,0)^m`
+/// (the specular part only where `specular`); `None` where it adds nothing (behind the
+/// surface, at the point itself, or nothing to shadow: glass has no diffuse term, so only
+/// its highlights count, and adding zero changes no value).
+#[inline(always)]
+fn phong_share(
+    mat: &ShadeMaterial,
+    hit: &SurfaceHit,
+    (n, v): (Vec3A, Vec3A),
+    specular: bool,
+    centre: Vec3A,
+) -> Option<(Vec3A, f32, Vec3A)> {
+    let to_light = centre - hit.point;
+    let dist = to_light.length();
+    if dist == 0.0 {
+        return None;
+    }
+    let l = to_light / dist;
+    let n_dot_l = n.dot(l);
+    if n_dot_l <= 0.0 {
+        return None;
+    }
+    let spec = if specular {
+        let r_dot_v = reflect(-l, n).dot(v);
+        // powf(0, m) is 0 for every positive m: no call for the unlit half.
+        if r_dot_v > 0.0 || mat.m <= 0.0 {
+            r_dot_v.max(0.0).powf(mat.m)
+        } else {
+            0.0
+        }
+    } else {
+        0.0
+    };
+    let unshadowed = mat.kd * n_dot_l + mat.ks * spec;
+    (unshadowed != Vec3A::ZERO).then_some((l, dist, unshadowed))
 }
 
 #[cfg(test)]

@@ -59,6 +59,8 @@ pub struct PointLight {
     pub radius: f32,
     /// The cone of a spot light.
     pub spot: Option<SpotCone>,
+    /// A point light shining everywhere (radius 0, no spot): the integrator's short path.
+    pub plain: bool,
 }
 
 /// The cone a spot light shines into (docs/shading.md §2.2).
@@ -175,6 +177,7 @@ impl Shading {
                 intensity: l.intensity.into(),
                 radius: l.radius as f32,
                 spot: l.spot.as_ref().map(|s| SpotCone::new(s, l.position)),
+                plain: l.radius == 0.0 && l.spot.is_none(),
             })
             .collect();
         let ambient: Vec3A = scene.ambient.into();
