@@ -134,6 +134,9 @@ fn rebased(job: &RenderJob) -> Option<(Scene, Camera)> {
         scene.transform_all(&Transform::translate(-eye));
         for light in &mut scene.lights {
             light.position -= eye;
+            if let Some(spot) = &mut light.spot {
+                spot.target -= eye;
+            }
         }
         let camera = Camera {
             eye: DVec3::ZERO,
@@ -199,6 +202,7 @@ fn trace_frame<T>(
         integrator: &integrator,
         size: (width as usize, height as usize),
         ahead,
+        draws: sampler::Draws::new(&camera, &integrator),
     };
     let (sampled, extra) = sample(&frame, sampling);
     let counts = sampled.rays;

@@ -129,6 +129,12 @@ impl Shot {
     }
 }
 
+/// Whether the samples of `job` draw points of a lens or of a spherical light: such frames
+/// are rendered in full, each alone (see `sampler::render_again`).
+fn draws(job: &RenderJob) -> bool {
+    job.camera.lens.is_some() || job.scene.lights.iter().any(|l| l.radius > 0.0)
+}
+
 /// What job `b` changes from job `a`, rendered with `settings`, when `b` can follow `a` in a
 /// shot; `None` when it changes everything (the camera, the image, its sampling, or what
 /// every pixel reads).
@@ -136,10 +142,11 @@ pub fn changes(a: &RenderJob, b: &RenderJob, settings: &RenderSettings) -> Optio
     let same_camera = a.camera.eye == b.camera.eye
         && a.camera.dir == b.camera.dir
         && a.camera.up == b.camera.up
-        && a.camera.fov_x_deg == b.camera.fov_x_deg;
+        && a.camera.fov_x_deg == b.camera.fov_x_deg
+        && a.camera.lens == b.camera.lens;
     let same_image =
         settings.resolve(a) == settings.resolve(b) && settings.sampling(a) == settings.sampling(b);
-    if !same_camera || !same_image || !same_frame(&a.scene, &b.scene) {
+    if !same_camera || !same_image || !same_frame(&a.scene, &b.scene) || draws(a) || draws(b) {
         return None;
     }
     let (sa, sb) = (&a.scene, &b.scene);
@@ -327,16 +334,8 @@ mod tests {
             ]
             .into(),
             lights: vec![
-                Light {
-                    name: "a".into(),
-                    position: DVec3::new(4.0, 9.0, 2.0),
-                    intensity: Vec3::splat(0.9),
-                },
-                Light {
-                    name: "b".into(),
-                    position: DVec3::new(-6.0, 5.0, -1.0),
-                    intensity: Vec3::new(0.3, 0.3, 0.5),
-                },
+                Light::point("a", DVec3::new(4.0, 9.0, 2.0), Vec3::splat(0.9)),
+                Light::point("b", DVec3::new(-6.0, 5.0, -1.0), Vec3::new(0.3, 0.3, 0.5)),
             ],
             ambient: Vec3::splat(0.3),
             background: Vec3::splat(background),

@@ -1,14 +1,18 @@
 //! Adaptive sampling's first pass: one ray through every pixel centre (exactly `--spp 1`),
 //! and what the later passes read of it: which pixels are flat and keep their centre sample
 //! ([`FirstPass::refinement`]), and what a refined pixel's samples may take as known of the
-//! lights ([`FirstPass::prior`]).
+//! lights ([`FirstPass::prior`]). Where the frame's samples draw lens or light points, the
+//! centres take the pinhole and ask spherical lights as a whole, and a pixel whose value
+//! hangs on those points (a penumbra, a blur) is refined.
 
+use super::defocus::{self, Centre};
 use super::motion::{streak_pairs, MotionProbe};
 use super::packet;
 use super::pattern::{tone3, FLAT_CONTRAST};
 use super::Frame;
+use crate::math::Ray;
 use crate::render::counts::RayCounts;
-use crate::render::integrator::{KnownNear, PixelPrior, TraceState};
+use crate::render::integrator::{CameraSample, KnownNear, PixelPrior, TraceState};
 use crate::render::motion::Shutter;
 use glam::Vec3A;
 use rayon::prelude::*;
@@ -38,6 +42,16 @@ impl Default for Sweep {
     }
 }
 
+/// What a centre's samples draw hangs on, as the first pass saw it.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Mark {
+    /// Its tree saw a spherical light in part (`CameraSample::penumbra`).
+    penumbra: bool,
+    /// The radius of the lens's circle of confusion at its hit, negative nearer than the
+    /// plane in focus (`PinholeCamera::blur`).
+    blur: f32,
+}
+
 /// What the first pass saw, per pixel (row-major).
 pub(super) struct FirstPass<'f> {
     frame: &'f Frame<'f>,
@@ -55,6 +69,11 @@ pub(super) struct FirstPass<'f> {
     /// depth of their hits (a frame with motion whose lights hold still and whose moving
     /// shapes are few enough to ask at each sample's instant).
     known_of_still: bool,
+    /// What each centre's lens and light points hang on (zeros where nothing is drawn).
+    marks: Vec<Mark>,
+    /// Whether a pixel's value hangs on its lens or light points: a penumbra around it, or a
+    /// blur that reaches it (`defocus`). Empty when the frame draws none.
+    spread: Vec<bool>,
 }
 
 impl<'f> FirstPass<'f> {
@@ -68,12 +87,17 @@ impl<'f> FirstPass<'f> {
             sweeps: vec![Sweep::default(); if frame.shutter.is_some() { w * h } else { 0 }],
             not_clear: vec![u32::MAX; w * h],
             known_of_still: known_of_still(frame),
+            marks: vec![Mark::default(); w * h],
+            spread: Vec::new(),
         };
         let counts = match frame.shutter {
             None => pass.trace_still(),
             Some(s) => pass.trace_moving(s),
         };
         pass.tones = pass.centres.par_iter().map(|(c, _)| tone3(*c)).collect();
+        if frame.draws.any() {
+            pass.spread = pass.spread_pixels();
+        }
         (pass, counts)
     }
 
@@ -100,10 +124,13 @@ impl<'f> FirstPass<'f> {
                 for x in (0..w).filter(|&x| until[y * w + x] <= at) {
                     let (centre, sweep, not_clear) = match &moving {
                         None => {
-                            let (centre, not_clear) = centre_still(frame, (x, y), &mut st);
+                            let (centre, not_clear, _) = centre_still(frame, (x, y), &mut st);
                             (centre, Sweep::default(), not_clear)
                         }
-                        Some(m) => m.trace((x, y), &mut st),
+                        Some(m) => {
+                            let (centre, sweep, not_clear, _) = m.trace((x, y), &mut st);
+                            (centre, sweep, not_clear)
+                        }
                     };
                     row.push(Retraced {
                         at: y * w + x,
@@ -125,6 +152,8 @@ impl<'f> FirstPass<'f> {
             sweeps: kept.sweeps.clone(),
             not_clear: kept.not_clear.clone(),
             known_of_still: known_of_still(frame),
+            marks: vec![Mark::default(); w * h],
+            spread: Vec::new(),
         });
         let mut changed = vec![fresh; w * h];
         let mut counts = RayCounts::default();
@@ -154,6 +183,8 @@ impl<'f> FirstPass<'f> {
             sweeps: kept.sweeps,
             not_clear: kept.not_clear,
             known_of_still: known_of_still(frame),
+            marks: vec![Mark::default(); w * h],
+            spread: Vec::new(),
         };
         pass.tones = pass.centres.par_iter().map(|(c, _)| tone3(*c)).collect();
         let changes = KeptChanges {
@@ -176,6 +207,29 @@ impl<'f> FirstPass<'f> {
         }
     }
 
+    /// Per pixel, whether its value hangs on its lens or light points: a centre around it
+    /// saw a spherical light in part, or the lens's blur reaches it.
+    fn spread_pixels(&self) -> Vec<bool> {
+        let (w, h) = self.frame.size;
+        let mut spread = if self.frame.draws.lens() {
+            defocus::blurred((w, h), |i| Centre {
+                blur: self.marks[i].blur,
+                prim: self.centres[i].1,
+                tone: self.tones[i],
+            })
+        } else {
+            vec![false; w * h]
+        };
+        if self.frame.draws.spherical_lights() {
+            for (i, out) in spread.iter_mut().enumerate() {
+                let (x, y) = (i % w, i / w);
+                *out =
+                    *out || around(x, y, (w, h)).any(|r| self.marks[r].iter().any(|m| m.penumbra));
+            }
+        }
+        spread
+    }
+
     /// The centres of a frame in which nothing moves, a row at a time (in packets where the
     /// scene's plan says so).
     fn trace_still(&mut self) -> RayCounts {
@@ -184,14 +238,16 @@ impl<'f> FirstPass<'f> {
         self.centres
             .par_chunks_mut(w)
             .zip(self.not_clear.par_chunks_mut(w))
+            .zip(self.marks.par_chunks_mut(w))
             .enumerate()
-            .map(|(y, (row, not_clear_row))| {
-                let mut st = frame.trace_state(false);
+            .map(|(y, ((row, not_clear_row), mark_row))| {
+                let mut st = trace_state(frame);
                 if packet::trace_centres(frame, y, row, not_clear_row, &mut st) {
                     return st.scratch.counts;
                 }
-                for (x, (px, nc)) in row.iter_mut().zip(not_clear_row).enumerate() {
-                    (*px, *nc) = centre_still(frame, (x, y), &mut st);
+                let pixels = row.iter_mut().zip(not_clear_row).zip(mark_row);
+                for (x, ((px, nc), mk)) in pixels.enumerate() {
+                    (*px, *nc, *mk) = centre_still(frame, (x, y), &mut st);
                 }
                 st.scratch.counts.primary += row.len() as u64;
                 st.scratch.counts
@@ -209,12 +265,17 @@ impl<'f> FirstPass<'f> {
             .par_chunks_mut(w)
             .zip(self.sweeps.par_chunks_mut(w))
             .zip(self.not_clear.par_chunks_mut(w))
+            .zip(self.marks.par_chunks_mut(w))
             .enumerate()
-            .map(|(y, ((row, sweep_row), not_clear_row))| {
-                let mut st = frame.trace_state(false);
-                let pixels = row.iter_mut().zip(sweep_row).zip(not_clear_row);
-                for (x, ((px, sw), nc)) in pixels.enumerate() {
-                    (*px, *sw, *nc) = moving.trace((x, y), &mut st);
+            .map(|(y, (((row, sweep_row), not_clear_row), mark_row))| {
+                let mut st = trace_state(frame);
+                let pixels = row
+                    .iter_mut()
+                    .zip(sweep_row)
+                    .zip(not_clear_row)
+                    .zip(mark_row);
+                for (x, (((px, sw), nc), mk)) in pixels.enumerate() {
+                    (*px, *sw, *nc, *mk) = moving.trace((x, y), &mut st);
                 }
                 st.scratch.counts.primary += row.len() as u64;
                 st.scratch.counts
@@ -223,10 +284,12 @@ impl<'f> FirstPass<'f> {
     }
 
     /// Whether pixel (x, y) is refined, and if so the largest tone-mapped difference (8-bit
-    /// levels) between its centre and those around it and whether motion touches it; `None`
-    /// if it is flat and keeps its centre sample. Flat: all nine centres around it hit one
-    /// surface within `FLAT_CONTRAST` levels, no centre ray around it met something moving,
-    /// and under a moving camera the image is flat along its streak.
+    /// levels) between its centre and those around it and whether motion (or a penumbra, or
+    /// a blur: [`FirstPass::spread_pixels`]) touches it; `None` if it is flat and keeps its
+    /// centre sample. Flat: all nine centres around it hit one surface within
+    /// `FLAT_CONTRAST` levels, no centre ray around it met something moving, under a moving
+    /// camera the image is flat along its streak, and its value hangs on no lens or light
+    /// point.
     pub fn refinement(&self, x: usize, y: usize) -> Option<(f32, bool)> {
         let (w, h) = self.frame.size;
         let prim = self.centres[y * w + x].1;
@@ -255,6 +318,9 @@ impl<'f> FirstPass<'f> {
             Some(Some(ends)) => self.streak(x, y, ends),
         };
         other_surface |= streak.other_surface;
+        // A pixel whose value hangs on its lens or light points spreads its samples over more
+        // dimensions than its position, as one that motion touches does over time.
+        moving |= self.spread.get(y * w + x).copied().unwrap_or(false);
         let flat = !moving && !other_surface && 255.0 * contrast.max(streak.bias) <= FLAT_CONTRAST;
         (!flat).then_some((255.0 * contrast.max(streak.contrast), moving))
     }
@@ -360,18 +426,19 @@ impl<'f> FirstPass<'f> {
 }
 
 /// The centre sample of pixel (`x`, `y`) of a frame in which nothing moves, ray by ray: its
-/// radiance and the surface it hit (`RenderScene::surface_key`), and the lights its tree did
-/// not see fully.
+/// radiance and the surface it hit (`RenderScene::surface_key`), the lights its tree did not
+/// see fully, and what its lens and light points hang on.
 pub(super) fn centre_still(
     frame: &Frame,
     (x, y): (usize, usize),
     st: &mut TraceState,
-) -> ((Vec3A, u32), u32) {
+) -> ((Vec3A, u32), u32, Mark) {
     let ray = frame.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
     let integrator = frame.integrator;
     let sample = integrator.camera_sample(&ray, &PixelPrior::NONE, st);
     let surface = integrator.scene.surface_key(sample.prim);
-    ((sample.radiance, surface), sample.not_clear)
+    let mark = mark(frame, &ray, &sample);
+    ((sample.radiance, surface), sample.not_clear, mark)
 }
 
 /// How the centres of a frame with motion are traced: what the first pass keeps of their
@@ -405,19 +472,20 @@ impl<'f> MovingCentre<'f> {
     }
 
     /// The centre of pixel (`x`, `y`) at the middle of the exposure, watched for the moving
-    /// shapes its rays may meet: its radiance and surface, how it saw the motion, and the
-    /// lights its tree did not see fully (all of them where that is not kept). Counts the
-    /// probe's camera rays, not the centre's.
+    /// shapes its rays may meet: its radiance and surface, how it saw the motion, the lights
+    /// its tree did not see fully (all of them where that is not kept), and what its lens and
+    /// light points hang on. Counts the probe's camera rays, not the centre's.
     pub(super) fn trace(
         &self,
         (x, y): (usize, usize),
         st: &mut TraceState,
-    ) -> ((Vec3A, u32), Sweep, u32) {
+    ) -> ((Vec3A, u32), Sweep, u32, Mark) {
         let frame = self.frame;
         let ray = frame.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
         let integrator = frame.integrator;
         let sample = integrator.camera_sample_swept(&ray, &PixelPrior::NONE, st);
         let px = (sample.radiance, integrator.scene.surface_key(sample.prim));
+        let mark = mark(frame, &ray, &sample);
         let mut sw = Sweep::default();
         let mut nc = u32::MAX;
         let swept = sample.swept;
@@ -432,7 +500,7 @@ impl<'f> MovingCentre<'f> {
         if self.shutter.camera_moves() {
             sw.streak = self.probe.camera_sweep(x, y, sample.t);
         }
-        (px, sw, nc)
+        (px, sw, nc, mark)
     }
 }
 
@@ -505,6 +573,29 @@ fn same_sweep(a: &Sweep, b: &Sweep) -> bool {
     bits(a) == bits(b)
 }
 
+/// A worker's trace state for the centres of `frame`: spherical lights asked as a whole.
+fn trace_state(frame: &Frame) -> TraceState {
+    if frame.draws.spherical_lights() {
+        // Never watched: frames that draw are not traced as frames of a shot
+        // (`sampler::render_again`).
+        TraceState::asking_whole_lights()
+    } else {
+        frame.trace_state(false)
+    }
+}
+
+/// What centre `sample` of `frame` (of the pinhole ray `ray`) hangs on.
+fn mark(frame: &Frame, ray: &Ray, sample: &CameraSample) -> Mark {
+    let blur = match sample.t {
+        Some(t) if frame.draws.lens() => frame.camera.blur(ray.at(t)),
+        _ => 0.0,
+    };
+    Mark {
+        penumbra: sample.penumbra,
+        blur,
+    }
+}
+
 /// What the pixels along a streak show ([`FirstPass::streak`]), in tone-mapped units.
 #[derive(Clone, Copy, Debug, Default)]
 struct Streak {
@@ -536,7 +627,11 @@ mod tests {
     /// buffer the adaptive sampler keeps per pixel at its peak.
     #[test]
     fn the_budget_per_pixel_covers_the_sampler_s_buffers() {
-        let first_pass = size_of::<(Vec3A, u32)>() + size_of::<Vec3A>() + size_of::<u32>();
+        let first_pass = size_of::<(Vec3A, u32)>()
+            + size_of::<Vec3A>()
+            + size_of::<u32>()
+            + size_of::<Mark>()
+            + size_of::<bool>();
         let refined =
             size_of::<glam::Vec3>() + size_of::<f32>() + size_of::<u8>() + size_of::<f32>();
         let motion = size_of::<Sweep>() + size_of::<Vec3A>();

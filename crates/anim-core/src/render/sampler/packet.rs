@@ -26,11 +26,13 @@ const ROW_RUN: usize = 8;
 
 /// Whether the camera rays of `frame` are traced in packets (the scene's plan says whether
 /// its hierarchy is deep enough for it to pay). Not in a frame of a shot, whose rays are
-/// watched pixel by pixel.
+/// watched pixel by pixel, nor where its samples draw lens or light points, which are the
+/// pixel's own.
 pub(super) fn packets_apply(frame: &Frame) -> bool {
     frame.shutter.is_none()
         && frame.ahead.is_none()
         && frame.integrator.scene.plan().1.camera_packets
+        && !frame.draws.any()
 }
 
 /// Each camera ray's radiance and primitive, and in `not_clear` the lights some shadow ray
