@@ -109,6 +109,14 @@ impl PinholeCamera {
         lens.aperture * d * (1.0 / lens.focus - 1.0 / z)
     }
 
+    /// [`PinholeCamera::blur`] of a point infinitely far along the view: `aperture · d /
+    /// focus`; 0 without a lens.
+    pub fn blur_at_infinity(&self) -> f32 {
+        self.lens.as_ref().map_or(0.0, |lens| {
+            lens.aperture * self.view.forward.length() / lens.focus
+        })
+    }
+
     /// Where the rays start.
     pub fn eye(&self) -> Vec3A {
         self.view.eye
@@ -256,5 +264,9 @@ mod tests {
         assert!(lens.blur(Vec3A::new(1.0, 1.0, -5.0)).abs() < 1e-4);
         assert!(lens.blur(Vec3A::new(0.0, 0.0, -2.0)) < 0.0);
         assert_eq!(pinhole.blur(p), 0.0);
+        // Far along the view the circle tends to its limit.
+        let far = lens.blur(Vec3A::new(0.0, 0.0, -1e6));
+        assert!((far - lens.blur_at_infinity()).abs() < 1e-3 * far, "{far}");
+        assert_eq!(pinhole.blur_at_infinity(), 0.0);
     }
 }

@@ -5,7 +5,8 @@
 //! (`PinholeCamera::blur`) around where the pinhole sees it, so a pixel shows the
 //! pinhole image of the points whose circles reach it. Points nearer than the plane in focus
 //! spread over whatever lies behind them; a point at or behind it is hidden from the lens by
-//! nothing the pinhole does not see in front of it. So a pixel keeps its centre when neither
+//! nothing the pinhole does not see in front of it, and spreads over what lies behind it,
+//! which is blurred more (the background counts as a point at infinity). So a pixel keeps its centre when neither
 //! its own hit nor a nearer point whose circle reaches it is blurred by more than
 //! [`SHARP_RADIUS`], or when everything within the largest such circle is one surface within
 //! the flat contrast (blurring it changes nothing). Decided per tile of the image, each as
@@ -25,8 +26,8 @@ pub const SHARP_RADIUS: f32 = 0.5;
 /// One pixel centre of the first pass, as this module reads it.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Centre {
-    /// The radius of the circle of confusion of the point it hit (0 for the background,
-    /// which is the same everywhere), negative for a point nearer than the plane in focus.
+    /// The radius of the circle of confusion of the point it hit (for the background, that of
+    /// a point at infinity), negative for a point nearer than the plane in focus.
     pub blur: f32,
     /// The primitive it hit.
     pub prim: u32,

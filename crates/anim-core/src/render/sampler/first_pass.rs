@@ -586,9 +586,12 @@ fn trace_state(frame: &Frame) -> TraceState {
 
 /// What centre `sample` of `frame` (of the pinhole ray `ray`) hangs on.
 fn mark(frame: &Frame, ray: &Ray, sample: &CameraSample) -> Mark {
+    // The background lies beyond everything: the lens spreads what lies in front of it over
+    // it as far as a point at infinity spreads.
     let blur = match sample.t {
-        Some(t) if frame.draws.lens() => frame.camera.blur(ray.at(t)),
-        _ => 0.0,
+        _ if !frame.draws.lens() => 0.0,
+        Some(t) => frame.camera.blur(ray.at(t)),
+        None => frame.camera.blur_at_infinity(),
     };
     Mark {
         penumbra: sample.penumbra,
