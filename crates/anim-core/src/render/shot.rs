@@ -440,6 +440,38 @@ mod tests {
         );
     }
 
+    /// Frames whose samples draw points of a lens or of a spherical light are not followed in
+    /// a shot (adaptive sampling asks such a light as a whole, a cone no footprint holds):
+    /// each starts its own, and a shot renders it as it renders alone.
+    #[test]
+    fn frames_that_draw_lens_or_light_points_start_their_own_shot() {
+        let lens = |job: &mut RenderJob| {
+            job.camera.lens = Some(crate::scene::Lens {
+                aperture: 0.15,
+                focus: 9.0,
+            })
+        };
+        let soft = |job: &mut RenderJob| job.scene.lights[0].radius = 0.8;
+        let settings = RenderSettings::default();
+        for draw in [lens, soft] {
+            let (mut a, mut b) = (frame(-1.0, 0.8, 0.1), frame(-0.8, 0.8, 0.1));
+            draw(&mut a);
+            draw(&mut b);
+            assert!(changes(&a, &a, &settings).is_none());
+            assert!(changes(&a, &b, &settings).is_none());
+            for spp in [None, Some(4)] {
+                let settings = RenderSettings {
+                    spp,
+                    ..RenderSettings::default()
+                };
+                let alone = render_job(&b, &settings, &|_| {}).unwrap().image;
+                let mut shot = Shot::new(Vec::new());
+                let again = shot.render(&Prepared::new(&b), &settings, &|_| {});
+                assert!(bits(&again.unwrap().rendered.image) == bits(&alone));
+            }
+        }
+    }
+
     #[test]
     fn what_every_pixel_reads_starts_a_new_shot() {
         let settings = RenderSettings::default();
