@@ -155,12 +155,12 @@ fn print_summary(dir: &Path, s: &Summary, range: Option<(usize, usize)>, quiet: 
     let incremental = match s.incremental {
         (0, _, _) => String::new(),
         (n, again, of) => format!(
-            " ({n} from the frame before, {:.1} % of their pixels traced again)",
+            "; {n} from the frame before, {:.1} % of their pixels traced again",
             100.0 * again as f64 / of.max(1) as f64
         ),
     };
     eprintln!(
-        "{}: {shard}{} rendered{incremental}{copied}, {} skipped (unchanged), {} failed in {:.2} s{rates}",
+        "{}: {shard}{} rendered{copied}, {} skipped (unchanged), {} failed in {:.2} s{rates}{incremental}",
         shown(dir),
         s.rendered.len(),
         s.skipped.len(),
