@@ -11,8 +11,11 @@
 //!   image tiles, in still and moving frames.
 //! - `shadows`: how much of a light passes the glass before it (`RenderScene::transmittance`),
 //!   with and without lookups, and through instanced composites.
+//! - `light_cones`: what a point sees of a spherical light as a whole
+//!   (`RenderScene::whole_light`) against shadow rays over its disc.
 
 mod hierarchy;
+mod light_cones;
 mod lookups;
 mod render_scene;
 mod shadows;
@@ -125,6 +128,8 @@ fn white_lights(positions: &[DVec3]) -> Vec<anim_core::scene::Light> {
             name: "l".into(),
             position,
             intensity: Vec3::ONE,
+            radius: 0.0,
+            spot: None,
         })
         .collect()
 }

@@ -8,6 +8,8 @@
 //!   the fingerprints of `golden/manifest.tsv` (not one pixel may change by accident).
 //! - `glass_edges`: glass where surfaces meet, and rays grazing faces and edges.
 //! - `finite_pixels`: no scene we ship or our users have renders a NaN or infinite pixel.
+//! - `distributed`: spherical and spot lights and the thin lens against their geometry;
+//!   radius 0 and aperture 0 as the point light and the pinhole to the byte.
 //! - `adaptive`: where adaptive anti-aliasing puts its samples; the uniform modes unchanged.
 //! - `mesh`: OBJ meshes drawn like the formulas and like the equivalent boxes; OBJ errors.
 //! - `instancing`: shared composites kept once, and drawn to the bytes of their flattened
@@ -19,6 +21,7 @@
 mod common;
 
 mod adaptive;
+mod distributed;
 mod finite_pixels;
 mod formats;
 mod glass_edges;

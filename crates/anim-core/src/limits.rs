@@ -57,12 +57,13 @@ pub const RENDER_STACK_BYTES: usize = 64 << 20;
 
 /// Bytes an image costs per pixel while it is made, at the adaptive sampler's peak: the centre
 /// sample with the primitive it hit (32), its tone (16), the lights it did not see clear (4),
-/// the refined radiance (12), coverage (4), sample count (1) and error estimate (4); in a
-/// frame with motion also the centre ray's sweep (28) and the tones that the motion pass
-/// reads (16). The image as stored (at most 16 bytes a pixel: float RGBA) and the encoded
-/// file come after the sampler's buffers are freed. `render::sampler` checks this against the
-/// sizes of its buffers.
-pub const IMAGE_BYTES_PER_PIXEL: u64 = 32 + 16 + 4 + 12 + 4 + 1 + 4 + 28 + 16;
+/// what its lens and light points hang on (8) and whether the pixel's value does (1), the
+/// refined radiance (12), coverage (4), sample count (1) and error estimate (4); in a frame
+/// with motion also the centre ray's sweep (28) and the tones that the motion pass reads (16).
+/// The image as stored (at most 16 bytes a pixel: float RGBA) and the encoded file come after
+/// the sampler's buffers are freed. `render::sampler` checks this against the sizes of its
+/// buffers.
+pub const IMAGE_BYTES_PER_PIXEL: u64 = 32 + 16 + 4 + 8 + 1 + 12 + 4 + 1 + 4 + 28 + 16;
 
 /// The memory a scene or an image may take when neither `--max-memory` nor the machine says:
 /// 4 GiB.

@@ -411,6 +411,37 @@ impl Bvh {
         false
     }
 
+    /// Offers every leaf under nodes whose boxes `meets(min, max)` (conservatively) to
+    /// `visit`, until it returns true (then true): the walk of a query that is no ray, such
+    /// as a cone of shadow rays. Children are offered left to right.
+    pub fn any_meeting(
+        &self,
+        meets: impl Fn(Vec4, Vec4) -> bool,
+        mut visit: impl FnMut(&[u32]) -> bool,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let mut stack: ArrayVec<u32, STACK_SIZE> = ArrayVec::new();
+        stack.push(0);
+        while let Some(reference) = stack.pop() {
+            if reference & LEAF != 0 {
+                if visit(self.leaf(reference)) {
+                    return true;
+                }
+                continue;
+            }
+            let node = &self.nodes[reference as usize];
+            for slot in (0..usize::from(node.len)).rev() {
+                let lane = |v: &[Vec4; 3]| Vec4::new(v[0][slot], v[1][slot], v[2][slot], 0.0);
+                if meets(lane(&node.min), lane(&node.max)) {
+                    stack.push(node.child[slot]);
+                }
+            }
+        }
+        false
+    }
+
     /// Bytes held by the hierarchy.
     pub fn memory_bytes(&self) -> usize {
         self.nodes.capacity() * std::mem::size_of::<Node>() + self.prims.capacity() * 4

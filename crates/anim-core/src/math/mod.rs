@@ -1,7 +1,9 @@
-//! Rays, bounding boxes, transforms and the one place where secondary rays are offset.
+//! Rays, bounding boxes, transforms, the one place where secondary rays are offset, and the
+//! maps sampled integrals draw their points with (`sampling`).
 
 pub(crate) mod aabb;
 pub mod motion;
+pub mod sampling;
 mod transform;
 
 pub use aabb::{Aabb, SLAB_WIDEN};

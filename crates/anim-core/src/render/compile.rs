@@ -3,8 +3,9 @@
 //! [`RenderScene::intersect_camera_packet`] for a block of camera rays), what lies before a
 //! light ([`RenderScene::occlusion`]), how much of a light passes the glass on the way
 //! ([`RenderScene::transmittance`], pbrt's `Integrator::Tr`, Mitsuba's `ray_test` with its
-//! transmission), and what the moving shapes do to a shadow ray
-//! ([`RenderScene::moving_shadow`]). Each takes a hint of what the ray is ([`RayHint`], in the
+//! transmission), what the moving shapes do to a shadow ray
+//! ([`RenderScene::moving_shadow`]), and what a point sees of a spherical light as a whole
+//! ([`RenderScene::whole_light`]). Each takes a hint of what the ray is ([`RayHint`], in the
 //! manner of Mitsuba's `coherent` flag), which lets the scene answer it from the structure
 //! that serves it best, and the worker's [`Scratch`].
 //!
@@ -14,9 +15,9 @@
 //! are re-exported here.
 
 use super::counts::RayCounts;
-use super::geometry::{Aggregate, Candidates, Dropped, MovingScratch};
+use super::geometry::{Aggregate, Candidates, Cone, Dropped, MovingScratch};
 use super::policy::{GeometryPlan, ViewPlan};
-use super::shading::{ShadeMaterial, Shading};
+use super::shading::{LightDisc, ShadeMaterial, Shading};
 use super::view::{View, Viewpoint};
 use crate::math::Ray;
 use crate::scene::Scene;
@@ -50,6 +51,41 @@ pub enum Occlusion {
     /// composite: which of them it crosses, and how often, is for the caller to find out.
     Walk,
 }
+
+/// What a point sees of a spherical light as a whole ([`RenderScene::whole_light`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WholeLight {
+    /// All of it: nothing may meet a shadow ray towards any point of it.
+    Visible,
+    /// None of it: one opaque primitive meets every shadow ray towards it.
+    Hidden,
+    /// Neither is proven: its shadow rays are sampled.
+    Partial,
+}
+
+/// A point asking about a whole spherical light ([`RenderScene::whole_light`]).
+#[derive(Clone, Copy, Debug)]
+pub struct LightSight<'a> {
+    /// The surface point, as its closest hit found it.
+    pub hit: &'a SurfaceHit,
+    /// The primitive it lies on.
+    pub leaving: PrimId,
+    /// The shading normal there (turned to the incoming ray).
+    pub normal: Vec3A,
+    /// The light's number.
+    pub light: usize,
+    /// Its centre, at `time`.
+    pub centre: Vec3A,
+    /// Its radius.
+    pub radius: f32,
+    /// The instant of the exposure the question is asked at.
+    pub time: f32,
+}
+
+/// Convex opaque primitives among a light cone's candidates tried as the one that hides all
+/// of the light: the blocker that casts an umbra is mostly the first or the light's last
+/// blocker, and each try costs four ray tests.
+const HIDING_TRIES: usize = 2;
 
 /// Bound on surfaces a shadow ray may pass through (glass behind glass behind glass ...).
 const MAX_SHADOW_CROSSINGS: usize = 64;
@@ -458,6 +494,95 @@ impl RenderScene {
         let (ray, t_max) = (&shadow.ray, shadow.t_max);
         self.geometry
             .moving_blocks(ray, t_max, from, &mut scratch.moving)
+    }
+
+    /// What the point `sight.hit` sees of the spherical light `sight.light`, when that is
+    /// cheap to prove: all of it when nothing may meet the cone of shadow rays towards its
+    /// disc (docs/shading.md §2.1), none of it when one opaque convex primitive meets the
+    /// rays to the four corners of a square around the disc (every segment to the disc then
+    /// crosses the hull of those four hits, which lies inside the primitive). The light's last
+    /// blocker is tried first. A light not wholly above the point's horizon is `Partial`.
+    pub fn whole_light(&self, sight: &LightSight, scratch: &mut Scratch) -> WholeLight {
+        let hit = sight.hit;
+        let to = sight.centre - hit.point;
+        let dist = to.length();
+        if dist.partial_cmp(&sight.radius) != Some(std::cmp::Ordering::Greater) {
+            return WholeLight::Partial;
+        }
+        let axis = to / dist;
+        // Every shadow ray towards the disc leaves from here: it lies on one side.
+        let apex = hit.spawn_origin(axis);
+        let Some(cone) = Cone::new(apex, sight.centre, sight.radius) else {
+            return WholeLight::Partial;
+        };
+        if !cone.above(sight.normal) {
+            return WholeLight::Partial;
+        }
+        let geometry = &self.geometry;
+        let outward = sight.normal.dot(hit.normal) > 0.0;
+        let own = sight.leaving;
+        let skip_own = geometry.is_flat(own) || (outward && geometry.is_convex(own));
+        let disc = LightDisc::new(sight.centre, sight.radius, axis);
+        let Scratch {
+            last_blockers,
+            moving,
+            ..
+        } = scratch;
+        let mut last = last_blockers.get_mut(sight.light);
+        let hides =
+            |i: PrimId, moving: &mut MovingScratch| self.hides(i, apex, &disc, sight.time, moving);
+        // Only a convex opaque primitive that all four corner rays meet meets every ray
+        // between them.
+        let solid = |i: PrimId| geometry.is_convex(i) && self.material(i).opacity >= 1.0;
+        if let Some(b) = last.as_deref().and_then(LastBlocker::guess) {
+            if solid(b) && hides(b, moving) {
+                return WholeLight::Hidden;
+            }
+        }
+        let (mut met, mut tries, mut hidden) = (false, 0, false);
+        geometry.cone_candidates(&cone, |i| {
+            if skip_own && i == own {
+                return false;
+            }
+            met = true;
+            if !solid(i) || tries == HIDING_TRIES {
+                return tries == HIDING_TRIES;
+            }
+            tries += 1;
+            hidden = hides(i, moving);
+            if let Some(last) = last.as_deref_mut().filter(|_| hidden) {
+                last.blocked_by(i);
+            }
+            hidden
+        });
+        match (met, hidden) {
+            (false, _) => WholeLight::Visible,
+            (true, true) => WholeLight::Hidden,
+            (true, false) => WholeLight::Partial,
+        }
+    }
+
+    /// Whether primitive `i` meets the rays from `apex` to the four corners of a square a
+    /// little larger than the one around `disc` (sides along its two directions across),
+    /// each before its corner: the margin keeps the disc's rim, where it touches the square,
+    /// clear of rounding.
+    fn hides(
+        &self,
+        i: PrimId,
+        apex: Vec3A,
+        disc: &LightDisc,
+        time: f32,
+        moving: &mut MovingScratch,
+    ) -> bool {
+        const C: f32 = 1.0 + 1.0 / 64.0;
+        [(C, C), (C, -C), (-C, C), (-C, -C)]
+            .into_iter()
+            .all(|corner| {
+                let to = disc.at(corner) - apex;
+                let length = to.length();
+                let ray = Ray::new(apex, to / length).at_time(time);
+                self.geometry.hit(i, &ray, length, moving).is_some()
+            })
     }
 
     /// Bytes the scene's geometry and lookups hold (not materials or lights).

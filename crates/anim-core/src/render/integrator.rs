@@ -1,14 +1,17 @@
-//! Whitted-style shading: the local Phong model of docs/shading.md §2 with hard shadows, mirror
-//! reflection and Fresnel refraction. Every question about a ray goes to the compiled scene's
-//! facade (`super::compile::RenderScene`): closest hits, and for a shadow ray how much of
-//! its light passes ([`RenderScene::transmittance`]) or what the moving shapes alone do to it
-//! ([`RenderScene::moving_shadow`]).
+//! Whitted-style shading: the local Phong model of docs/shading.md §2 with shadows (soft under
+//! spherical lights, sampled at the point of the light the camera sample's pattern gives),
+//! spot lights, mirror reflection and Fresnel refraction. Every question about a ray goes to
+//! the compiled scene's facade (`super::compile::RenderScene`): closest hits, and for a
+//! shadow ray how much of its light passes ([`RenderScene::transmittance`]) or what the
+//! moving shapes alone do to it ([`RenderScene::moving_shadow`]), and what a point sees of a
+//! spherical light as a whole ([`RenderScene::whole_light`]).
 
 use super::camera::PinholeCamera;
 use super::compile::{
-    MovingShadow, PrimId, RayHint, RenderScene, Scratch, ShadowRay, SurfaceHit, NO_HIT,
+    LightSight, MovingShadow, PrimId, RayHint, RenderScene, Scratch, ShadowRay, SurfaceHit,
+    WholeLight, NO_HIT,
 };
-use super::shading::ShadeMaterial;
+use super::shading::{LightDisc, PointLight, ShadeMaterial};
 use crate::math::{reflect, Ray};
 use glam::Vec3A;
 
@@ -30,6 +33,15 @@ pub struct TraceState {
     /// Bit k: a shadow ray towards light k of the current camera sample's tree found it not
     /// fully visible (blocked, or through glass); [`CameraSample::not_clear`].
     not_clear: u32,
+    /// Per light, the point of the unit square at which the current camera sample samples
+    /// it if it is a sphere (set by the sampler, from the pixel's pattern); a light without
+    /// one here is sampled at its centre.
+    pub light_points: Vec<[f32; 2]>,
+    /// Whether spherical lights are asked as a whole first ([`RenderScene::whole_light`]).
+    whole_lights: bool,
+    /// Whether the current camera sample's tree sampled a spherical light it saw only in
+    /// part; [`CameraSample::penumbra`].
+    penumbra: bool,
 }
 
 /// What adaptive sampling's first pass learned about a pixel, handed to the integrator for
@@ -70,6 +82,10 @@ pub struct CameraSample {
     /// shapes the sample's rays may have met at some instant, where it was measured
     /// ([`Integrator::camera_sample_swept`]); 0 otherwise.
     pub swept: f32,
+    /// Whether, with spherical lights asked as a whole ([`TraceState::asking_whole_lights`]),
+    /// a point of the sample's tree saw one in part (or could not be shown to see all or
+    /// none of it): its radiance then depends on where the light is sampled.
+    pub penumbra: bool,
 }
 
 /// Where a camera hit of a frame with motion must lie for the lights the first pass's
@@ -110,6 +126,9 @@ impl Default for TraceState {
             scratch: Scratch::default(),
             shadow_cut: 0.0,
             not_clear: 0,
+            light_points: Vec::new(),
+            whole_lights: false,
+            penumbra: false,
         }
     }
 }
@@ -129,6 +148,27 @@ impl TraceState {
             ..TraceState::default()
         }
     }
+
+    /// For adaptive sampling's first pass: a spherical light is first asked as a whole
+    /// ([`RenderScene::whole_light`]), and its one shadow ray, where that proves nothing, goes
+    /// to its centre ([`CameraSample::penumbra`] says so).
+    pub fn asking_whole_lights() -> Self {
+        TraceState {
+            whole_lights: true,
+            ..TraceState::default()
+        }
+    }
+}
+
+/// What a camera sample finds of a spherical light before the glass walk
+/// (`Integrator::sphere_sight`).
+enum SphereSight {
+    /// All of it lights the point, without a shadow ray.
+    Lit,
+    /// None of it does.
+    Hidden,
+    /// The shadow ray to trace.
+    Ray(ShadowRay),
 }
 
 /// The lights taken as visible at a camera hit without a shadow ray ([`PixelPrior`]).
@@ -218,7 +258,7 @@ impl Integrator<'_> {
     }
 
     /// Radiance along a camera ray, with what the sampler knows of its pixel (`prior`).
-    #[inline]
+    #[inline(always)]
     pub fn camera_sample(
         &self,
         ray: &Ray,
@@ -228,6 +268,16 @@ impl Integrator<'_> {
         let hit = self
             .scene
             .intersect(ray, f32::INFINITY, RayHint::Camera, &mut st.scratch);
+        self.shade_camera_hit(ray, hit.as_ref(), prior, st)
+    }
+
+    /// [`Integrator::camera_sample`] of a camera ray that leaves a thin lens, not the eye the
+    /// scene was compiled for (docs/shading.md §1.1).
+    #[inline(never)]
+    pub fn lens_sample(&self, ray: &Ray, prior: &PixelPrior, st: &mut TraceState) -> CameraSample {
+        let hit = self
+            .scene
+            .intersect(ray, f32::INFINITY, RayHint::Secondary, &mut st.scratch);
         self.shade_camera_hit(ray, hit.as_ref(), prior, st)
     }
 
@@ -257,6 +307,7 @@ impl Integrator<'_> {
         st: &mut TraceState,
     ) -> CameraSample {
         st.not_clear = 0;
+        st.penumbra = false;
         let Some((prim, hit)) = hit else {
             return CameraSample {
                 radiance: self.scene.shading().background,
@@ -264,6 +315,7 @@ impl Integrator<'_> {
                 t: None,
                 not_clear: 0,
                 swept: 0.0,
+                penumbra: false,
             };
         };
         let known = self.known_at(prior, *prim, hit);
@@ -283,6 +335,7 @@ impl Integrator<'_> {
             t: Some(hit.t),
             not_clear: st.not_clear,
             swept: 0.0,
+            penumbra: st.penumbra,
         }
     }
 
@@ -382,7 +435,8 @@ impl Integrator<'_> {
         // `ks·spec` is exactly zero without a specular colour (spec is at most 1 for m ≥ 0).
         let specular = mat.ks != Vec3A::ZERO || mat.m < 0.0 || mat.m.is_nan();
         for (k, light) in shading.lights.iter().enumerate() {
-            let to_light = shading.light_position(k, light, time) - hit.point;
+            let centre = shading.light_position(k, light, time);
+            let to_light = centre - hit.point;
             let dist = to_light.length();
             if dist == 0.0 {
                 continue;
@@ -392,6 +446,14 @@ impl Integrator<'_> {
             if n_dot_l <= 0.0 {
                 continue;
             }
+            // A spot sends its intensity scaled by the direction to the point.
+            let intensity = match &light.spot {
+                None => light.intensity,
+                Some(spot) => match spot.factor(-l) {
+                    f if f > 0.0 => light.intensity * f,
+                    _ => continue,
+                },
+            };
             let spec = if specular {
                 let r_dot_v = reflect(-l, n).dot(v);
                 // powf(0, m) is 0 for every positive m: no call for the unlit half.
@@ -409,33 +471,141 @@ impl Integrator<'_> {
             if unshadowed == Vec3A::ZERO {
                 continue;
             }
-            let lit = light.intensity * unshadowed;
-            let shadow = || ShadowRay::new(hit, l, dist, time, k);
-            // A light known clear of what holds still is lit unless a moving shape, asked at
-            // the sample's instant, may block it; then the shadow ray is traced in full.
-            if lit.max_element() * weight < st.shadow_cut
-                || ((known.lights >> k.min(31)) & 1 != 0
-                    && !known.ask_moving.is_some_and(|leaving| {
-                        let moving = self
-                            .scene
-                            .moving_shadow(&shadow(), leaving, &mut st.scratch);
-                        moving != MovingShadow::Clear
-                    }))
-            {
-                c += lit;
-                continue;
-            }
+            let lit = intensity * unshadowed;
+            // One call of the glass walk for both kinds of light, as the point light had it.
+            let shadow = if light.radius == 0.0 {
+                let shadow = || ShadowRay::new(hit, l, dist, time, k);
+                if self.taken_as_lit(lit, weight, known, k, shadow, st) {
+                    c += lit;
+                    continue;
+                }
+                shadow()
+            } else {
+                let sight = LightSight {
+                    hit,
+                    leaving: at.prim,
+                    normal: n,
+                    light: k,
+                    centre,
+                    radius: light.radius,
+                    time,
+                };
+                match self.sphere_sight(&sight, l, light, (lit, weight, known), st) {
+                    SphereSight::Lit => {
+                        c += lit;
+                        continue;
+                    }
+                    SphereSight::Hidden => {
+                        st.not_clear |= 1 << k.min(31);
+                        continue;
+                    }
+                    SphereSight::Ray(shadow) => shadow,
+                }
+            };
             st.scratch.counts.shadow += 1;
-            let vis = self.scene.transmittance(&shadow(), &mut st.scratch);
+            let vis = self.scene.transmittance(&shadow, &mut st.scratch);
             if vis < 1.0 {
                 st.not_clear |= 1 << k.min(31);
             }
             if vis == 0.0 {
                 continue;
             }
-            c += light.intensity * vis * unshadowed;
+            c += intensity * vis * unshadowed;
         }
         c
+    }
+
+    /// What one camera sample finds of spherical light `light` (number `sight.light`, seen
+    /// from `sight.hit` along unit `l` to its centre): the shadow ray towards the point of
+    /// the light the sample draws (docs/shading.md §2.1), or `Lit` where `taken_as_lit` (given
+    /// `lit`, `weight` and `known`) needs none. Asking as a whole first
+    /// ([`TraceState::asking_whole_lights`]), a light all visible or all hidden takes no ray,
+    /// and one in part sends its ray to the centre, noted as a penumbra (and as not clear).
+    /// Not inlined: scenes without spherical lights keep the point-light path of `local` as
+    /// small as it was.
+    #[inline(never)]
+    fn sphere_sight(
+        &self,
+        sight: &LightSight,
+        l: Vec3A,
+        light: &PointLight,
+        (lit, weight, known): (Vec3A, f32, KnownLit),
+        st: &mut TraceState,
+    ) -> SphereSight {
+        let (k, centre) = (sight.light, sight.centre);
+        let sampled = self.light_point(k, light, centre, l, st);
+        let shadow = || self.towards(sight.hit, sampled, sight.time, k);
+        if self.taken_as_lit(lit, weight, known, k, shadow, st) {
+            return SphereSight::Lit;
+        }
+        let aim = if st.whole_lights {
+            match self.scene.whole_light(sight, &mut st.scratch) {
+                WholeLight::Visible => return SphereSight::Lit,
+                WholeLight::Hidden => return SphereSight::Hidden,
+                WholeLight::Partial => {
+                    st.penumbra = true;
+                    st.not_clear |= 1 << k.min(31);
+                    centre
+                }
+            }
+        } else {
+            sampled
+        };
+        let ray = self.towards(sight.hit, aim, sight.time, k);
+        // A point of the light below the surface's horizon is hidden by the surface itself.
+        if ray.ray.dir.dot(sight.normal).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return SphereSight::Hidden;
+        }
+        SphereSight::Ray(ray)
+    }
+
+    /// Whether light `k` is taken as visible without a shadow ray: its share `lit` (times the
+    /// pixel share `weight`) is below the shadow cut, or it is `known` clear of what holds
+    /// still and no moving shape, asked at the sample's instant along `shadow()`, may block it.
+    #[inline]
+    fn taken_as_lit(
+        &self,
+        lit: Vec3A,
+        weight: f32,
+        known: KnownLit,
+        k: usize,
+        shadow: impl Fn() -> ShadowRay,
+        st: &mut TraceState,
+    ) -> bool {
+        lit.max_element() * weight < st.shadow_cut
+            || ((known.lights >> k.min(31)) & 1 != 0
+                && !known.ask_moving.is_some_and(|leaving| {
+                    let moving = self
+                        .scene
+                        .moving_shadow(&shadow(), leaving, &mut st.scratch);
+                    moving != MovingShadow::Clear
+                }))
+    }
+
+    /// Where the current camera sample samples spherical light `k` (centre `centre`, seen
+    /// along unit `l`): the point of its disc that the sample's point of the unit square
+    /// maps to, or the centre when the sampler gave none.
+    #[inline]
+    fn light_point(
+        &self,
+        k: usize,
+        light: &PointLight,
+        centre: Vec3A,
+        l: Vec3A,
+        st: &TraceState,
+    ) -> Vec3A {
+        match st.light_points.get(k) {
+            Some(&uv) => LightDisc::new(centre, light.radius, l).sample(uv),
+            None => centre,
+        }
+    }
+
+    /// The shadow ray from `hit` towards point `to` of light `k`, at instant `time`.
+    #[inline]
+    fn towards(&self, hit: &SurfaceHit, to: Vec3A, time: f32, k: usize) -> ShadowRay {
+        let d = to - hit.point;
+        let dist = d.length();
+        ShadowRay::new(hit, d / dist, dist, time, k)
     }
 }
 
@@ -477,6 +647,8 @@ mod tests {
                 name: "top".into(),
                 position: DVec3::new(0.0, 5.0, 0.0),
                 intensity: Vec3::ONE,
+                radius: 0.0,
+                spot: None,
             }],
             ambient: Vec3::splat(0.2),
             ..Scene::default()

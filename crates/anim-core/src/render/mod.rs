@@ -97,6 +97,9 @@ impl<'j> Prepared<'j> {
             scene.transform_all(&Transform::translate(-eye));
             for light in &mut scene.lights {
                 light.position -= eye;
+                if let Some(spot) = &mut light.spot {
+                    spot.target -= eye;
+                }
             }
             let camera = Camera {
                 eye: DVec3::ZERO,
@@ -176,6 +179,7 @@ pub fn render_prepared(
         shutter: shutter.as_ref(),
         integrator: &integrator,
         size: (width as usize, height as usize),
+        draws: sampler::Draws::new(&camera, &integrator),
     };
     let sampled = sampler::render(&frame, sampling, on_pixels);
     let counts = sampled.rays;

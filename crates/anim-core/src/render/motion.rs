@@ -75,12 +75,27 @@ impl Shutter {
     /// (`limits::quantized_time`), so every thing of the scene is seen at one instant.
     #[inline]
     pub fn ray(&self, still: &PinholeCamera, x: f32, y: f32, time: f32) -> Ray {
+        self.placed(still, time)
+            .ray(x, y)
+            .at_time(quantized_time(time))
+    }
+
+    /// [`Shutter::ray`] from the point of the camera's lens that `uv` of the unit square maps
+    /// to (`PinholeCamera::lens_ray`).
+    #[inline]
+    pub fn lens_ray(&self, still: &PinholeCamera, x: f32, y: f32, time: f32, uv: [f32; 2]) -> Ray {
+        let camera = self.placed(still, time);
+        camera.lens_ray(x, y, uv).at_time(quantized_time(time))
+    }
+
+    /// The camera at the instant `time` is rounded to (`still` where it holds still, or is
+    /// degenerate then).
+    #[inline]
+    fn placed<'c>(&'c self, still: &'c PinholeCamera, time: f32) -> &'c PinholeCamera {
         let step = motion_step(time);
-        let camera = self
-            .at_step
+        self.at_step
             .get(step as usize)
             .and_then(Option::as_ref)
-            .unwrap_or(still);
-        camera.ray(x, y).at_time(quantized_time(time))
+            .unwrap_or(still)
     }
 }

@@ -1,9 +1,11 @@
-//! The shading part of a compiled scene: materials in f32 SIMD form, point lights (and where
-//! the moving ones are at an instant), the ambient light and the background, and the bounds
-//! the integrator stops rays by (docs/shading.md).
+//! The shading part of a compiled scene: materials in f32 SIMD form, lights (and where the
+//! moving ones are at an instant; the cone a spot shines into; the disc a spherical light
+//! shows a point), the ambient light and the background, and the bounds the integrator stops
+//! rays by (docs/shading.md).
 
+use crate::math::sampling::{concentric, orthonormal_pair};
 use crate::scene::motion::Motion;
-use crate::scene::{Material, Scene};
+use crate::scene::{Material, Scene, Spot};
 use glam::{DVec3, Vec3A};
 use std::sync::Arc;
 
@@ -45,13 +47,97 @@ impl ShadeMaterial {
     }
 }
 
-/// A point light: where it is (in the middle of the exposure, if it moves) and its intensity.
+/// A light: where it is (in the middle of the exposure, if it moves), its intensity, and the
+/// radius of the sphere it is (0 for a point) and the cone it shines into, if any.
 #[derive(Clone, Debug)]
 pub struct PointLight {
-    /// Where it is (camera-relative).
+    /// Where it is (camera-relative): the centre of its sphere.
     pub position: Vec3A,
     /// Brightness times colour, per channel.
     pub intensity: Vec3A,
+    /// The radius of its sphere; 0 for a point light.
+    pub radius: f32,
+    /// The cone of a spot light.
+    pub spot: Option<SpotCone>,
+}
+
+/// The cone a spot light shines into (docs/shading.md §2.2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpotCone {
+    /// The unit direction of its axis, from the light towards its target.
+    pub axis: Vec3A,
+    /// The cosine of the half-angle inside which it shines in full.
+    pub cos_inner: f32,
+    /// The cosine of the half-angle beyond which it does not shine.
+    pub cos_outer: f32,
+}
+
+impl SpotCone {
+    /// The cone of `spot`, for a light at `position`.
+    fn new(spot: &Spot, position: DVec3) -> SpotCone {
+        let axis = (spot.target - position).normalize_or_zero();
+        SpotCone {
+            axis: Vec3A::from(axis.as_vec3()),
+            cos_inner: spot.inner_deg.to_radians().cos() as f32,
+            cos_outer: spot.outer_deg.to_radians().cos() as f32,
+        }
+    }
+
+    /// The share of the light's intensity sent along unit direction `dir` (from the light):
+    /// 1 inside the inner cone, 0 outside the outer one, and between them smoothstep of the
+    /// cosine, as pbrt's and POV-Ray's spot lights fall off.
+    #[inline]
+    pub fn factor(&self, dir: Vec3A) -> f32 {
+        let cos = self.axis.dot(dir);
+        if cos >= self.cos_inner {
+            return 1.0;
+        }
+        if cos <= self.cos_outer {
+            return 0.0;
+        }
+        let t = (cos - self.cos_outer) / (self.cos_inner - self.cos_outer);
+        t * t * (3.0 - 2.0 * t)
+    }
+}
+
+/// The disc a spherical light of `radius` about `centre` shows from a point in direction
+/// `axis` (unit, from the point to the centre): a sphere of even brightness looks like an
+/// evenly bright disc across the line of sight. Its points are those of the unit disc, taken
+/// across `axis` (docs/shading.md §2.1).
+#[derive(Clone, Copy, Debug)]
+pub struct LightDisc {
+    /// The centre of the light.
+    pub centre: Vec3A,
+    /// The radius of the light.
+    pub radius: f32,
+    /// Two unit vectors across the line of sight, at right angles to each other.
+    pub across: [Vec3A; 2],
+}
+
+impl LightDisc {
+    /// The disc of a light of `radius` about `centre`, seen along unit direction `axis`.
+    #[inline]
+    pub fn new(centre: Vec3A, radius: f32, axis: Vec3A) -> LightDisc {
+        LightDisc {
+            centre,
+            radius,
+            across: orthonormal_pair(axis),
+        }
+    }
+
+    /// The point of the disc at `(u, v)` of the unit disc.
+    #[inline]
+    pub fn at(&self, (u, v): (f32, f32)) -> Vec3A {
+        self.centre + (self.across[0] * u + self.across[1] * v) * self.radius
+    }
+
+    /// The point of the disc that the point `uv` of the unit square maps to (Shirley and
+    /// Chiu's concentric map, which keeps strata of the square strata of the disc, of even
+    /// area).
+    #[inline]
+    pub fn sample(&self, uv: [f32; 2]) -> Vec3A {
+        self.at(concentric(uv))
+    }
 }
 
 /// Materials, lights, ambient and background of a compiled scene.
@@ -87,6 +173,8 @@ impl Shading {
             .map(|l| PointLight {
                 position: l.position.as_vec3().into(),
                 intensity: l.intensity.into(),
+                radius: l.radius as f32,
+                spot: l.spot.as_ref().map(|s| SpotCone::new(s, l.position)),
             })
             .collect();
         let ambient: Vec3A = scene.ambient.into();
@@ -122,6 +210,11 @@ impl Shading {
         }
     }
 
+    /// Whether some light is a sphere (of radius above 0).
+    pub fn any_spherical(&self) -> bool {
+        self.lights.iter().any(|l| l.radius > 0.0)
+    }
+
     /// Whether a light moves during the exposure.
     pub fn lights_move(&self) -> bool {
         self.light_motion.is_some()
@@ -144,4 +237,49 @@ fn light_at((motion, positions): &(Arc<Motion>, Vec<DVec3>), k: usize, time: f32
         .get(k)
         .map_or(DVec3::ZERO, |&p| motion.light_position(k, p, time as f64));
     Vec3A::from(p.as_vec3())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_spot_shines_in_full_inside_its_inner_cone_and_not_at_all_outside_its_outer_one() {
+        let spot = Spot {
+            target: DVec3::new(0.0, -1.0, 0.0),
+            inner_deg: 20.0,
+            outer_deg: 40.0,
+        };
+        let cone = SpotCone::new(&spot, DVec3::ZERO);
+        let at = |deg: f32| {
+            let r = deg.to_radians();
+            cone.factor(Vec3A::new(r.sin(), -r.cos(), 0.0))
+        };
+        assert_eq!(at(0.0), 1.0);
+        assert_eq!(at(19.9), 1.0);
+        assert_eq!(at(40.1), 0.0);
+        assert_eq!(at(90.0), 0.0);
+        // Halfway in cosine, smoothstep is one half; it falls all the way between.
+        let mid = ((20f32.to_radians().cos() + 40f32.to_radians().cos()) / 2.0).acos();
+        assert!((at(mid.to_degrees()) - 0.5).abs() < 1e-4);
+        let falls = (20..=40).map(|d| at(d as f32)).collect::<Vec<_>>();
+        assert!(falls.windows(2).all(|w| w[1] <= w[0]), "{falls:?}");
+    }
+
+    #[test]
+    fn a_disc_lies_across_its_axis() {
+        for axis in [
+            Vec3A::X,
+            Vec3A::NEG_Z,
+            Vec3A::new(0.3, -0.4, 0.866).normalize(),
+        ] {
+            let disc = LightDisc::new(Vec3A::new(1.0, 2.0, 3.0), 0.5, axis);
+            let [e1, e2] = disc.across;
+            assert!(e1.dot(axis).abs() < 1e-6 && e2.dot(axis).abs() < 1e-6);
+            assert!(e1.dot(e2).abs() < 1e-6);
+            assert!((e1.length() - 1.0).abs() < 1e-6 && (e2.length() - 1.0).abs() < 1e-6);
+            let rim = disc.sample([1.0, 0.5]);
+            assert!(((rim - disc.centre).length() - 0.5).abs() < 1e-5);
+        }
+    }
 }

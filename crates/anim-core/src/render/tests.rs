@@ -64,11 +64,15 @@ fn base_scene() -> Scene {
                 name: "a".into(),
                 position: DVec3::new(5.0, 10.0, 0.0),
                 intensity: Vec3::splat(1.2),
+                radius: 0.0,
+                spot: None,
             },
             Light {
                 name: "b".into(),
                 position: DVec3::new(-8.0, 4.0, -2.0),
                 intensity: Vec3::new(0.3, 0.3, 0.6),
+                radius: 0.0,
+                spot: None,
             },
         ],
         ambient: Vec3::splat(0.4),
@@ -114,6 +118,8 @@ fn perfect_mirror_shows_the_mirrored_configuration() {
         name: "l".into(),
         position: DVec3::new(2.0, 6.0, z),
         intensity: Vec3::splat(1.5),
+        radius: 0.0,
+        spot: None,
     };
     let in_front = Scene {
         materials: vec![ball.clone(), mirror],
@@ -197,6 +203,7 @@ fn total_internal_reflection_is_not_black() {
         eye: DVec3::ZERO,
         dir: DVec3::new(0.0, angle.sin(), -angle.cos()),
         up: DVec3::Y,
+        lens: None,
     };
     let img = render(&job(scene, cam, 3, 3));
     assert_eq!(film::to_rgb8(&img)[12..15], [128, 0, 0]);
@@ -216,6 +223,8 @@ fn no_pixel_is_ever_nan_or_infinite() {
         name: "on".into(),
         position: DVec3::new(0.5, 1.0, -8.0),
         intensity: Vec3::ONE,
+        radius: 0.0,
+        spot: None,
     });
     for eye in [DVec3::ZERO, DVec3::new(-1.0, 0.0, -6.0)] {
         let cam = Camera {
@@ -274,6 +283,8 @@ fn shadow_through_glass_is_attenuated_per_surface_crossed() {
             name: "l".into(),
             position: DVec3::new(0.0, 10.0, 0.0),
             intensity: Vec3::splat(2.0),
+            radius: 0.0,
+            spot: None,
         }],
         ambient: Vec3::splat(0.5),
         background: Vec3::ZERO,
@@ -285,6 +296,7 @@ fn shadow_through_glass_is_attenuated_per_surface_crossed() {
         eye: DVec3::new(0.0, 1.0, 5.0),
         dir: DVec3::new(0.0, -1.0, -5.0),
         up: DVec3::Y,
+        lens: None,
     };
     let img = render(&job(scene, cam, 3, 3));
     let expected = Vec3::splat(0.2 * 0.5) + Vec3::new(0.6, 0.4, 0.2) * (2.0 * 0.25);
@@ -386,6 +398,8 @@ fn an_opaque_blocker_above_glass_casts_a_full_shadow() {
             name: "l".into(),
             position: DVec3::new(0.0, 10.0, 0.0),
             intensity: Vec3::splat(2.0),
+            radius: 0.0,
+            spot: None,
         }],
         ambient: Vec3::splat(0.5),
         background: Vec3::ZERO,
@@ -397,6 +411,7 @@ fn an_opaque_blocker_above_glass_casts_a_full_shadow() {
         eye: DVec3::new(0.0, 1.0, 5.0),
         dir: DVec3::new(0.0, -1.0, -5.0),
         up: DVec3::Y,
+        lens: None,
     };
     let img = render(&job(scene, cam, 3, 3));
     let expected = Vec3::splat(0.2 * 0.5);

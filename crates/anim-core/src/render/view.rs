@@ -70,17 +70,27 @@ impl View {
             Lookup::Cells => Some(Candidacy::Cells(cells(v.view.eye))),
             Lookup::Tiles => ImageTiles::new(v.view, v.size, n, bound, pad).map(Candidacy::Tiles),
         });
+        // A spherical light's shadow rays end all over its disc, away from the centre the
+        // lookups are built around: the geometry's own strategy answers them.
+        let point = |l: &&PointLight| l.radius == 0.0;
         let lights = match plan.lights {
             Lookup::None => Vec::new(),
             Lookup::Cells => lights
                 .iter()
-                .map(|l| Some(Candidacy::Cells(cells(l.position))))
+                .map(|l| {
+                    Some(l)
+                        .filter(point)
+                        .map(|l| Candidacy::Cells(cells(l.position)))
+                })
                 .collect(),
             Lookup::Tiles => {
                 let all = (0..n).fold(Aabb::EMPTY, |all, i| all.union(bound(i)));
                 lights
                     .iter()
-                    .map(|l| ImageTiles::around(l.position, &all, n, bound, pad))
+                    .map(|l| {
+                        let tiles = Some(l).filter(point);
+                        tiles.and_then(|l| ImageTiles::around(l.position, &all, n, bound, pad))
+                    })
                     .map(|t| t.map(Candidacy::Tiles))
                     .collect()
             }

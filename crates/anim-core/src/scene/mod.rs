@@ -178,19 +178,58 @@ impl Names {
     }
 }
 
-/// A point light, already in world space. Intensity is brightness · colour.
+/// A light, already in world space: a point, or a sphere about it, shining everywhere or
+/// into a cone (docs/shading.md §2). Intensity is brightness · colour.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Light {
     /// The name its definition gives it.
     pub name: String,
-    /// Where the light is, in world space.
+    /// Where the light is (the centre of its sphere), in world space.
     pub position: DVec3,
     /// `I_l` of the shading model per channel, not limited to [0, 1]; it does not fall off
     /// with distance.
     pub intensity: Vec3,
+    /// The radius of the sphere it is; 0 for a point light.
+    pub radius: f64,
+    /// The cone a spot light shines into; `None` for a light that shines everywhere.
+    pub spot: Option<Spot>,
 }
 
-/// A pinhole camera in world space (its transforms already applied). `dir` and `up` need not
+impl Light {
+    /// A point light shining everywhere.
+    pub fn point(name: &str, position: DVec3, intensity: Vec3) -> Light {
+        Light {
+            name: name.to_string(),
+            position,
+            intensity,
+            radius: 0.0,
+            spot: None,
+        }
+    }
+}
+
+/// The cone of a spot light, in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spot {
+    /// A point on the cone's axis, away from the light.
+    pub target: DVec3,
+    /// The half-angle inside which the light shines in full, in degrees.
+    pub inner_deg: f64,
+    /// The half-angle beyond which it does not shine, in degrees (at least `inner_deg`).
+    pub outer_deg: f64,
+}
+
+/// A camera's thin lens (docs/shading.md §1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lens {
+    /// The radius of the aperture, in scene units; above 0 (a camera without a lens is a
+    /// pinhole).
+    pub aperture: f64,
+    /// How far in front of the eye, along the view direction, the plane in focus lies.
+    pub focus: f64,
+}
+
+/// A camera in world space (its transforms already applied). `dir` and `up` need not
 /// be unit length or orthogonal; the renderer re-orthonormalises them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
@@ -204,10 +243,12 @@ pub struct Camera {
     pub dir: DVec3,
     /// The direction that shows as up in the image, in world space.
     pub up: DVec3,
+    /// Its thin lens; `None` for a pinhole camera.
+    pub lens: Option<Lens>,
 }
 
 impl Camera {
-    /// At the origin, looking along −z, y up.
+    /// At the origin, looking along −z, y up; a pinhole.
     pub fn default_with_fov(name: &str, fov_x_deg: f64) -> Self {
         Camera {
             name: name.to_string(),
@@ -215,6 +256,7 @@ impl Camera {
             eye: DVec3::ZERO,
             dir: DVec3::NEG_Z,
             up: DVec3::Y,
+            lens: None,
         }
     }
 }

@@ -430,7 +430,7 @@ pub enum StatementKind {
         /// The shapes and composites it groups, as listed.
         children: Vec<NameRef>,
     },
-    /// `define light`: a named point light.
+    /// `define light`: a named point light (spherical with a radius, a spot with a cone).
     Light(LightDef),
     /// Sets the scene's ambient light.
     Ambient(Vec3),
@@ -451,6 +451,8 @@ pub enum StatementKind {
     Render(RenderDef),
     /// A thing's motion while the shutter is open (docs/scene-language.md §10).
     Motion(MotionDef),
+    /// `lens`: a camera's thin lens (docs/scene-language.md §6.1).
+    Lens(LensDef),
 }
 
 /// A material as its line defines it, its extras read by the material layout (each field as
@@ -475,7 +477,8 @@ pub struct MaterialDef {
     pub ior: f32,
 }
 
-/// A point light; intensity = brightness · colour.
+/// A point light; intensity = brightness · colour. With a radius it is a sphere of that
+/// radius about its position, with a spot it shines into a cone (docs/scene-language.md §5).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightDef {
     /// The name it defines.
@@ -486,6 +489,33 @@ pub struct LightDef {
     pub color: Vec3,
     /// The factor the colour is scaled by.
     pub brightness: f32,
+    /// The radius of the sphere it is (scene units); 0 for a point.
+    pub radius: f64,
+    /// The cone it shines into, if it is a spot.
+    pub spot: Option<SpotDef>,
+}
+
+/// The cone of a spot light: `spot [target] <inner-deg> <outer-deg>`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpotDef {
+    /// The point the cone's axis runs through, before the light's transforms.
+    pub target: DVec3,
+    /// The half-angle of full intensity, in degrees.
+    pub inner_deg: f64,
+    /// The half-angle at which the intensity has fallen to zero, in degrees (at least
+    /// `inner_deg`).
+    pub outer_deg: f64,
+}
+
+/// `lens <camera> <aperture> <focus>`: a camera's thin lens.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LensDef {
+    /// The camera it belongs to.
+    pub camera: NameRef,
+    /// The radius of the aperture (scene units); 0 for a pinhole.
+    pub aperture: f64,
+    /// How far in front of the eye, along the view direction, the plane in focus lies.
+    pub focus: f64,
 }
 
 /// A camera as its line defines it, before its transforms (`crate::scene::Camera` is the
@@ -635,14 +665,24 @@ impl fmt::Display for StatementKind {
                 }
                 Ok(())
             }
-            StatementKind::Light(l) => write!(
-                f,
-                "define light {} {} {} {}",
-                l.name,
-                v3(l.position),
-                c3(l.color),
-                Num32(l.brightness)
-            ),
+            StatementKind::Light(l) => {
+                write!(
+                    f,
+                    "define light {} {} {} {}",
+                    l.name,
+                    v3(l.position),
+                    c3(l.color),
+                    Num32(l.brightness)
+                )?;
+                if l.radius != 0.0 {
+                    write!(f, " radius {}", Num(l.radius))?;
+                }
+                if let Some(s) = &l.spot {
+                    let (inner, outer) = (Num(s.inner_deg), Num(s.outer_deg));
+                    write!(f, " spot {} {inner} {outer}", v3(s.target))?;
+                }
+                Ok(())
+            }
             StatementKind::Ambient(rgb) => write!(f, "ambient {}", c3(*rgb)),
             // There is no canonical "add" statement: a light named like this with zero
             // intensity in the lecture's 9-number form carries the ambient contribution.
@@ -667,6 +707,13 @@ impl fmt::Display for StatementKind {
                 write!(f, "motion {} {}", m.target.name, Num(m.at))?;
                 write_ops(f, &m.ops)
             }
+            StatementKind::Lens(l) => write!(
+                f,
+                "lens {} {} {}",
+                l.camera.name,
+                Num(l.aperture),
+                Num(l.focus)
+            ),
             StatementKind::Render(r) => {
                 write!(
                     f,

@@ -38,6 +38,7 @@ fn names(kind: &StatementKind) -> Vec<&str> {
         StatementKind::Ambient(_) | StatementKind::AmbientAdd(_) => vec![AMBIENT],
         StatementKind::Background(_) => vec![BACKGROUND],
         StatementKind::Camera(c) => vec![&c.name],
+        StatementKind::Lens(l) => vec![&l.camera.name],
         StatementKind::Transform { target, .. } => vec![&target.name],
         StatementKind::Motion(m) => vec![&m.target.name],
         StatementKind::Render(r) => vec![RENDER, &r.camera.name],

@@ -15,6 +15,7 @@
 //! same two questions.
 
 mod closest;
+mod cone;
 mod instancing;
 mod leaf;
 mod listed;
@@ -24,6 +25,7 @@ mod packet;
 pub mod primitive;
 
 pub(crate) use closest::Candidates;
+pub use cone::Cone;
 pub use motion::{MovingScratch, MovingShadow};
 pub use primitive::{Primitive, SurfaceHit};
 

@@ -489,6 +489,11 @@ impl Primitive {
         }
     }
 
+    /// The shape, when it is baked into world space.
+    pub fn world_shape(&self) -> Option<&Shape> {
+        self.object.is_none().then_some(&self.shape)
+    }
+
     /// The box, when this is one baked into world space (the render scene slab-tests those
     /// four at a time).
     pub fn world_box(&self) -> Option<&AaBox> {

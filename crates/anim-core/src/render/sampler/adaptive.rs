@@ -83,9 +83,10 @@ impl Adaptive<'_> {
         }
     }
 
-    /// Sample `i` of pixel (x, y)'s own pattern: its radiance, and whether it hit a surface.
-    /// The first `PRIOR_SAMPLES` take what `prior` knows of the lights; the others trace
-    /// every shadow ray.
+    /// Sample `i` of pixel (x, y)'s own pattern (its position, and its instant, lens point
+    /// and light points where the frame has them): its radiance, and whether it hit a
+    /// surface. The first `PRIOR_SAMPLES` take what `prior` knows of the lights; the others
+    /// trace every shadow ray.
     fn sample(
         &self,
         (x, y): (usize, usize),
@@ -97,14 +98,18 @@ impl Adaptive<'_> {
         let (dx, dy) = pattern.sample(i);
         let (px, py) = (x as f32 + dx, y as f32 + dy);
         let frame = self.frame;
-        let ray = match frame.shutter {
-            None => frame.camera.ray(px, py),
-            Some(s) => s.ray(frame.camera, px, py, pattern.time(i)),
-        };
         let prior = if i < PRIOR_SAMPLES {
             prior
         } else {
             &PixelPrior::NONE
+        };
+        if frame.draws.any() {
+            let time = frame.shutter.map(|_| pattern.time(i));
+            return frame.trace_drawing((px, py), time, (pattern, i), prior, st);
+        }
+        let ray = match frame.shutter {
+            None => frame.camera.ray(px, py),
+            Some(s) => s.ray(frame.camera, px, py, pattern.time(i)),
         };
         let sample = frame.integrator.camera_sample(&ray, prior, st);
         (sample.radiance, sample.t.is_some())

@@ -1,14 +1,18 @@
 //! Adaptive sampling's first pass: one ray through every pixel centre (exactly `--spp 1`),
 //! and what the later passes read of it: which pixels are flat and keep their centre sample
 //! ([`FirstPass::refinement`]), and what a refined pixel's samples may take as known of the
-//! lights ([`FirstPass::prior`]).
+//! lights ([`FirstPass::prior`]). Where the frame's samples draw lens or light points, the
+//! centres take the pinhole and ask spherical lights as a whole, and a pixel whose value
+//! hangs on those points (a penumbra, a blur) is refined.
 
+use super::defocus::{self, Centre};
 use super::motion::{streak_pairs, MotionProbe};
 use super::packet;
 use super::pattern::{tone3, FLAT_CONTRAST};
 use super::Frame;
+use crate::math::Ray;
 use crate::render::counts::RayCounts;
-use crate::render::integrator::{KnownNear, PixelPrior, TraceState};
+use crate::render::integrator::{CameraSample, KnownNear, PixelPrior, TraceState};
 use crate::render::motion::Shutter;
 use glam::Vec3A;
 use rayon::prelude::*;
@@ -38,6 +42,16 @@ impl Default for Sweep {
     }
 }
 
+/// What a centre's samples draw hangs on, as the first pass saw it.
+#[derive(Clone, Copy, Debug, Default)]
+struct Mark {
+    /// Its tree saw a spherical light in part (`CameraSample::penumbra`).
+    penumbra: bool,
+    /// The radius of the lens's circle of confusion at its hit, negative nearer than the
+    /// plane in focus (`PinholeCamera::blur`).
+    blur: f32,
+}
+
 /// What the first pass saw, per pixel (row-major).
 pub(super) struct FirstPass<'f> {
     frame: &'f Frame<'f>,
@@ -55,6 +69,11 @@ pub(super) struct FirstPass<'f> {
     /// depth of their hits (a frame with motion whose lights hold still and whose moving
     /// shapes are few enough to ask at each sample's instant).
     known_of_still: bool,
+    /// What each centre's lens and light points hang on (zeros where nothing is drawn).
+    marks: Vec<Mark>,
+    /// Whether a pixel's value hangs on its lens or light points: a penumbra around it, or a
+    /// blur that reaches it (`defocus`). Empty when the frame draws none.
+    spread: Vec<bool>,
 }
 
 impl<'f> FirstPass<'f> {
@@ -69,13 +88,41 @@ impl<'f> FirstPass<'f> {
             not_clear: vec![u32::MAX; w * h],
             known_of_still: frame.shutter.is_some_and(|s| !s.lights_move())
                 && frame.integrator.scene.plan().0.ask_moving,
+            marks: vec![Mark::default(); w * h],
+            spread: Vec::new(),
         };
         let counts = match frame.shutter {
             None => pass.trace_still(),
             Some(s) => pass.trace_moving(s),
         };
         pass.tones = pass.centres.par_iter().map(|(c, _)| tone3(*c)).collect();
+        if frame.draws.any() {
+            pass.spread = pass.spread_pixels();
+        }
         (pass, counts)
+    }
+
+    /// Per pixel, whether its value hangs on its lens or light points: a centre around it
+    /// saw a spherical light in part, or the lens's blur reaches it.
+    fn spread_pixels(&self) -> Vec<bool> {
+        let (w, h) = self.frame.size;
+        let mut spread = if self.frame.draws.lens() {
+            defocus::blurred((w, h), |i| Centre {
+                blur: self.marks[i].blur,
+                prim: self.centres[i].1,
+                tone: self.tones[i],
+            })
+        } else {
+            vec![false; w * h]
+        };
+        if self.frame.draws.spherical_lights() {
+            for (i, out) in spread.iter_mut().enumerate() {
+                let (x, y) = (i % w, i / w);
+                *out =
+                    *out || around(x, y, (w, h)).any(|r| self.marks[r].iter().any(|m| m.penumbra));
+            }
+        }
+        spread
     }
 
     /// The centres of a frame in which nothing moves, a row at a time (in packets where the
@@ -86,19 +133,22 @@ impl<'f> FirstPass<'f> {
         self.centres
             .par_chunks_mut(w)
             .zip(self.not_clear.par_chunks_mut(w))
+            .zip(self.marks.par_chunks_mut(w))
             .enumerate()
-            .map(|(y, (row, not_clear_row))| {
-                let mut st = TraceState::default();
+            .map(|(y, ((row, not_clear_row), mark_row))| {
+                let mut st = trace_state(frame);
                 if packet::trace_centres(frame, y, row, not_clear_row, &mut st) {
                     return st.scratch.counts;
                 }
-                for (x, (px, nc)) in row.iter_mut().zip(not_clear_row).enumerate() {
+                let pixels = row.iter_mut().zip(not_clear_row).zip(mark_row);
+                for (x, ((px, nc), mk)) in pixels.enumerate() {
                     let ray = frame.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
                     let sample = frame
                         .integrator
                         .camera_sample(&ray, &PixelPrior::NONE, &mut st);
                     *px = (sample.radiance, sample.prim);
                     *nc = sample.not_clear;
+                    *mk = mark(frame, &ray, &sample);
                 }
                 st.scratch.counts.primary += row.len() as u64;
                 st.scratch.counts
@@ -124,11 +174,16 @@ impl<'f> FirstPass<'f> {
             .par_chunks_mut(w)
             .zip(self.sweeps.par_chunks_mut(w))
             .zip(self.not_clear.par_chunks_mut(w))
+            .zip(self.marks.par_chunks_mut(w))
             .enumerate()
-            .map(|(y, ((row, sweep_row), not_clear_row))| {
-                let mut st = TraceState::default();
-                let pixels = row.iter_mut().zip(sweep_row).zip(not_clear_row);
-                for (x, ((px, sw), nc)) in pixels.enumerate() {
+            .map(|(y, (((row, sweep_row), not_clear_row), mark_row))| {
+                let mut st = trace_state(frame);
+                let pixels = row
+                    .iter_mut()
+                    .zip(sweep_row)
+                    .zip(not_clear_row)
+                    .zip(mark_row);
+                for (x, (((px, sw), nc), mk)) in pixels.enumerate() {
                     let (x, y) = (x as u32, y as u32);
                     let ray = frame.camera.ray(x as f32 + 0.5, y as f32 + 0.5);
                     let sample =
@@ -136,6 +191,7 @@ impl<'f> FirstPass<'f> {
                             .integrator
                             .camera_sample_swept(&ray, &PixelPrior::NONE, &mut st);
                     *px = (sample.radiance, sample.prim);
+                    *mk = mark(frame, &ray, &sample);
                     let swept = sample.swept;
                     if shadows_hold && (of_still || swept == 0.0) {
                         *nc = sample.not_clear;
@@ -155,10 +211,12 @@ impl<'f> FirstPass<'f> {
     }
 
     /// Whether pixel (x, y) is refined, and if so the largest tone-mapped difference (8-bit
-    /// levels) between its centre and those around it and whether motion touches it; `None`
-    /// if it is flat and keeps its centre sample. Flat: all nine centres around it hit one
-    /// surface within `FLAT_CONTRAST` levels, no centre ray around it met something moving,
-    /// and under a moving camera the image is flat along its streak.
+    /// levels) between its centre and those around it and whether motion (or a penumbra, or
+    /// a blur: [`FirstPass::spread_pixels`]) touches it; `None` if it is flat and keeps its
+    /// centre sample. Flat: all nine centres around it hit one surface within
+    /// `FLAT_CONTRAST` levels, no centre ray around it met something moving, under a moving
+    /// camera the image is flat along its streak, and its value hangs on no lens or light
+    /// point.
     pub fn refinement(&self, x: usize, y: usize) -> Option<(f32, bool)> {
         let (w, h) = self.frame.size;
         let prim = self.centres[y * w + x].1;
@@ -187,6 +245,9 @@ impl<'f> FirstPass<'f> {
             Some(Some(ends)) => self.streak(x, y, ends),
         };
         other_surface |= streak.other_surface;
+        // A pixel whose value hangs on its lens or light points spreads its samples over more
+        // dimensions than its position, as one that motion touches does over time.
+        moving |= self.spread.get(y * w + x).copied().unwrap_or(false);
         let flat = !moving && !other_surface && 255.0 * contrast.max(streak.bias) <= FLAT_CONTRAST;
         (!flat).then_some((255.0 * contrast.max(streak.contrast), moving))
     }
@@ -267,6 +328,27 @@ impl<'f> FirstPass<'f> {
     }
 }
 
+/// A worker's trace state for the centres of `frame`: spherical lights asked as a whole.
+fn trace_state(frame: &Frame) -> TraceState {
+    if frame.draws.spherical_lights() {
+        TraceState::asking_whole_lights()
+    } else {
+        TraceState::default()
+    }
+}
+
+/// What centre `sample` of `frame` (of the pinhole ray `ray`) hangs on.
+fn mark(frame: &Frame, ray: &Ray, sample: &CameraSample) -> Mark {
+    let blur = match sample.t {
+        Some(t) if frame.draws.lens() => frame.camera.blur(ray.at(t)),
+        _ => 0.0,
+    };
+    Mark {
+        penumbra: sample.penumbra,
+        blur,
+    }
+}
+
 /// What the pixels along a streak show ([`FirstPass::streak`]), in tone-mapped units.
 #[derive(Clone, Copy, Debug, Default)]
 struct Streak {
@@ -298,7 +380,11 @@ mod tests {
     /// buffer the adaptive sampler keeps per pixel at its peak.
     #[test]
     fn the_budget_per_pixel_covers_the_sampler_s_buffers() {
-        let first_pass = size_of::<(Vec3A, u32)>() + size_of::<Vec3A>() + size_of::<u32>();
+        let first_pass = size_of::<(Vec3A, u32)>()
+            + size_of::<Vec3A>()
+            + size_of::<u32>()
+            + size_of::<Mark>()
+            + size_of::<bool>();
         let refined =
             size_of::<glam::Vec3>() + size_of::<f32>() + size_of::<u8>() + size_of::<f32>();
         let motion = size_of::<Sweep>() + size_of::<Vec3A>();

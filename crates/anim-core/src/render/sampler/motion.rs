@@ -254,6 +254,7 @@ mod tests {
             eye: eye.into(),
             dir: dir.into(),
             up: [0.0, 1.0, 0.0].into(),
+            lens: None,
         };
         PinholeCamera::new(&cam, 64, 36).expect("a camera")
     }

@@ -25,9 +25,10 @@ pub(super) const BLOCK: usize = (BLOCK_W * BLOCK_H) as usize;
 const ROW_RUN: usize = 8;
 
 /// Whether the camera rays of `frame` are traced in packets (the scene's plan says whether
-/// its hierarchy is deep enough for it to pay).
+/// its hierarchy is deep enough for it to pay): not where its samples draw lens or light
+/// points, which are the pixel's own.
 pub(super) fn packets_apply(frame: &Frame) -> bool {
-    frame.shutter.is_none() && frame.integrator.scene.plan().1.camera_packets
+    frame.shutter.is_none() && frame.integrator.scene.plan().1.camera_packets && !frame.draws.any()
 }
 
 /// Each camera ray's radiance and primitive, and in `not_clear` the lights some shadow ray

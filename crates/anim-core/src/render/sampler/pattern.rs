@@ -9,6 +9,12 @@
 //!
 //! The error of a pixel is estimated for its tone-mapped mean in 8-bit levels, the quantity
 //! the output is judged in, so the target `--error` means the same on dark and bright pixels.
+//!
+//! A sample's other dimensions (the instant of the exposure, the point of the lens, the
+//! point of each spherical light) come from the same pixel's sequence: the instant is the
+//! third Sobol dimension, and each 2D pair is the first two dimensions again at a shuffled
+//! index ([`PixelPattern::pair`]), as Burley ("Practical hash-based Owen scrambling", 2020)
+//! pads a sequence: stratified like the pixel position, and not correlated with it.
 
 use crate::util::mix64;
 use glam::Vec3A;
@@ -48,6 +54,14 @@ const EDGE_ERROR_SHARE: f32 = 0.2;
 
 pub use crate::render::film::{tone, tone3};
 
+/// The dimension pair of a thin lens ([`PixelPattern::pair`]).
+pub const LENS_PAIR: u32 = 0;
+
+/// The dimension pair of light `k` ([`PixelPattern::pair`]).
+pub fn light_pair(k: usize) -> u32 {
+    u32::try_from(k).map_or(u32::MAX, |k| k.saturating_add(1))
+}
+
 /// The scramble of one pixel: one key per dimension, derived from the pixel position alone.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PixelPattern {
@@ -78,6 +92,28 @@ impl PixelPattern {
             None => sobol3(i).reverse_bits(),
         };
         to_unit(owen_scramble_reversed(t, self.keys[2]))
+    }
+
+    /// Point `i` of this pixel's dimension pair `pair` (one per thin lens or light: see
+    /// [`LENS_PAIR`], [`light_pair`]), in [0,1)². The first two Sobol dimensions at index
+    /// `j`, a nested scramble of `i` read from its highest bit down, keyed by the pixel and
+    /// the pair: the first `2^m` indices go to the `2^m` of one aligned block, in some order,
+    /// and every aligned block of a (0,2)-sequence is a (0,m,2)-net, so every power-of-two
+    /// prefix is stratified as the pixel positions are; the shuffle pairs the strata of one
+    /// pair with those of another (and of the position) differently in every pixel.
+    pub fn pair(&self, i: u32, pair: u32) -> [f32; 2] {
+        let key = |salt: u64| {
+            mix64(self.keys[0] ^ mix64(u64::from(pair) << 8 | salt ^ 0x9a1d_5eed_0fa1_b2c3))
+        };
+        let j = owen_scramble_reversed(i.reverse_bits(), key(0));
+        let b = match SOBOL_TABLE.get(j as usize) {
+            Some(&[b, _]) => b,
+            None => sobol2(j).1.reverse_bits(),
+        };
+        [
+            to_unit(owen_scramble_reversed(j, key(1))),
+            to_unit(owen_scramble_reversed(b, key(2))),
+        ]
     }
 
     /// Sample `i` of this pixel, in [0,1)².
@@ -347,6 +383,56 @@ mod tests {
                 }
                 assert!(seen.iter().all(|&c| c == 1), "m={m} a={a}");
             }
+        }
+    }
+
+    #[test]
+    fn every_prefix_of_a_dimension_pair_is_a_net_for_all_interval_shapes() {
+        for (x, y) in [(0, 0), (5, 9), (639, 359)] {
+            let p = PixelPattern::new(x, y);
+            for pair in [LENS_PAIR, light_pair(0), light_pair(7)] {
+                for m in 0..=8u32 {
+                    for a in 0..=m {
+                        let (cx, cy) = (1u32 << a, 1u32 << (m - a));
+                        let mut seen = vec![0u32; (cx * cy) as usize];
+                        for i in 0..1u32 << m {
+                            let [u, v] = p.pair(i, pair);
+                            assert!((0.0..1.0).contains(&u) && (0.0..1.0).contains(&v));
+                            seen[(cell(v, cy) * cx + cell(u, cx)) as usize] += 1;
+                        }
+                        assert!(
+                            seen.iter().all(|&c| c == 1),
+                            "({x},{y}) pair {pair} m={m} a={a}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn dimension_pairs_are_not_tied_to_the_position_or_to_each_other() {
+        // Were a pair tied to the pixel position (or to another pair), the half of the pixel
+        // a sample falls in would fix the half of the lens or the light it takes. Over many
+        // pixels and samples, each half of one meets each half of the other about as often.
+        let mut same = [0u32; 2];
+        let mut total = 0u32;
+        for y in 0..32 {
+            for x in 0..32 {
+                let p = PixelPattern::new(x, y);
+                for i in 0..16 {
+                    let (u, _) = p.sample(i);
+                    let [lens, _] = p.pair(i, LENS_PAIR);
+                    let [light, _] = p.pair(i, light_pair(0));
+                    same[0] += u32::from((u < 0.5) == (lens < 0.5));
+                    same[1] += u32::from((lens < 0.5) == (light < 0.5));
+                    total += 1;
+                }
+            }
+        }
+        for s in same {
+            let share = s as f32 / total as f32;
+            assert!((share - 0.5).abs() < 0.03, "{share}");
         }
     }
 

@@ -3,7 +3,7 @@
 //! with motion, at instants of the exposure stratified per pixel (`pattern::uniform_time`).
 
 use super::packet::{self, BLOCK, BLOCK_H, BLOCK_W};
-use super::pattern::uniform_time;
+use super::pattern::{uniform_time, PixelPattern};
 use super::{coverage, Frame, Sampled};
 use crate::math::Ray;
 use crate::render::compile::NO_HIT;
@@ -109,13 +109,19 @@ fn render_band(
 
 /// Pixel (`x`, `y`) ray by ray: the mean of its samples at `offsets` (in a frame with
 /// motion, at the instants `uniform_time` gives them), added in that order, as the camera
-/// packets add theirs, and its coverage. Does not count the camera rays.
+/// packets add theirs, and its coverage. Does not count the camera rays. Always inlined: its
+/// two callers are the hot loops of uniform sampling, and the drawing path beside it would
+/// otherwise tip the compiler into a call per pixel.
+#[inline(always)]
 pub(super) fn uniform_pixel(
     frame: &Frame,
     (x, y): (u32, u32),
     offsets: &[(f32, f32)],
     st: &mut TraceState,
 ) -> (Vec3, f32) {
+    if frame.draws.any() {
+        return drawing_pixel(frame, (x, y), offsets, st);
+    }
     let (mut sum, mut hits) = (Vec3A::ZERO, 0u32);
     for (i, &(dx, dy)) in offsets.iter().enumerate() {
         let (px, py) = (x as f32 + dx, y as f32 + dy);
@@ -148,6 +154,30 @@ fn exposure_ray(
     (i, n): (u32, u32),
 ) -> Ray {
     shutter.ray(frame.camera, px, py, uniform_time(x, y, i, n))
+}
+
+/// [`uniform_pixel`] of a frame whose samples draw lens and light points: sample `i` draws
+/// them as the pixel's pattern gives them by index. Apart, and not inlined, so that frames
+/// that draw none keep the loop above as small as it was.
+#[inline(never)]
+fn drawing_pixel(
+    frame: &Frame,
+    (x, y): (u32, u32),
+    offsets: &[(f32, f32)],
+    st: &mut TraceState,
+) -> (Vec3, f32) {
+    let (mut sum, mut hits) = (Vec3A::ZERO, 0u32);
+    let n = offsets.len() as u32;
+    let pattern = PixelPattern::new(x, y);
+    for (i, &(dx, dy)) in (0..).zip(offsets) {
+        let (px, py) = (x as f32 + dx, y as f32 + dy);
+        let time = frame.shutter.map(|_| uniform_time(x, y, i, n));
+        let prior = &PixelPrior::NONE;
+        let (radiance, hit) = frame.trace_drawing((px, py), time, (&pattern, i), prior, st);
+        sum += radiance;
+        hits += u32::from(hit);
+    }
+    (Vec3::from(sum * (1.0 / n as f32)), coverage(hits, n))
 }
 
 /// Sub-pixel sample positions in [0,1)²: a k×k stratified grid when `n = k²`, otherwise a

@@ -2,10 +2,12 @@
 //! did not come through the reader.
 
 use super::{At, Builder};
+use crate::diag::Severity;
 use crate::limits::{clamp_fraction, fov_is_valid, FOV_RULE};
 use crate::scene::{Geometry, Material};
 use crate::sdf::ast::{
-    CameraDef, LightDef, MaterialDef, MotionDef, NameRef, Statement, StatementKind, TransformOp,
+    CameraDef, LensDef, LightDef, MaterialDef, MotionDef, NameRef, Statement, StatementKind,
+    TransformOp,
 };
 use crate::sdf::repair;
 use crate::shape::geometry::{is_zero, parallel};
@@ -50,6 +52,8 @@ pub(super) struct Definitions<'s> {
     pub(super) camera_index: HashMap<&'s str, usize>,
     pub(super) lights: Vec<&'s LightDef>,
     pub(super) light_index: HashMap<&'s str, usize>,
+    /// Camera name → its lens (the last `lens` line of the camera).
+    pub(super) lenses: HashMap<&'s str, &'s LensDef>,
     pub(super) ambient: Vec3,
     pub(super) background: Vec3,
 }
@@ -83,7 +87,29 @@ impl Builder<'_> {
             .collect();
         let fallback_of = self.undefined_materials(&mut d, &undefined);
         self.resolve_names(&mut d, statements, &first, &fallback_of);
+        self.resolve_lenses(&mut d);
         d
+    }
+
+    /// Drops the lenses of names that are no camera of the file (reported, unless the
+    /// camera's own line was rejected).
+    fn resolve_lenses(&mut self, d: &mut Definitions) {
+        let mut unknown: Vec<&NameRef> = d
+            .lenses
+            .values()
+            .map(|l| &l.camera)
+            .filter(|c| !d.camera_index.contains_key(c.name.as_str()))
+            .collect();
+        unknown.sort_by_key(|c| (c.loc.line, c.loc.col));
+        for camera in unknown {
+            d.lenses.remove(camera.name.as_str());
+            if self.skipped(&camera.name) {
+                continue;
+            }
+            let help = self.name_help(&camera.name, d.camera_index.keys().copied());
+            let message = format!("lens of `{}`, which is no camera of this file", camera.name);
+            self.at_ref(Severity::Error, camera, message, help);
+        }
     }
 
     /// Every definition of `statements`, final versions, with shapes' materials and
@@ -147,8 +173,24 @@ impl Builder<'_> {
                     self.define_object(&mut d, object);
                 }
                 StatementKind::Light(l) => {
+                    if !self.from_reader && !self.light_ok(l, stmt) {
+                        continue;
+                    }
                     let (items, names) = (&mut d.lights, &mut d.light_index);
                     self.define_named(stmt, "light", &l.name, l, items, names);
+                }
+                StatementKind::Lens(l) => {
+                    let usable = l.aperture >= 0.0 && l.focus > 0.0;
+                    if !self.from_reader && !usable {
+                        let message = "a lens needs an aperture of at least 0 and a focus above 0";
+                        self.error(At::Name(stmt), message.to_string(), None);
+                    } else if d.lenses.insert(&l.camera.name, l).is_some() {
+                        let message = format!(
+                            "camera `{}` already has a lens; the later line replaces it",
+                            l.camera.name
+                        );
+                        self.warn(At::Name(stmt), message, None);
+                    }
                 }
                 StatementKind::Camera(c) => {
                     if !self.from_reader && !self.camera_ok(c, stmt) {
@@ -359,6 +401,28 @@ impl Builder<'_> {
         out
     }
 
+    /// Checks a light made by a program (the parser checks those it reads): a radius of at
+    /// least 0, a spot's target away from the light and its angles in order.
+    fn light_ok(&mut self, l: &LightDef, stmt: &Statement) -> bool {
+        let spot_ok = l.spot.is_none_or(|s| {
+            s.target != l.position
+                && 0.0 <= s.inner_deg
+                && s.inner_deg <= s.outer_deg
+                && 0.0 < s.outer_deg
+                && s.outer_deg <= 180.0
+        });
+        if l.radius >= 0.0 && spot_ok {
+            return true;
+        }
+        let message = format!(
+            "light `{}` needs a radius of at least 0 and, as a spot, a target away from it and \
+             half-angles 0 ≤ inner ≤ outer ≤ 180 (outer above 0)",
+            l.name
+        );
+        self.error(At::Name(stmt), message, None);
+        false
+    }
+
     /// Checks a camera made by a program (the parser checks those it reads).
     pub(super) fn camera_ok(&mut self, c: &CameraDef, stmt: &Statement) -> bool {
         let problem = if !fov_is_valid(c.fov_x_deg) {
@@ -399,7 +463,16 @@ pub(super) fn finite_statement(kind: &StatementKind) -> bool {
                 && m.ior.is_finite()
         }
         StatementKind::Shape { geometry, .. } => geometry.is_finite(),
-        StatementKind::Light(l) => v(&l.position) && c(&l.color) && l.brightness.is_finite(),
+        StatementKind::Light(l) => {
+            v(&l.position)
+                && c(&l.color)
+                && l.brightness.is_finite()
+                && l.radius.is_finite()
+                && l.spot.is_none_or(|s| {
+                    v(&s.target) && s.inner_deg.is_finite() && s.outer_deg.is_finite()
+                })
+        }
+        StatementKind::Lens(l) => l.aperture.is_finite() && l.focus.is_finite(),
         StatementKind::Ambient(rgb)
         | StatementKind::AmbientAdd(rgb)
         | StatementKind::Background(rgb) => c(rgb),

@@ -11,7 +11,7 @@ use crate::limits::MAX_WALK;
 use crate::limits::{self, DEFAULT_IMAGE_SIZE, MAX_NESTING};
 use crate::math::Transform;
 use crate::scene::{
-    Camera, Geometry, Instance, Instanced, Light, Names, RenderJob, Scene, NO_NAME,
+    Camera, Geometry, Instance, Instanced, Lens, Light, Names, RenderJob, Scene, Spot, NO_NAME,
 };
 use crate::sdf::ast::{CameraDef, NameRef, Statement, StatementKind};
 use crate::sdf::default_output;
@@ -108,7 +108,7 @@ impl Builder<'_> {
                         continue;
                     }
                     let camera = match d.cameras.first() {
-                        Some(c) => place_camera(c, snapshot),
+                        Some(c) => place_camera(c, d, snapshot),
                         None => Camera::default_with_fov("default", limits::DEFAULT_FOV_DEG),
                     };
                     let output = default_output(self.path);
@@ -145,7 +145,7 @@ impl Builder<'_> {
         snapshot: &Snapshot,
     ) -> Option<Camera> {
         match d.camera_index.get(name.name.as_str()) {
-            Some(&i) => Some(place_camera(d.cameras[i], snapshot)),
+            Some(&i) => Some(place_camera(d.cameras[i], d, snapshot)),
             None => {
                 if !self.skipped(&name.name) {
                     let help = self
@@ -210,10 +210,18 @@ impl Builder<'_> {
                     .get(&(Space::Light, l.name.as_str()))
                     .copied()
                     .unwrap_or_default();
+                // The target is a point the light's transforms carry with it; the radius and
+                // the angles are as written.
                 Light {
                     name: l.name.clone(),
                     position: t.point(l.position),
                     intensity: l.color * l.brightness,
+                    radius: l.radius,
+                    spot: l.spot.map(|s| Spot {
+                        target: t.point(s.target),
+                        inner_deg: s.inner_deg,
+                        outer_deg: s.outer_deg,
+                    }),
                 }
             })
             .collect::<Vec<Light>>();
@@ -674,17 +682,24 @@ const DOUBLING: &str =
 /// How to allow a bigger scene.
 const RAISE: &str = "--max-memory raises the limit";
 
-/// A camera definition with its transform applied: the eye as a point, dir and up as vectors.
-pub(super) fn place_camera(c: &CameraDef, snapshot: &Snapshot) -> Camera {
+/// A camera definition with its transform applied (the eye as a point, dir and up as
+/// vectors) and its lens, if the definitions `d` give it one of some aperture. The lens is
+/// in scene units as written: a transform places the camera, not its optics.
+pub(super) fn place_camera(c: &CameraDef, d: &Definitions, snapshot: &Snapshot) -> Camera {
     let t = snapshot
         .get(&(Space::Camera, c.name.as_str()))
         .copied()
         .unwrap_or_default();
+    let lens = d.lenses.get(c.name.as_str()).filter(|l| l.aperture > 0.0);
     Camera {
         name: c.name.clone(),
         fov_x_deg: c.fov_x_deg,
         eye: t.point(c.eye),
         dir: t.vector(c.dir),
         up: t.vector(c.up),
+        lens: lens.map(|l| Lens {
+            aperture: l.aperture,
+            focus: l.focus,
+        }),
     }
 }

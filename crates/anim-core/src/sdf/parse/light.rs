@@ -1,11 +1,15 @@
 //! Lights, ambient light and the background colour.
 
 use super::{At, Fail, PResult, Parser};
-use crate::sdf::ast::{LightDef, StatementKind};
+use crate::diag::suggest;
+use crate::sdf::ast::{LightDef, SpotDef, StatementKind};
 use crate::sdf::lexer::{looks_numeric, Line};
 use glam::{DVec3, Vec3};
 
 const FORM_LIGHT: &str = "define light <name> [pos] [color] <brightness>";
+const FORM_CLAUSES: &str = "define light <name> [pos] [color] <brightness> [radius <r>] [spot [target] <inner-deg> <outer-deg>]";
+/// The words that may follow a point light's numbers, each with its own.
+const CLAUSES: [&str; 2] = ["radius", "spot"];
 const FORM_AMBIENT_LIGHT: &str = "define light ambient <name> [rgb]";
 const FORM_AMBIENT: &str = "ambient [rgb]";
 const FORM_BACKGROUND: &str = "background [rgb]";
@@ -23,15 +27,23 @@ impl LightNumbers<'_> {
         Vec3::new(nums[i] as f32, nums[i + 1] as f32, nums[i + 2] as f32)
     }
 
-    /// The light at the position of the first three numbers, with `color` and `brightness`.
+    /// The point light at the position of the first three numbers, with `color` and
+    /// `brightness`.
     fn light(&self, color: Vec3, brightness: f32) -> LightDef {
-        let nums = self.nums;
         LightDef {
             name: self.name.to_string(),
-            position: DVec3::new(nums[0], nums[1], nums[2]),
+            position: self.position(),
             color,
             brightness,
+            radius: 0.0,
+            spot: None,
         }
+    }
+
+    /// The first three numbers.
+    fn position(&self) -> DVec3 {
+        let nums = self.nums;
+        DVec3::new(nums[0], nums[1], nums[2])
     }
 }
 
@@ -89,7 +101,10 @@ impl Parser<'_> {
             ));
         };
         let name = name_tok.text.to_string();
-        let nums = self.numbers(line, name_at + 1, toks.len())?;
+        let clauses_at = (name_at + 1..toks.len())
+            .find(|&i| CLAUSES.contains(&toks[i].text))
+            .unwrap_or(toks.len());
+        let nums = self.numbers(line, name_at + 1, clauses_at)?;
         if let Some(worst) = nums
             .iter()
             .skip(3)
@@ -99,7 +114,7 @@ impl Parser<'_> {
         {
             self.warn(
                 line,
-                At::Span(name_at + 4, toks.len() - 1),
+                At::Span(name_at + 4, clauses_at - 1),
                 format!("light `{name}` has a negative colour or brightness ({worst}): it takes light away"),
                 Some("colours lie between 0 and 1, brightness is at least 0".to_string()),
             );
@@ -108,6 +123,9 @@ impl Parser<'_> {
             name: &name,
             nums: &nums,
         };
+        if clauses_at < toks.len() {
+            return self.light_with_clauses(line, (name_at, clauses_at), &numbers);
+        }
         match nums.len() {
             10 => self.lecture_light_with_brightness(line, name_at, &numbers),
             7 => {
@@ -205,21 +223,166 @@ impl Parser<'_> {
 
     /// `[pos] <radius> [color] <brightness>`: a spherical light of renderers with soft shadows.
     /// The fourth number cannot be a colour component and the next three can, so the layout
-    /// is clear; the radius has no point-light meaning.
+    /// is clear.
     fn light_with_radius(&mut self, line: &Line, name_at: usize, numbers: &LightNumbers) {
-        let l = numbers.light(numbers.color(4), numbers.nums[7] as f32);
+        let l = LightDef {
+            radius: numbers.nums[3].abs(),
+            ..numbers.light(numbers.color(4), numbers.nums[7] as f32)
+        };
         self.variant(
             line,
             At::Tok(name_at + 4),
             "light-radius",
             format!(
-                "8-number light read as [pos] <radius> [color] <brightness>: a point \
-                 light at its centre, the radius {} is ignored",
-                numbers.nums[3]
+                "8-number light read as [pos] <radius> [color] <brightness>: a spherical \
+                 light of radius {}",
+                l.radius
             ),
             format!("read as `{}`", StatementKind::Light(l.clone())),
         );
         self.emit_named(line, name_at, StatementKind::Light(l));
+    }
+
+    /// A point light's 6 or 7 numbers (`numbers`) followed by `radius` and `spot` clauses
+    /// from token `clauses_at` on.
+    fn light_with_clauses(
+        &mut self,
+        line: &Line,
+        (name_at, clauses_at): (usize, usize),
+        numbers: &LightNumbers,
+    ) -> PResult<()> {
+        let brightness = match numbers.nums.len() {
+            6 => 1.0,
+            7 => numbers.nums[6] as f32,
+            n => {
+                return Err(self.error(
+                    line,
+                    At::Tok(clauses_at),
+                    format!(
+                    "`{}` follows the 7 numbers [pos] [color] <brightness>, found {n} before it",
+                    line.tokens[clauses_at].text
+                ),
+                    Some(format!("canonical form: `{FORM_CLAUSES}`")),
+                ))
+            }
+        };
+        let mut l = numbers.light(numbers.color(3), brightness);
+        let mut seen = [false; CLAUSES.len()];
+        let mut i = clauses_at;
+        while i < line.tokens.len() {
+            let to = Self::number_run_end(line, i + 1);
+            let word = line.tokens[i].text;
+            let Some(k) = CLAUSES.iter().position(|&c| c == word) else {
+                let hint = suggest(word, CLAUSES).map(|s| format!("did you mean `{s}`?"));
+                return Err(self.error(
+                    line,
+                    At::Tok(i),
+                    format!("expected `radius` or `spot`, found '{word}'"),
+                    hint.or_else(|| Some(format!("canonical form: `{FORM_CLAUSES}`"))),
+                ));
+            };
+            if std::mem::replace(&mut seen[k], true) {
+                return Err(self.error(
+                    line,
+                    At::Tok(i),
+                    format!("a light takes one `{word}`"),
+                    Some(format!("canonical form: `{FORM_CLAUSES}`")),
+                ));
+            }
+            let nums = self.numbers(line, i + 1, to)?;
+            if k == 0 {
+                l.radius = self.light_radius(line, i, &nums)?;
+            } else {
+                l.spot = Some(self.spot(line, i, &nums, l.position)?);
+            }
+            i = to;
+        }
+        self.emit_named(line, name_at, StatementKind::Light(l));
+        Ok(())
+    }
+
+    /// The numbers `nums` after `radius` (token `at`): one radius, read as its size when
+    /// negative.
+    fn light_radius(&mut self, line: &Line, at: usize, nums: &[f64]) -> PResult<f64> {
+        let [r] = nums[..] else {
+            return Err(self.error(
+                line,
+                if nums.is_empty() {
+                    At::Tok(at)
+                } else {
+                    At::Span(at + 1, at + nums.len())
+                },
+                format!(
+                    "`radius` takes 1 number (the light's radius), found {}",
+                    nums.len()
+                ),
+                Some(format!("canonical form: `{FORM_CLAUSES}`")),
+            ));
+        };
+        if r < 0.0 {
+            self.warn(
+                line,
+                At::Tok(at + 1),
+                format!("negative light radius {r}: read as {}", -r),
+                None,
+            );
+        }
+        Ok(r.abs())
+    }
+
+    /// The numbers `nums` after `spot` (token `at`) of a light at `position`: a target and
+    /// two half-angles, 0 ≤ inner ≤ outer ≤ 180 with outer above 0.
+    fn spot(&mut self, line: &Line, at: usize, nums: &[f64], position: DVec3) -> PResult<SpotDef> {
+        let help = || Some(format!("canonical form: `{FORM_CLAUSES}`"));
+        let [x, y, z, inner_deg, outer_deg] = nums[..] else {
+            return Err(self.error(
+                line,
+                if nums.is_empty() {
+                    At::Tok(at)
+                } else {
+                    At::Span(at + 1, at + nums.len())
+                },
+                format!(
+                    "`spot` takes 5 numbers ([target] <inner-deg> <outer-deg>), found {}",
+                    nums.len()
+                ),
+                help(),
+            ));
+        };
+        let target = DVec3::new(x, y, z);
+        if target == position {
+            return Err(self.error(
+                line,
+                At::Span(at + 1, at + 3),
+                "a spot's target must differ from the light's position (it gives the direction)",
+                help(),
+            ));
+        }
+        let angles = At::Span(at + 4, at + 5);
+        if !(0.0..=180.0).contains(&inner_deg)
+            || !(0.0..=180.0).contains(&outer_deg)
+            || outer_deg == 0.0
+        {
+            return Err(self.error(
+                line,
+                angles,
+                format!("a spot's half-angles lie from 0 to 180 degrees, the outer above 0: found {inner_deg} and {outer_deg}"),
+                help(),
+            ));
+        }
+        if inner_deg > outer_deg {
+            return Err(self.error(
+                line,
+                angles,
+                format!("a spot's inner half-angle ({inner_deg}) is larger than its outer one ({outer_deg})"),
+                Some("full intensity inside the inner half-angle, none beyond the outer: write the inner one first".into()),
+            ));
+        }
+        Ok(SpotDef {
+            target,
+            inner_deg,
+            outer_deg,
+        })
     }
 
     /// Four numbers, no position: the only meaning left is an ambient term, colour ×
@@ -363,6 +526,7 @@ mod tests {
         assert_eq!(l[0].position, DVec3::new(0.0, 100.0, 0.0));
         assert_eq!(l[0].color, Vec3::new(1.0, 0.5, 1.0));
         assert_eq!(l[0].brightness, 0.7);
+        assert_eq!(l[0].radius, 10.0);
         assert!(ds.iter().all(|d| d.severity == Severity::Warning), "{ds:?}");
         assert!(ds.iter().any(|d| d.message.contains("<radius> [color]")));
         let (_, ds) = lights(text, true);
@@ -375,5 +539,44 @@ mod tests {
         let (l, ds) = lights("define light l 0 1 0 0.5 1 1 1 0.7\n", false);
         assert!(l.is_empty());
         assert!(ds.iter().any(|d| d.severity == Severity::Error), "{ds:?}");
+    }
+
+    #[test]
+    fn radius_and_spot_clauses_read_back_as_written_in_either_order() {
+        let canonical = "define light l 0 5 0 1 1 1 2 radius 0.5 spot 0 0 -1 20 30";
+        for text in [
+            canonical,
+            "define light l 0 5 0 1 1 1 2 spot 0 0 -1 20 30 radius 0.5",
+        ] {
+            let (l, ds) = lights(&format!("{text}\n"), true);
+            assert!(ds.is_empty(), "{ds:?}");
+            assert_eq!(l[0].radius, 0.5);
+            let spot = l[0].spot.expect("a spot");
+            assert_eq!(spot.target, DVec3::new(0.0, 0.0, -1.0));
+            assert_eq!((spot.inner_deg, spot.outer_deg), (20.0, 30.0));
+            assert_eq!(StatementKind::Light(l[0].clone()).to_string(), canonical);
+        }
+        // Six numbers (brightness 1) take clauses too; a radius of 0 is a point light.
+        let (l, ds) = lights("define light l 0 5 0 1 1 1 radius 0\n", true);
+        assert!(ds.is_empty(), "{ds:?}");
+        assert_eq!((l[0].brightness, l[0].radius), (1.0, 0.0));
+        let text = StatementKind::Light(l[0].clone()).to_string();
+        assert_eq!(text, "define light l 0 5 0 1 1 1 1");
+    }
+
+    #[test]
+    fn a_transform_carries_a_spot_s_target_with_the_light() {
+        let text = "define light l 0 5 0 1 1 1 1 spot 0 0 0 10 20 radius 1\n\
+                    transform l translate 3 0 0\n\
+                    define camera c 60\nrender c o.png 4 4\n";
+        let loaded = crate::load::load_str(text, Path::new("s.sdf"), &LoadOptions::default())
+            .expect("loads");
+        let light = &loaded.jobs[0].scene.lights[0];
+        assert_eq!(light.position, DVec3::new(3.0, 5.0, 0.0));
+        assert_eq!(
+            light.spot.map(|s| s.target),
+            Some(DVec3::new(3.0, 0.0, 0.0))
+        );
+        assert_eq!(light.radius, 1.0);
     }
 }

@@ -11,6 +11,7 @@ mod camera;
 mod dialect;
 mod include;
 mod layout;
+mod lens;
 mod light;
 mod material;
 mod motion;
@@ -33,12 +34,13 @@ use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use std::sync::Arc;
 
-const STATEMENT_KEYWORDS: [&str; 7] = [
+const STATEMENT_KEYWORDS: [&str; 8] = [
     "define",
     "include",
     "transform",
     "render",
     "camera",
+    "lens",
     "ambient",
     "background",
 ];
@@ -582,6 +584,7 @@ impl Parser<'_> {
             "ambient" => self.ambient(line, 1),
             "background" => self.background(line, 1),
             "motion" => self.motion(line),
+            "lens" => self.lens(line),
             "include" => self.include(line),
             other => {
                 let help = if other.starts_with("<<<<<<<")
