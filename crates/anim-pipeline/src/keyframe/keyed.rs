@@ -1,6 +1,6 @@
 //! Keyed values written into a frame's definitions: a camera's pose, field of view and lens, a
-//! light's brightness, colour, radius and spot cone, a material's colours and coefficients, the ambient and
-//! background colours, and which shapes and composites are shown.
+//! light's brightness, colour, radius and spot cone, a material's colours and coefficients,
+//! the ambient and background colours, and which shapes and composites are shown.
 
 use super::base::BaseScene;
 use super::orbit::Pose;

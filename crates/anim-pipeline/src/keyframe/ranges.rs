@@ -1,9 +1,10 @@
 //! Values that must stay in range between keys: a scale that would pass through 0 (and turn
 //! its object inside out), a field of view outside 0–180°, a negative brightness, an opacity
 //! or reflectivity outside 0–1, an index of refraction at or below 0, a negative radius or
-//! aperture, a spot's half-angle outside 0–180°, a focus distance at or below 0. Keys are checked where
-//! they are written; curves that overshoot (Catmull-Rom, Back, Elastic) can leave the range
-//! between them, so every frame's span of time is checked too, not only its instant.
+//! aperture, a spot's half-angle outside 0–180°, a focus distance at or below 0. Keys are
+//! checked where they are written; curves that overshoot (Catmull-Rom, Back, Elastic) can
+//! leave the range between them, so every frame's span of time is checked too, not only its
+//! instant.
 
 use super::expr::Val;
 use super::interp::Keyable;
