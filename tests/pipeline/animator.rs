@@ -501,6 +501,8 @@ fn the_new_example_specs_generate_frames_that_load_without_warnings() {
         "candle.ron",
         "rig.ron",
         "flythrough.ron",
+        "rack.ron",
+        "penumbra.ron",
     ] {
         let out = tempfile::tempdir().unwrap();
         let (ok, stderr) = generate(&repo().join("animations").join(spec), out.path());

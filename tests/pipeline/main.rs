@@ -19,6 +19,8 @@
 //!   check that says what `anim check` would.
 //! - `timing`: keys at `Frames(n)`, fractional frame rates, `--frames A..B`.
 //! - `layering`: tracks on one value combined by `blend`, or refused without it.
+//! - `optics`: keyed light radii, spot cones and lenses, `focus: Object` (a rack focus), and
+//!   their example shots rendered and encoded.
 //! - `rigs`: paths at constant speed, `orient: AlongPath`, parents.
 //! - `tangents`: a key's `in` and `out` sides, and the clamped spline `Auto`.
 //! - `shots`: the example shots of round two (candle, rig, flythrough) do what they show.
@@ -40,6 +42,7 @@ mod holds;
 mod incremental;
 mod keyframe_spec;
 mod layering;
+mod optics;
 mod rigs;
 mod service;
 mod shots;

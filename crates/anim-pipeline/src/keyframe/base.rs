@@ -196,9 +196,14 @@ impl SceneNames for BaseScene {
                 (StatementKind::Light(l), _) if l.name == target => match channel {
                     "brightness" => num(f64::from(l.brightness)),
                     "color" => vec(l.color),
+                    "radius" => num(l.radius),
+                    "inner" => l.spot.and_then(|s| num(s.inner_deg)),
+                    "outer" => l.spot.and_then(|s| num(s.outer_deg)),
                     _ => None,
                 },
                 (StatementKind::Camera(c), "fov") if c.name == target => num(c.fov_x_deg),
+                (StatementKind::Lens(l), "aperture") if l.camera.name == target => num(l.aperture),
+                (StatementKind::Lens(l), "focus") if l.camera.name == target => num(l.focus),
                 (StatementKind::Material(m), _) if m.name == target => match channel {
                     "ka" => vec(m.ka),
                     "kd" => vec(m.kd),

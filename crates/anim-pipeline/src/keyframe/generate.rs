@@ -20,7 +20,7 @@ use super::motion::{self, TrackPose};
 use super::orbit::{self, Pose};
 use super::placement::Placer;
 use super::ranges;
-use super::spec_file::{Animation, Source, TargetKind};
+use super::spec_file::{Animation, Focus, Source, TargetKind, Track};
 use super::split::{Split, STATIC_FILE};
 use super::tidy::tidy;
 use anim_core::diag::{Diagnostic, Loc};
@@ -104,6 +104,28 @@ impl<'a> Generator<'a> {
         Some(pose.map_err(|why| vec![self.src.error(&[path], format!("{} {why}", when()))]))
     }
 
+    /// The distance along camera `track`'s view at time `t` of the centre of the object its
+    /// `focus: Object(…)` names; `None` for a track without one.
+    fn focus_on(
+        &self,
+        track: &Track,
+        t: f64,
+        when: &dyn Fn() -> String,
+    ) -> Result<Option<f64>, Vec<Diagnostic>> {
+        let Some(Focus::Object { name, path }) = &track.optics.focus else {
+            return Ok(None);
+        };
+        let pose = match self.camera_rig(&track.target, t, when) {
+            Some(pose) => pose?,
+            None => self
+                .placer
+                .camera_world(&track.target, t)
+                .map_err(|why| vec![self.src.error(&[path], format!("{} {why}", when()))])?,
+        };
+        let dir = pose.dir.normalize_or_zero();
+        Ok(Some((self.placer.centre_at(name, t) - pose.eye).dot(dir)))
+    }
+
     /// The statements of frame `i`.
     pub fn frame_statements(&self, i: usize) -> Result<Vec<Statement>, Vec<Diagnostic>> {
         let anim = self.anim;
@@ -131,6 +153,8 @@ impl<'a> Generator<'a> {
         for (k, track) in anim.tracks.iter().enumerate() {
             keyed::set_parameters(&mut out, track, t, self.src, &when)?;
             keyed::set_material(&mut out, track, t, self.src, &when)?;
+            let focus = self.focus_on(track, t, &when)?;
+            keyed::set_lens(&mut out, track, t, focus, self.src, &when, &self.loc())?;
             if self.is_aimed_camera(&track.target) {
                 continue;
             }

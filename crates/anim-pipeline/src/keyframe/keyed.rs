@@ -1,15 +1,15 @@
-//! Keyed values written into a frame's definitions: a camera's pose and field of view, a
-//! light's brightness and colour, a material's colours and coefficients, the ambient and
-//! background colours, and which shapes and composites are shown.
+//! Keyed values written into a frame's definitions: a camera's pose, field of view and lens, a
+//! light's brightness, colour, radius and spot cone, a material's colours and coefficients,
+//! the ambient and background colours, and which shapes and composites are shown.
 
 use super::base::BaseScene;
 use super::orbit::Pose;
 use super::ranges::{in_unit_interval, RangeCheck};
-use super::spec_file::{Animation, Blend, Channel, Source, Track};
+use super::spec_file::{Animation, Blend, Channel, Focus, Source, TargetKind, Track};
 use super::tidy::{tidy, tidy3};
 use anim_core::diag::{Diagnostic, Loc};
 use anim_core::limits;
-use anim_core::sdf::ast::{Statement, StatementKind};
+use anim_core::sdf::ast::{LensDef, LightDef, NameRef, Statement, StatementKind};
 use glam::{DVec3, Vec3};
 use std::collections::BTreeSet;
 
@@ -115,6 +115,7 @@ pub fn set_parameters(
                 if let Some(c) = rgb {
                     l.color = combined_colour(track.blend, l.color, c);
                 }
+                set_light_optics(l, track, t, src, when)?;
             }
             StatementKind::Camera(cam) if cam.name == track.target => {
                 if let Some((f, c)) = fov {
@@ -127,6 +128,201 @@ pub fn set_parameters(
             }
             _ => {}
         }
+    }
+    Ok(())
+}
+
+/// The number channel `c` of `track` at `t` combined with `current` by the track's blend;
+/// `Err` (at the key that plays then) when the combination is not `ok`.
+#[allow(clippy::too_many_arguments)]
+fn combined(
+    c: &Option<Channel<f64>>,
+    current: f64,
+    ok: fn(f64) -> bool,
+    what: &str,
+    range: &str,
+    track: &Track,
+    t: f64,
+    src: &Source,
+    when: &dyn Fn() -> String,
+) -> Result<Option<f64>, Vec<Diagnostic>> {
+    let Some((v, c)) = c.as_ref().and_then(|c| Some((c.at(t)?, c))) else {
+        return Ok(None);
+    };
+    let v = Blend::combine(track.blend, current, v);
+    if !ok(v) {
+        return Err(vec![src.error(
+            &[&c.key_path_at(t)],
+            format!(
+                "{} the {what} of '{}' is {}, {range} (a smooth curve overshoots here, or its tracks combine so: add a key or use another interp)",
+                when(),
+                track.target,
+                tidy(v)
+            ),
+        )]);
+    }
+    Ok(Some(tidy(v)))
+}
+
+/// A light's keyed radius and spot cone; a cone whose inner half-angle passes its outer one
+/// is an error at the key that plays then.
+fn set_light_optics(
+    l: &mut LightDef,
+    track: &Track,
+    t: f64,
+    src: &Source,
+    when: &dyn Fn() -> String,
+) -> Result<(), Vec<Diagnostic>> {
+    let o = &track.optics;
+    let non_negative: fn(f64) -> bool = |v| v >= 0.0;
+    if let Some(r) = combined(
+        &o.radius,
+        l.radius,
+        non_negative,
+        "radius",
+        "below 0",
+        track,
+        t,
+        src,
+        when,
+    )? {
+        l.radius = r;
+    }
+    let Some(spot) = l.spot.as_mut() else {
+        return Ok(());
+    };
+    let angle: fn(f64) -> bool = |v| (0.0..=180.0).contains(&v);
+    let range = "outside 0–180°";
+    if let Some(a) = combined(
+        &o.inner,
+        spot.inner_deg,
+        angle,
+        "inner half-angle",
+        range,
+        track,
+        t,
+        src,
+        when,
+    )? {
+        spot.inner_deg = a;
+    }
+    if let Some(a) = combined(
+        &o.outer,
+        spot.outer_deg,
+        angle,
+        "outer half-angle",
+        range,
+        track,
+        t,
+        src,
+        when,
+    )? {
+        spot.outer_deg = a;
+    }
+    if spot.inner_deg > spot.outer_deg || spot.outer_deg <= 0.0 {
+        let c = o.inner.as_ref().or(o.outer.as_ref());
+        if let Some(c) = c {
+            return Err(vec![src.error(
+                &[&c.key_path_at(t)],
+                format!(
+                    "{} the spot '{}' has an inner half-angle of {}° and an outer one of {}°: the inner may not pass the outer, and the outer must be above 0",
+                    when(),
+                    track.target,
+                    spot.inner_deg,
+                    spot.outer_deg
+                ),
+            )]);
+        }
+    }
+    Ok(())
+}
+
+/// Sets camera `track`'s keyed lens at time `t`: its aperture and focus distance (`focus`:
+/// the distance `focus: Object(…)` measured at `t`, for the tracks that say so), in the
+/// camera's last `lens` line, or in a new one (at `loc`) where the base scene has none.
+#[allow(clippy::too_many_arguments)]
+pub fn set_lens(
+    out: &mut Vec<Statement>,
+    track: &Track,
+    t: f64,
+    focus: Option<f64>,
+    src: &Source,
+    when: &dyn Fn() -> String,
+    loc: &Loc,
+) -> Result<(), Vec<Diagnostic>> {
+    let o = &track.optics;
+    if track.kind != TargetKind::Camera || (o.aperture.is_none() && o.focus.is_none()) {
+        return Ok(());
+    }
+    let at = out
+        .iter()
+        .rposition(|s| matches!(&s.kind, StatementKind::Lens(l) if l.camera.name == track.target));
+    let at = at.unwrap_or_else(|| {
+        out.push(Statement::new(
+            StatementKind::Lens(LensDef {
+                camera: NameRef {
+                    name: track.target.clone(),
+                    loc: loc.clone(),
+                },
+                aperture: 0.0,
+                focus: 1.0,
+            }),
+            loc.clone(),
+        ));
+        out.len() - 1
+    });
+    let StatementKind::Lens(lens) = &mut out[at].kind else {
+        return Ok(());
+    };
+    let non_negative: fn(f64) -> bool = |v| v >= 0.0;
+    if let Some(a) = combined(
+        &o.aperture,
+        lens.aperture,
+        non_negative,
+        "aperture",
+        "below 0",
+        track,
+        t,
+        src,
+        when,
+    )? {
+        lens.aperture = a;
+    }
+    let distance = match (&o.focus, focus) {
+        (Some(Focus::Object { name, path }), Some(d)) => {
+            let d = Blend::combine(track.blend, lens.focus, d);
+            if d <= 0.0 {
+                return Err(vec![src.error(
+                    &[path],
+                    format!(
+                        "{} '{name}' is not in front of camera '{}' (its centre lies {} along the view): a lens focuses in front of the eye",
+                        when(),
+                        track.target,
+                        tidy(d)
+                    ),
+                )]);
+            }
+            Some(tidy(d))
+        }
+        (Some(Focus::Distance(c)), _) => {
+            let positive: fn(f64) -> bool = |v| v > 0.0;
+            let c = Some(c.clone());
+            combined(
+                &c,
+                lens.focus,
+                positive,
+                "focus distance",
+                "at or below 0",
+                track,
+                t,
+                src,
+                when,
+            )?
+        }
+        _ => None,
+    };
+    if let Some(d) = distance {
+        lens.focus = d;
     }
     Ok(())
 }

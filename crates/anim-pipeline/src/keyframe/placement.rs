@@ -1,5 +1,5 @@
 //! Where things are at a time: each target's placement by its tracks, the centre of a moving
-//! object (what `look_at: Object(…)` follows), and the turn of a track that looks at
+//! object (what `look_at: Object(…)` follows and `focus: Object(…)` keeps sharp), and the turn of a track that looks at
 //! something. The rules are documented for users in `docs/animation.md` ("Aim").
 
 use super::base::{ops_transform, BaseScene};
@@ -7,7 +7,9 @@ use super::follow::follow_ops;
 use super::motion::TrackPose;
 use super::orbit::Pose;
 use super::rotation::{can_look, facing, rolled_up};
-use super::spec_file::{Aim, AimTarget, AlongPath, Animation, Parent, PathMotion, TargetKind};
+use super::spec_file::{
+    Aim, AimTarget, AlongPath, Animation, Focus, Parent, PathMotion, TargetKind,
+};
 use super::tidy::tidy3;
 use anim_core::limits;
 use anim_core::math::Transform;
@@ -82,9 +84,14 @@ impl<'a> Placer<'a> {
                 }
             }
         }
-        for parent in anim.tracks.iter().filter_map(|t| t.parent.as_ref()) {
-            centres.insert(parent.name.clone(), base.default_pivot(&parent.name));
-            ancestors.insert(parent.name.clone(), ancestors_of(base, &parent.name));
+        let parents = anim.tracks.iter().filter_map(|t| t.parent.as_ref());
+        let focused = anim.tracks.iter().filter_map(|t| match &t.optics.focus {
+            Some(Focus::Object { name, .. }) => Some(name),
+            _ => None,
+        });
+        for name in parents.map(|p| &p.name).chain(focused) {
+            centres.insert(name.clone(), base.default_pivot(name));
+            ancestors.insert(name.clone(), ancestors_of(base, name));
         }
         let led_by_cameras = anim
             .tracks
@@ -396,6 +403,30 @@ impl<'a> Placer<'a> {
             dir,
             up: tidy3(rolled_up(dir, aim.up, roll)),
         }))
+    }
+
+    /// Camera `name`'s pose in the world at time `t`: as its aim places it if a track aims
+    /// it, else its base line carried by its own transforms, its tracks and its parent.
+    pub fn camera_world(&self, name: &str, t: f64) -> Result<Pose, String> {
+        if let Some(pose) = self.camera_pose(name, t) {
+            return pose;
+        }
+        let m = self.world_at(name, t, true, 0)?;
+        let def = self
+            .base
+            .statements
+            .iter()
+            .rev()
+            .find_map(|s| match &s.kind {
+                StatementKind::Camera(c) if c.name == name => Some(c),
+                _ => None,
+            });
+        let def = def.ok_or_else(|| format!("the base scene has no camera '{name}'"))?;
+        Ok(Pose {
+            eye: m.point(def.eye),
+            dir: m.vector(def.dir),
+            up: m.vector(def.up),
+        })
     }
 
     /// How far (degrees) anything turns by orientations and aims over `[t0, t1]`, along its

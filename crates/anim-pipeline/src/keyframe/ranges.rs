@@ -1,12 +1,14 @@
 //! Values that must stay in range between keys: a scale that would pass through 0 (and turn
 //! its object inside out), a field of view outside 0–180°, a negative brightness, an opacity
-//! or reflectivity outside 0–1, an index of refraction at or below 0. Keys are checked where
-//! they are written; curves that overshoot (Catmull-Rom, Back, Elastic) can leave the range
-//! between them, so every frame's span of time is checked too, not only its instant.
+//! or reflectivity outside 0–1, an index of refraction at or below 0, a negative radius or
+//! aperture, a spot's half-angle outside 0–180°, a focus distance at or below 0. Keys are
+//! checked where they are written; curves that overshoot (Catmull-Rom, Back, Elastic) can
+//! leave the range between them, so every frame's span of time is checked too, not only its
+//! instant.
 
 use super::expr::Val;
 use super::interp::Keyable;
-use super::spec_file::{Animation, Blend, Channel, Track};
+use super::spec_file::{Animation, Blend, Channel, Focus, Track};
 use super::tidy::tidy;
 use anim_core::limits;
 use glam::DVec3;
@@ -58,10 +60,19 @@ fn expressions_are_finite(
 ) -> Result<(), OutOfRange> {
     let name = &track.target;
     let m = &track.material;
+    let focus = match &track.optics.focus {
+        Some(Focus::Distance(c)) => Some(c.clone()),
+        _ => None,
+    };
     let numbers = [
         (&track.rotate, "turn"),
         (&track.brightness, "brightness"),
         (&track.fov, "field of view"),
+        (&track.optics.radius, "radius"),
+        (&track.optics.inner, "inner half-angle"),
+        (&track.optics.outer, "outer half-angle"),
+        (&track.optics.aperture, "aperture"),
+        (&focus, "focus distance"),
         (&m.reflectivity, "reflectivity"),
         (&m.opacity, "opacity"),
         (&m.ior, "index of refraction"),
@@ -123,7 +134,18 @@ fn check_track(track: &Track, instants: &[f64], span: &str, i: usize) -> Result<
     if let Some(c) = &track.scale {
         scale_keeps_its_sign(c, instants, name, span, i)?;
     }
-    let checks: [RangeCheck; 5] = [
+    let o = &track.optics;
+    let focus = match &o.focus {
+        Some(Focus::Distance(c)) => Some(c.clone()),
+        _ => None,
+    };
+    let half_angle = |v: f64| (0.0..=180.0).contains(&v);
+    let checks: [RangeCheck; 10] = [
+        (&o.radius, "radius", |v| v >= 0.0, "below 0"),
+        (&o.inner, "inner half-angle", half_angle, "outside 0–180°"),
+        (&o.outer, "outer half-angle", half_angle, "outside 0–180°"),
+        (&o.aperture, "aperture", |v| v >= 0.0, "below 0"),
+        (&focus, "focus distance", |v| v > 0.0, "at or below 0"),
         (
             &track.fov,
             "field of view",

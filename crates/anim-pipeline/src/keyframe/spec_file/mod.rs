@@ -7,6 +7,7 @@
 mod across;
 mod checker;
 mod model;
+mod optics;
 mod path;
 mod raw;
 mod source;
@@ -14,8 +15,9 @@ mod track;
 mod validate;
 
 pub use model::{
-    Aim, AimTarget, AlongPath, Animation, Blend, Channel, End, Follow, Fps, MaterialChannels,
-    NamePattern, Orbit, OrientChannel, Parent, PathMotion, SceneNames, TargetKind, Track,
+    Aim, AimTarget, AlongPath, Animation, Blend, Channel, End, Focus, Follow, Fps,
+    MaterialChannels, NamePattern, OpticsChannels, Orbit, OrientChannel, Parent, PathMotion,
+    SceneNames, TargetKind, Track,
 };
 pub use raw::{
     AimSpec, FpsSpec, KeySpec, KeyTime, Length, OrbitSpec, Orientation, Rgb, Scale, SceneSource,

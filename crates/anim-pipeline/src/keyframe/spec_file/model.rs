@@ -143,6 +143,44 @@ impl MaterialChannels {
     }
 }
 
+/// The keyed size and cone of a light and lens of a camera (docs/scene-language.md §5, §6.1).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct OpticsChannels {
+    /// A light's radius (a spherical light's soft shadows).
+    pub radius: Option<Channel<f64>>,
+    /// A spot's half-angles, in degrees.
+    pub inner: Option<Channel<f64>>,
+    pub outer: Option<Channel<f64>>,
+    /// A camera's aperture radius.
+    pub aperture: Option<Channel<f64>>,
+    /// A camera's focus distance.
+    pub focus: Option<Focus>,
+}
+
+/// Where a camera's lens focuses.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Focus {
+    /// A keyed distance along the view direction.
+    Distance(Channel<f64>),
+    /// The centre of a shape or composite, wherever it is: its distance along the view
+    /// direction at every instant (a rack focus).
+    Object {
+        name: String,
+        /// `tracks[i].focus`, for messages.
+        path: String,
+    },
+}
+
+impl Focus {
+    /// The path of its keys or of its object, for messages.
+    pub fn path(&self) -> &str {
+        match self {
+            Focus::Distance(c) => &c.path,
+            Focus::Object { path, .. } => path,
+        }
+    }
+}
+
 /// What of a parent's motion a child follows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
 pub enum Follow {
@@ -280,6 +318,8 @@ pub struct Track {
     pub parent: Option<Parent>,
     pub aim: Option<Aim>,
     pub material: MaterialChannels,
+    /// A light's radius and cone, a camera's lens.
+    pub optics: OpticsChannels,
     /// 1 shown, 0 hidden; stepped.
     pub visible: Option<Channel<f64>>,
     /// `tracks[i]`, for messages.
@@ -290,10 +330,14 @@ impl Track {
     /// The values it sets in its target's definition (not motion), each named as in the spec,
     /// with the path of its keys or expression.
     pub fn values(&self) -> Vec<(&'static str, &str)> {
-        let m = &self.material;
+        let (m, o) = (&self.material, &self.optics);
         let numbers = [
             ("brightness", &self.brightness),
             ("fov", &self.fov),
+            ("radius", &o.radius),
+            ("inner", &o.inner),
+            ("outer", &o.outer),
+            ("aperture", &o.aperture),
             ("reflectivity", &m.reflectivity),
             ("opacity", &m.opacity),
             ("ior", &m.ior),
@@ -314,6 +358,7 @@ impl Track {
                 .into_iter()
                 .filter_map(|(n, c)| Some((n, c.as_ref()?.path.as_str()))),
         );
+        out.extend(o.focus.as_ref().map(|f| ("focus", f.path())));
         out
     }
 

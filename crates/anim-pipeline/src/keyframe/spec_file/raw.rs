@@ -311,6 +311,21 @@ pub struct TrackSpec {
     /// Cameras only: horizontal field of view in degrees.
     #[serde(default)]
     pub fov: ChannelSpec<f64>,
+    /// Lights only: the radius of a spherical light.
+    #[serde(default)]
+    pub radius: ChannelSpec<f64>,
+    /// Spot lights only: the half-angles of full light and of none, in degrees.
+    #[serde(default)]
+    pub inner: ChannelSpec<f64>,
+    #[serde(default)]
+    pub outer: ChannelSpec<f64>,
+    /// Cameras only: the lens's aperture radius.
+    #[serde(default)]
+    pub aperture: ChannelSpec<f64>,
+    /// Cameras only: the focus distance, or `Object("name")` (read as a channel whose one
+    /// part is the name; the variant's name is checked against the text).
+    #[serde(default)]
+    pub focus: ChannelSpec<f64>,
     /// Materials only: ambient, diffuse and specular colours.
     #[serde(default)]
     pub ka: ChannelSpec<Rgb>,
@@ -366,6 +381,11 @@ impl TrackSpec {
             .chain(key_times(&self.brightness.keys))
             .chain(key_times(&self.color.keys))
             .chain(key_times(&self.fov.keys))
+            .chain(key_times(&self.radius.keys))
+            .chain(key_times(&self.inner.keys))
+            .chain(key_times(&self.outer.keys))
+            .chain(key_times(&self.aperture.keys))
+            .chain(key_times(&self.focus.keys))
             .chain(key_times(&self.ka.keys))
             .chain(key_times(&self.kd.keys))
             .chain(key_times(&self.ks.keys))

@@ -84,8 +84,14 @@ fn fits(kind: TargetKind, channel: &str) -> bool {
         TargetKind::Shape | TargetKind::Composite => {
             moving || matches!(channel, "look_at" | "visible")
         }
-        TargetKind::Camera => moving || matches!(channel, "look_at" | "fov"),
-        TargetKind::Light => moving || matches!(channel, "brightness" | "color"),
+        TargetKind::Camera => moving || matches!(channel, "look_at" | "fov" | "aperture" | "focus"),
+        TargetKind::Light => {
+            moving
+                || matches!(
+                    channel,
+                    "brightness" | "color" | "radius" | "inner" | "outer"
+                )
+        }
         TargetKind::Material => matches!(
             channel,
             "ka" | "kd" | "ks" | "reflectivity" | "opacity" | "ior"
@@ -115,7 +121,7 @@ fn kinds_for(channel: &str) -> String {
 }
 
 /// Every channel field of a track, with whether it keys anything.
-fn keyed_channels(t: &TrackSpec) -> [(&'static str, bool); 19] {
+fn keyed_channels(t: &TrackSpec) -> [(&'static str, bool); 24] {
     [
         ("translate", !t.translate.is_empty()),
         ("path", t.path.is_some()),
@@ -126,6 +132,11 @@ fn keyed_channels(t: &TrackSpec) -> [(&'static str, bool); 19] {
         ("brightness", !t.brightness.is_empty()),
         ("color", !t.color.is_empty()),
         ("fov", !t.fov.is_empty()),
+        ("radius", !t.radius.is_empty()),
+        ("inner", !t.inner.is_empty()),
+        ("outer", !t.outer.is_empty()),
+        ("aperture", !t.aperture.is_empty()),
+        ("focus", !t.focus.is_empty()),
         ("ka", !t.ka.is_empty()),
         ("kd", !t.kd.is_empty()),
         ("ks", !t.ks.is_empty()),
@@ -283,6 +294,7 @@ impl Checker<'_> {
         );
         let (brightness, color, fov) = self.parameters(s, timing, names, layered);
         let material = self.material(s, timing, names, layered);
+        let optics = self.optics(s, timing, names, layered, kind);
         let visible = self.visible(s, timing);
         let axis = self.axis_and_pivot(s);
         if !keyed_channels(t).iter().any(|(_, keyed)| *keyed) && s.curve.is_none() {
@@ -321,6 +333,7 @@ impl Checker<'_> {
             }),
             aim,
             material,
+            optics,
             visible,
             path,
         })
@@ -357,7 +370,7 @@ impl Checker<'_> {
 
     /// Where channel `name` of the track's target is, reading the base scene's value where no
     /// key sets it.
-    fn base_of<'p>(
+    pub(super) fn base_of<'p>(
         &self,
         s: &Sources,
         names: &dyn SceneNames,
@@ -370,7 +383,7 @@ impl Checker<'_> {
     }
 
     /// A numeric channel of the target's definition, its keys checked by `check`.
-    fn value(
+    pub(super) fn value(
         &mut self,
         s: &Sources,
         names: &dyn SceneNames,
@@ -766,6 +779,6 @@ impl Checker<'_> {
     }
 }
 
-fn target_name(t: &TrackSpec) -> &str {
+pub(super) fn target_name(t: &TrackSpec) -> &str {
     t.target.as_deref().unwrap_or("")
 }
