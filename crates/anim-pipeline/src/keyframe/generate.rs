@@ -154,7 +154,8 @@ impl<'a> Generator<'a> {
             keyed::set_parameters(&mut out, track, t, self.src, &when)?;
             keyed::set_material(&mut out, track, t, self.src, &when)?;
             let focus = self.focus_on(track, t, &when)?;
-            keyed::set_lens(&mut out, track, t, focus, self.src, &when, &self.loc())?;
+            let keying = (self.src, &when as &dyn Fn() -> String);
+            keyed::set_lens(&mut out, (track, t), focus, keying, &self.loc())?;
             if self.is_aimed_camera(&track.target) {
                 continue;
             }

@@ -115,7 +115,13 @@ pub fn set_parameters(
                 if let Some(c) = rgb {
                     l.color = combined_colour(track.blend, l.color, c);
                 }
-                set_light_optics(l, track, t, src, when)?;
+                let at = Keying {
+                    track,
+                    t,
+                    src,
+                    when,
+                };
+                set_light_optics(l, &at)?;
             }
             StatementKind::Camera(cam) if cam.name == track.target => {
                 if let Some((f, c)) = fov {
@@ -132,20 +138,38 @@ pub fn set_parameters(
     Ok(())
 }
 
-/// The number channel `c` of `track` at `t` combined with `current` by the track's blend;
-/// `Err` (at the key that plays then) when the combination is not `ok`.
-#[allow(clippy::too_many_arguments)]
+/// A track at one instant: what a keyed value is read from, and where its errors point.
+struct Keying<'a> {
+    track: &'a Track,
+    t: f64,
+    src: &'a Source,
+    /// Names the frame, for errors that only a frame shows.
+    when: &'a dyn Fn() -> String,
+}
+
+/// What a keyed number must be: `ok` of it, else an error naming the `what` and saying it is
+/// `range`.
+struct Valid<'a> {
+    ok: fn(f64) -> bool,
+    what: &'a str,
+    range: &'a str,
+}
+
+/// The number channel `c` of the keying track at its instant combined with `current` by the
+/// track's blend; `Err` (at the key that plays then) when the combination is not valid.
 fn combined(
     c: &Option<Channel<f64>>,
     current: f64,
-    ok: fn(f64) -> bool,
-    what: &str,
-    range: &str,
-    track: &Track,
-    t: f64,
-    src: &Source,
-    when: &dyn Fn() -> String,
+    valid: Valid,
+    at: &Keying,
 ) -> Result<Option<f64>, Vec<Diagnostic>> {
+    let Keying {
+        track,
+        t,
+        src,
+        when,
+    } = *at;
+    let Valid { ok, what, range } = valid;
     let Some((v, c)) = c.as_ref().and_then(|c| Some((c.at(t)?, c))) else {
         return Ok(None);
     };
@@ -166,25 +190,25 @@ fn combined(
 
 /// A light's keyed radius and spot cone; a cone whose inner half-angle passes its outer one
 /// is an error at the key that plays then.
-fn set_light_optics(
-    l: &mut LightDef,
-    track: &Track,
-    t: f64,
-    src: &Source,
-    when: &dyn Fn() -> String,
-) -> Result<(), Vec<Diagnostic>> {
+fn set_light_optics(l: &mut LightDef, at: &Keying) -> Result<(), Vec<Diagnostic>> {
+    let Keying {
+        track,
+        t,
+        src,
+        when,
+        ..
+    } = *at;
     let o = &track.optics;
     let non_negative: fn(f64) -> bool = |v| v >= 0.0;
     if let Some(r) = combined(
         &o.radius,
         l.radius,
-        non_negative,
-        "radius",
-        "below 0",
-        track,
-        t,
-        src,
-        when,
+        Valid {
+            ok: non_negative,
+            what: "radius",
+            range: "below 0",
+        },
+        at,
     )? {
         l.radius = r;
     }
@@ -196,26 +220,24 @@ fn set_light_optics(
     if let Some(a) = combined(
         &o.inner,
         spot.inner_deg,
-        angle,
-        "inner half-angle",
-        range,
-        track,
-        t,
-        src,
-        when,
+        Valid {
+            ok: angle,
+            what: "inner half-angle",
+            range,
+        },
+        at,
     )? {
         spot.inner_deg = a;
     }
     if let Some(a) = combined(
         &o.outer,
         spot.outer_deg,
-        angle,
-        "outer half-angle",
-        range,
-        track,
-        t,
-        src,
-        when,
+        Valid {
+            ok: angle,
+            what: "outer half-angle",
+            range,
+        },
+        at,
     )? {
         spot.outer_deg = a;
     }
@@ -240,16 +262,19 @@ fn set_light_optics(
 /// Sets camera `track`'s keyed lens at time `t`: its aperture and focus distance (`focus`:
 /// the distance `focus: Object(…)` measured at `t`, for the tracks that say so), in the
 /// camera's last `lens` line, or in a new one (at `loc`) where the base scene has none.
-#[allow(clippy::too_many_arguments)]
 pub fn set_lens(
     out: &mut Vec<Statement>,
-    track: &Track,
-    t: f64,
+    (track, t): (&Track, f64),
     focus: Option<f64>,
-    src: &Source,
-    when: &dyn Fn() -> String,
+    (src, when): (&Source, &dyn Fn() -> String),
     loc: &Loc,
 ) -> Result<(), Vec<Diagnostic>> {
+    let keying = &Keying {
+        track,
+        t,
+        src,
+        when,
+    };
     let o = &track.optics;
     if track.kind != TargetKind::Camera || (o.aperture.is_none() && o.focus.is_none()) {
         return Ok(());
@@ -278,13 +303,12 @@ pub fn set_lens(
     if let Some(a) = combined(
         &o.aperture,
         lens.aperture,
-        non_negative,
-        "aperture",
-        "below 0",
-        track,
-        t,
-        src,
-        when,
+        Valid {
+            ok: non_negative,
+            what: "aperture",
+            range: "below 0",
+        },
+        keying,
     )? {
         lens.aperture = a;
     }
@@ -310,13 +334,12 @@ pub fn set_lens(
             combined(
                 &c,
                 lens.focus,
-                positive,
-                "focus distance",
-                "at or below 0",
-                track,
-                t,
-                src,
-                when,
+                Valid {
+                    ok: positive,
+                    what: "focus distance",
+                    range: "at or below 0",
+                },
+                keying,
             )?
         }
         _ => None,
