@@ -133,6 +133,11 @@ pub struct RenderArgs {
     /// Render only frames i (counting from 0 in natural order) with i mod N = K−1.
     #[arg(long, value_name = "K/N", value_parser = parse_shard)]
     pub shard: Option<Shard>,
+    /// Render only frames A to B of a directory, both included, counting from 0 in natural
+    /// order (for generated frames, the numbers in their names): `10..19`, `10..` (to the
+    /// end), `..19`, or one frame `12`.
+    #[arg(long, value_name = "A..B", value_parser = parse_frame_range)]
+    pub frames: Option<(usize, usize)>,
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
@@ -174,6 +179,11 @@ pub struct GenerateArgs {
     /// the scene that no frame changes from static.sdfi in the frame directory.
     #[arg(long)]
     pub standalone: bool,
+    /// Write only frames A to B, both included (`10..19`, `10..`, `..19` or `12`); every frame
+    /// is still made and the static part is the whole animation's, so the frames written
+    /// match those of a full run.
+    #[arg(long, value_name = "A..B", value_parser = parse_frame_range)]
+    pub frames: Option<(usize, usize)>,
 }
 
 #[derive(Args, Debug, Clone)]
@@ -374,6 +384,32 @@ fn parse_shard(s: &str) -> Result<Shard, String> {
     s.parse()
 }
 
+/// `A..B` (both included), `A..`, `..B` or `N`: the first and last frame, counting from 0.
+pub fn parse_frame_range(s: &str) -> Result<(usize, usize), String> {
+    let number = |t: &str| {
+        t.trim()
+            .parse::<usize>()
+            .map_err(|_| format!("'{t}' is not a frame number (frames count from 0)"))
+    };
+    let (first, last) = match s.split_once("..") {
+        Some((a, b)) => (
+            if a.trim().is_empty() { 0 } else { number(a)? },
+            if b.trim().is_empty() {
+                usize::MAX
+            } else {
+                number(b)?
+            },
+        ),
+        None => (number(s)?, number(s)?),
+    };
+    if first > last {
+        return Err(format!(
+            "the range {s} is empty: write the first frame, then the last (A..B, both included)"
+        ));
+    }
+    Ok((first, last))
+}
+
 /// A whole number within `range` (one of the value rules of `limits`).
 fn whole_in(s: &str, range: std::ops::RangeInclusive<u32>) -> Result<u32, String> {
     let n: u32 = s
@@ -450,6 +486,7 @@ impl RenderArgs {
             frames: FrameOptions {
                 force: self.force,
                 shard: self.shard,
+                range: self.frames,
             },
             quiet: self.quiet,
         }
@@ -483,6 +520,7 @@ impl GenerateArgs {
             spec: self.spec.clone(),
             out: self.out.clone(),
             standalone: self.standalone,
+            frames: self.frames,
         }
     }
 }

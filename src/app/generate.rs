@@ -22,7 +22,15 @@ pub fn run(config: &GenerateConfig, quiet: bool, print_dir: bool) -> ExitCode {
                     keyframe::tidy::tidy(report.duration),
                     report.fps
                 );
-                let mut line = if report.written == report.frames {
+                let mut line = if let Some((a, b)) = config.frames {
+                    let last = b.min(report.frames.saturating_sub(1));
+                    format!(
+                        "wrote {} of frames {a}..{last} of {} ({length}) to {}; the others were unchanged or not asked for",
+                        report.written,
+                        report.frames,
+                        super::shown(&report.dir)
+                    )
+                } else if report.written == report.frames {
                     format!(
                         "wrote {} frames ({length}) to {}",
                         report.frames,

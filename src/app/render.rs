@@ -80,7 +80,7 @@ fn render_dir(dir: &Path, config: &RenderConfig) -> bool {
     let log = FrameLog::new(config.quiet);
     match frames::render_dir(dir, &config.settings, &config.load, &config.frames, &log) {
         Ok(summary) => {
-            print_summary(dir, &summary, config.quiet);
+            print_summary(dir, &summary, config.frames.range, config.quiet);
             summary.failed.is_empty()
         }
         Err(diagnostics) => {
@@ -93,7 +93,7 @@ fn render_dir(dir: &Path, config: &RenderConfig) -> bool {
 }
 
 /// Prints warnings (unless quiet), failures with their located errors, and the totals.
-fn print_summary(dir: &Path, s: &Summary, quiet: bool) {
+fn print_summary(dir: &Path, s: &Summary, range: Option<(usize, usize)>, quiet: bool) {
     if !quiet {
         for (d, count) in &s.warnings {
             eprintln!("{}", in_frames(&d.to_string(), *count));
@@ -123,6 +123,21 @@ fn print_summary(dir: &Path, s: &Summary, quiet: bool) {
             s.total
         ),
         None => String::new(),
+    };
+    let shard = match range {
+        Some((a, b)) => {
+            let last = if b == usize::MAX {
+                String::new()
+            } else {
+                b.to_string()
+            };
+            format!(
+                "{shard}frames {a}..{last} ({} of {} frames): ",
+                s.selected(),
+                s.total
+            )
+        }
+        None => shard,
     };
     let rates = if secs > 0.0 && !s.rendered.is_empty() {
         format!(

@@ -10,13 +10,13 @@ use crate::common;
 use glam::{DQuat, DVec3};
 use std::path::{Path, PathBuf};
 
-fn repo() -> PathBuf {
+pub(crate) fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
 /// Runs `anim generate SPEC -o OUT --standalone` (whole frame files, which the tests read);
 /// (success, stderr).
-fn generate(spec: &Path, out: &Path) -> (bool, String) {
+pub(crate) fn generate(spec: &Path, out: &Path) -> (bool, String) {
     let run = common::anim()
         .args(["generate", "--standalone"])
         .arg(spec)
@@ -31,7 +31,7 @@ fn generate(spec: &Path, out: &Path) -> (bool, String) {
 }
 
 /// Writes `files` into a new temporary directory.
-fn project(files: &[(&str, &str)]) -> tempfile::TempDir {
+pub(crate) fn project(files: &[(&str, &str)]) -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("tempdir");
     for (name, text) in files {
         std::fs::write(dir.path().join(name), text).expect("write");
@@ -40,7 +40,7 @@ fn project(files: &[(&str, &str)]) -> tempfile::TempDir {
 }
 
 /// The `.sdf` frames of a directory, in order.
-fn frames(dir: &Path) -> Vec<(String, String)> {
+pub(crate) fn frames(dir: &Path) -> Vec<(String, String)> {
     let mut out: Vec<(String, String)> = std::fs::read_dir(dir)
         .expect("frame dir")
         .filter_map(Result::ok)
@@ -55,7 +55,7 @@ fn frames(dir: &Path) -> Vec<(String, String)> {
     out
 }
 
-fn numbers(words: &[&str]) -> Vec<f64> {
+pub(crate) fn numbers(words: &[&str]) -> Vec<f64> {
     words
         .iter()
         .map(|w| w.parse::<f64>().unwrap_or_else(|_| panic!("number: {w}")))
@@ -64,7 +64,7 @@ fn numbers(words: &[&str]) -> Vec<f64> {
 
 /// The transform of a frame's `transform NAME …` lines for `name`, applied in order (each
 /// after the ones before, docs/scene-language.md §7), to a point.
-fn place(text: &str, name: &str, mut p: DVec3) -> DVec3 {
+pub(crate) fn place(text: &str, name: &str, mut p: DVec3) -> DVec3 {
     for line in text.lines() {
         let w: Vec<&str> = line.split_whitespace().collect();
         if w.len() < 3 || w[0] != "transform" || w[1] != name {
@@ -86,7 +86,7 @@ fn place(text: &str, name: &str, mut p: DVec3) -> DVec3 {
 }
 
 /// The words of the first line of `text` that starts with `prefix`.
-fn line_with<'t>(text: &'t str, prefix: &str) -> Vec<&'t str> {
+pub(crate) fn line_with<'t>(text: &'t str, prefix: &str) -> Vec<&'t str> {
     text.lines()
         .find(|l| l.starts_with(prefix))
         .unwrap_or_else(|| panic!("no line `{prefix}` in\n{text}"))
@@ -132,7 +132,7 @@ fn the_fly_by_camera_keeps_the_moving_ball_in_the_middle_of_every_frame() {
 }
 
 /// A base scene with one ball at the origin, a light and a camera looking at it.
-const BALL: &str = "define material red 0.2 0 0 0.8 0.1 0.1 0.5 0.5 0.5 20
+pub(crate) const BALL: &str = "define material red 0.2 0 0 0.8 0.1 0.1 0.5 0.5 0.5 20
 define shape sphere ball 0 0 0 1 red
 define light sun 5 5 5 1 1 1 1
 define camera cam 60 0 0 10 0 0 -1 0 1 0
@@ -332,6 +332,7 @@ define camera cam 60 0 0 10 0 0 -1 0 1 0
         spec: dir.path().join("spec.ron"),
         out: Some(out.clone()),
         standalone: false,
+        frames: None,
     };
     anim_pipeline::keyframe::run_generate_reporting(&config, |warnings| {
         let written = std::fs::read_dir(&out).map_or(0, |d| d.count());
@@ -443,34 +444,64 @@ fn a_bracket_left_open_is_shown_where_it_opens() {
 #[test]
 fn every_example_spec_generates_the_frames_it_always_has() {
     // Each line: spec, frame count, and the 64-bit FNV-1a of every frame file's name and
-    // bytes in name order (each followed by a 0xff byte), as generated before the animator's
-    // fields existed. New fields are opt-in: the frames of these specs must not change.
+    // bytes in name order (each followed by a 0xff byte), whole (`--standalone`) and split
+    // (the frames with `static.sdfi`), as anim 4a69291 generated them. New fields and
+    // defaults are opt-in: the frames of these specs must not change.
     let manifest = include_str!("animations.tsv");
     let out = tempfile::tempdir().unwrap();
+    let fingerprint = |dir: &Path, extensions: &[&str]| {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .expect("frame dir")
+            .filter_map(Result::ok)
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| extensions.iter().any(|x| n.ends_with(x)))
+            .collect();
+        names.sort();
+        let mut h = anim_core::util::Fnv64::default();
+        for name in &names {
+            h.write_part(name.as_bytes());
+            h.write_part(&std::fs::read(dir.join(name)).expect("frame"));
+        }
+        format!("{:016x}", h.finish())
+    };
     for line in manifest.lines().filter(|l| !l.starts_with('#')) {
         let cols: Vec<&str> = line.split('\t').collect();
-        let (spec, count, hash) = (cols[0], cols[1].parse::<usize>().unwrap(), cols[2]);
-        let dir = out.path().join(spec);
-        let (ok, stderr) = generate(&repo().join("animations").join(spec), &dir);
+        let (spec, count) = (cols[0], cols[1].parse::<usize>().unwrap());
+        let whole = out.path().join(spec);
+        let (ok, stderr) = generate(&repo().join("animations").join(spec), &whole);
         assert!(ok, "{spec}: {stderr}");
-        let frames = frames(&dir);
-        let mut h = anim_core::util::Fnv64::default();
-        for (name, text) in &frames {
-            h.write_part(name.as_bytes());
-            h.write_part(text.as_bytes());
-        }
-        assert_eq!(frames.len(), count, "{spec}");
+        assert_eq!(frames(&whole).len(), count, "{spec}");
         assert_eq!(
-            format!("{:016x}", h.finish()),
-            hash,
+            fingerprint(&whole, &[".sdf"]),
+            cols[2],
             "{spec}'s frames changed"
+        );
+        let split = out.path().join(format!("{spec}.split"));
+        let run = common::anim()
+            .arg("generate")
+            .arg(repo().join("animations").join(spec))
+            .arg("-o")
+            .arg(&split)
+            .output()
+            .expect("run anim");
+        assert!(run.status.success(), "{spec}");
+        assert_eq!(
+            fingerprint(&split, &[".sdf", ".sdfi"]),
+            cols[3],
+            "{spec}'s split frames changed"
         );
     }
 }
 
 #[test]
 fn the_new_example_specs_generate_frames_that_load_without_warnings() {
-    for spec in ["logo.ron", "crowd.ron"] {
+    for spec in [
+        "logo.ron",
+        "crowd.ron",
+        "candle.ron",
+        "rig.ron",
+        "flythrough.ron",
+    ] {
         let out = tempfile::tempdir().unwrap();
         let (ok, stderr) = generate(&repo().join("animations").join(spec), out.path());
         assert!(ok && stderr.is_empty(), "{spec}: {stderr}");

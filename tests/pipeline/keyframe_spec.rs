@@ -84,10 +84,10 @@ fn misspelt_top_level_field_is_an_error_not_ignored() {
 
 #[test]
 fn wrong_type_is_located() {
-    let text = "(\n    scene: Inline(\"\"),\n    fps: \"24\",\n    length: Seconds(5),\n    resolution: (64, 36),\n)";
+    let text = "(\n    scene: Inline(\"\"),\n    fps: true,\n    length: Seconds(5),\n    resolution: (64, 36),\n)";
     let e = one_error(text);
     assert!(
-        e.starts_with("spec.ron:3:10: error: expected a number (in `fps`)"),
+        e.starts_with("spec.ron:3:10: error: expected a number of frames per second or a ratio \"A/B\", found the boolean `true` (in `fps`)"),
         "{e}"
     );
     let text = "(\n    scene: Inline(\"\"),\n    fps: 24,\n    length: Seconds(5),\n    resolution: (64.5, 36),\n)";
@@ -149,6 +149,7 @@ fn carets_cover_exactly_the_bad_text() {
     ));
     assert_eq!(caret(&e), (66, 5), "{e}");
     let e = one_error("(\n    scene: Inline(\"\"),\n    fps: \"24\",\n    length: Seconds(5),\n    resolution: (64, 36),\n)");
+    assert!(e.contains("not \"24\""), "{e}");
     assert_eq!(caret(&e), (10, 4), "{e}");
 }
 
@@ -230,7 +231,7 @@ fn several_problems_are_all_reported() {
 #[test]
 fn defaults_and_frame_count() {
     let a = check(&format!("(\n    {HEADER})")).expect("valid");
-    assert_eq!(a.fps, 24);
+    assert_eq!(a.fps.to_string(), "24");
     assert_eq!(a.frames, 120);
     assert_eq!(a.camera, "cam");
     assert_eq!(a.output.image(7, a.digits()), "frame_0007.png");
@@ -253,9 +254,9 @@ fn lengths_and_rates_must_be_whole_frames() {
         e.starts_with("spec.ron:4:20: error: the number of frames must be a whole number"),
         "{e}"
     );
-    let e = one_error(&format!("{base}    length: Frames(2),\n    fps: 29.97,\n)"));
+    let e = one_error(&format!("{base}    length: Frames(2),\n    fps: 24.5,\n)"));
     assert!(
-        e.starts_with("spec.ron:5:10: error: fps must be a whole number from 1 to 1000, not 29.97"),
+        e.starts_with("spec.ron:5:10: error: fps must be a whole number from 1 to 1000, an NTSC rate (23.976, 29.97, 59.94) or a ratio \"A/B\", not 24.5"),
         "{e}"
     );
 }
@@ -610,6 +611,7 @@ fn frames_keep_the_materials_of_a_base_scene_in_another_layout() {
         spec: dir.path().join("spec.ron"),
         out: Some(dir.path().join("frames")),
         standalone: false,
+        frames: None,
     };
     anim_pipeline::keyframe::run_generate(&config).unwrap_or_else(|e| panic!("{e:?}"));
     let frame = dir.path().join("frames/frame_0000.sdf");

@@ -14,6 +14,14 @@
 //! - `bench`: `anim bench` at its tiny size, and the files it writes.
 //! - `animator`: aim, orientation keys, the inclusive end, curves kept in range, materials,
 //!   visibility, reuse, the early check of the base scene, and the example specs' frames.
+//! - `expressions`: channels as formulas of time, named values, noise.
+//! - `generated_frames`: frames read as what they say (no inference), and the first-frame
+//!   check that says what `anim check` would.
+//! - `timing`: keys at `Frames(n)`, fractional frame rates, `--frames A..B`.
+//! - `layering`: tracks on one value combined by `blend`, or refused without it.
+//! - `rigs`: paths at constant speed, `orient: AlongPath`, parents.
+//! - `tangents`: a key's `in` and `out` sides, and the clamped spline `Auto`.
+//! - `shots`: the example shots of round two (candle, rig, flythrough) do what they show.
 //! - `service`: the one way from a scene file to images in memory, which `anim render` and
 //!   `anim preview` share, and the files a frame's fingerprint follows.
 
@@ -23,8 +31,15 @@ mod common;
 mod animator;
 mod bench;
 mod encode;
+mod expressions;
 mod frames;
+mod generated_frames;
 mod holds;
 mod keyframe_spec;
+mod layering;
+mod rigs;
 mod service;
+mod shots;
 mod split;
+mod tangents;
+mod timing;

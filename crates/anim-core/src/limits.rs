@@ -42,6 +42,14 @@ pub const MAX_INCLUDE_REPEATS: u64 = 1 << 18;
 /// Frames per second of a keyframe spec.
 pub const FPS: RangeInclusive<u32> = 1..=1000;
 
+/// The longest expression a keyframe spec may hold, in characters: far beyond a formula
+/// anyone writes; it bounds the nodes of one and so the time to evaluate it.
+pub const MAX_EXPRESSION_CHARS: usize = 4096;
+
+/// How deep an expression of a keyframe spec may nest (parentheses, calls, signs): its
+/// reader descends once per level, so this bounds the stack it takes.
+pub const MAX_EXPRESSION_DEPTH: usize = 64;
+
 /// The default reflection/refraction depth (`--max-depth`).
 pub const DEFAULT_MAX_DEPTH: u32 = 8;
 

@@ -93,6 +93,7 @@ impl Project {
             spec: self.input.clone(),
             out: Some(self.frames_dir.clone()),
             standalone: false,
+            frames: None,
         })
         .map_err(text)?;
         let paths = list_frames(&report.dir)
@@ -108,7 +109,7 @@ impl Project {
         let spec = read_spec(&self.input);
         Ok(Built {
             frames,
-            fps: f64::from(report.fps),
+            fps: report.fps.as_f64(),
             keys: spec.as_ref().map(SpecFile::key_times).unwrap_or_default(),
             warnings: text(report.warnings),
         })

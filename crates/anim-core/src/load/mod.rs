@@ -100,13 +100,21 @@ pub(crate) fn load_str_whole(
     finish_load(parsed, path, opts, || Some(Cow::Borrowed(text)))
 }
 
-/// Builds the jobs of a parsed file; `text` gives the file's text again for quoting.
+/// Builds the jobs of a parsed file; `text` gives the file's text again for quoting. A frame
+/// `anim generate` wrote is built with every guess turned off, as it was read.
 fn finish_load<'t>(
     parsed: sdf::Parsed,
     path: &Path,
     opts: &LoadOptions,
     text: impl FnOnce() -> Option<Cow<'t, str>>,
 ) -> Result<Loaded, Vec<Diagnostic>> {
+    let canonical;
+    let opts = if parsed.generated {
+        canonical = opts.without_inference();
+        &canonical
+    } else {
+        opts
+    };
     let (mut jobs, mut built) = if parsed.omissions.abandoned {
         (Vec::new(), Vec::new())
     } else {
@@ -118,39 +126,26 @@ fn finish_load<'t>(
             Some(&parsed.omissions),
         )
     };
-    // The text is asked for at most once: here when the transform order is in question (a
-    // generated frame says what it means), else by `conclude` for quoting.
-    let mut text = Some(text);
-    let mut text_read = None;
     if may_need_another_reading(&parsed.statements, &jobs, &built, opts) {
-        let t = text.take().and_then(|read| read());
-        if !t.as_deref().is_some_and(sdf::is_generated_frame) {
-            let (statements, omissions) = (&parsed.statements, &parsed.omissions);
-            // The camera's sense first: over the public corpus it shows what the other
-            // order shows, and more (load/camera_sense.rs).
-            let other = camera_sense::read_with_cameras_turned_back(
-                statements, omissions, &jobs, path, opts,
-            )
-            .or_else(|| {
-                is_composed(statements)
-                    .then(|| read_in_other_order(statements, omissions, &jobs, path, opts))
-                    .flatten()
-            });
-            if let Some(other) = other {
-                (jobs, built) = other;
-            }
+        let (statements, omissions) = (&parsed.statements, &parsed.omissions);
+        // The camera's sense first: over the public corpus it shows what the other order
+        // shows, and more (load/camera_sense.rs).
+        let other =
+            camera_sense::read_with_cameras_turned_back(statements, omissions, &jobs, path, opts)
+                .or_else(|| {
+                    is_composed(statements)
+                        .then(|| read_in_other_order(statements, omissions, &jobs, path, opts))
+                        .flatten()
+                });
+        if let Some(other) = other {
+            (jobs, built) = other;
         }
-        text_read = Some(t);
     }
     // The statements are no longer needed once the jobs hold the scenes: freed before the
     // images are made.
     drop(parsed.statements);
     let mut diagnostics = parsed.diagnostics;
     diagnostics.extend(built);
-    let text = move || match text_read {
-        Some(t) => t,
-        None => text.and_then(|read| read()),
-    };
     let quoting = Quoting {
         path,
         opts,

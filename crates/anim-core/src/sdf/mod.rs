@@ -50,7 +50,12 @@ pub enum TransformOrder {
 pub const GENERATED_FRAME_SIGNATURE: &str = "by anim";
 
 /// Whether `text` is a frame written by `anim generate`: its first line is the generator's
-/// header comment, `# Frame ... generated from SPEC by anim VERSION.`
+/// header comment, `# Frame ... generated from SPEC by anim VERSION.` Such a frame, and every
+/// file it includes, is read with every guess turned off
+/// ([`LoadOptions::without_inference`]): anim wrote it in the canonical language, so a
+/// reading that makes it "more plausible" could only misread it (an invisible material read
+/// in another layout, a camera turned round). The header turns guesses off and nothing else:
+/// a file that forges it is read as written, which is what its text says anyway.
 pub fn is_generated_frame(text: &str) -> bool {
     let first = text.lines().next().unwrap_or("");
     first.starts_with("# Frame ")
@@ -117,6 +122,24 @@ pub struct LoadOptions {
     pub includes: IncludeCache,
 }
 
+impl LoadOptions {
+    /// These options with every guess turned off: the standard material layout where the
+    /// layout would be inferred, and the transform order as given (never the other one, nor
+    /// cameras turned round). Explicit choices (`--material-fields LIST`,
+    /// `--transform-order local`) stay: they are not guesses.
+    pub fn without_inference(&self) -> LoadOptions {
+        let material_fields = match &self.material_fields {
+            MaterialLayout::Auto => MaterialLayout::standard(),
+            fields => fields.clone(),
+        };
+        LoadOptions {
+            material_fields,
+            infer_transform_order: false,
+            ..self.clone()
+        }
+    }
+}
+
 impl Default for LoadOptions {
     fn default() -> Self {
         LoadOptions {
@@ -164,7 +187,12 @@ pub fn parse_source_whole(text: &str, path: &Path, opts: &LoadOptions) -> Parsed
 
 fn read(text: &str, path: &Path, opts: &LoadOptions, flat: bool) -> Parsed {
     let chain = parse::Chain::outermost(path, text, opts);
-    parse::parse(text, path, opts, flat, chain)
+    if chain.generated {
+        // Its includes are read with these options too (see `is_generated_frame`).
+        parse::parse(text, path, &opts.without_inference(), flat, chain)
+    } else {
+        parse::parse(text, path, opts, flat, chain)
+    }
 }
 
 /// Orders diagnostics by position (file-wide ones last) and applies `--strict`.
@@ -251,4 +279,80 @@ pub fn not_shown(path: &Path, errors: usize, warnings: usize) -> Diagnostic {
     .with_severity(severity);
     d.left_out = Some(LeftOut { errors, warnings });
     d
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::load::load_str;
+
+    /// A material made invisible by a fade: reflectivity 0, opacity 0, index of refraction 1
+    /// in the standard layout, which inference would read another way.
+    const FADED: &str = "define material ghost 1 0 0 1 0 0 0 0 0 10 0 0 1
+define shape sphere ball 0 0 -5 1 ghost
+define light sun 0 5 5 1 1 1 1
+define camera eye 60
+render eye image.ppm 8 8
+";
+
+    fn opacity(text: &str, path: &Path, opts: &LoadOptions) -> f32 {
+        let loaded = load_str(text, path, opts).expect("loads");
+        let scene = &loaded.jobs[0].scene;
+        let ghost = scene.materials.iter().find(|m| m.name == "ghost");
+        ghost.expect("ghost").opacity
+    }
+
+    fn header() -> String {
+        format!(
+            "# Frame 0 of 24 (t = 0 s at 24 fps), generated from fade.ron {GENERATED_FRAME_SIGNATURE} 0.1.0.\n"
+        )
+    }
+
+    #[test]
+    fn a_generated_frame_is_read_with_the_standard_layout_whatever_inference_would_say() {
+        let auto = LoadOptions {
+            material_fields: MaterialLayout::Auto,
+            infer_transform_order: true,
+            ..LoadOptions::default()
+        };
+        let path = Path::new("fade.sdf");
+        // By hand, the same text is read in the layout that makes it plausible: visible.
+        assert_ne!(opacity(FADED, path, &auto), 0.0);
+        let frame = format!("{}{FADED}", header());
+        assert!(is_generated_frame(&frame));
+        assert_eq!(opacity(&frame, path, &auto), 0.0);
+        let loaded = load_str(&frame, path, &auto).expect("loads");
+        assert!(loaded.diagnostics.is_empty(), "{:?}", loaded.diagnostics);
+    }
+
+    #[test]
+    fn what_a_generated_frame_includes_is_read_with_the_standard_layout_too() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let (materials, rest) = FADED.split_once('\n').expect("two parts");
+        std::fs::write(dir.path().join("static.sdfi"), format!("{materials}\n")).expect("write");
+        let frame = format!("{}include static.sdfi\n{rest}", header());
+        let by_hand = format!("include static.sdfi\n{rest}");
+        let auto = LoadOptions {
+            material_fields: MaterialLayout::Auto,
+            ..LoadOptions::default()
+        };
+        let path = dir.path().join("frame_0000.sdf");
+        // One cache for both readings, as one `anim render DIR` run shares it: each reading
+        // keeps its own layout, in either order.
+        for _ in 0..2 {
+            assert_eq!(opacity(&frame, &path, &auto), 0.0);
+            assert_ne!(opacity(&by_hand, &path, &auto), 0.0);
+        }
+        // An explicit layout is no guess: it stays (its second field, a transparency of 0, is
+        // an opacity of 1).
+        let explicit = LoadOptions {
+            material_fields: MaterialLayout::Fields(vec![
+                MaterialField::Reflectivity,
+                MaterialField::Transparency,
+                MaterialField::Ior,
+            ]),
+            ..LoadOptions::default()
+        };
+        assert_eq!(opacity(&frame, &path, &explicit), 1.0);
+    }
 }

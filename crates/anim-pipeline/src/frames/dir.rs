@@ -29,6 +29,10 @@ pub struct FrameOptions {
     pub force: bool,
     /// Render only this shard's frames.
     pub shard: Option<Shard>,
+    /// Render only the frames from the first to the last of these, counting from 0 in
+    /// natural order as shards do (`--frames A..B`; for generated frames, the numbers in
+    /// their names).
+    pub range: Option<(usize, usize)>,
 }
 
 /// What happened to the frames of one directory.
@@ -211,7 +215,8 @@ fn plan_frames(
     let mut first_of_scene: HashMap<u64, usize> = HashMap::new();
     let mut images: HashMap<PathBuf, String> = HashMap::new();
     for (i, path) in frames.iter().enumerate() {
-        if options.shard.is_some_and(|s| !s.contains(i)) {
+        let in_range = options.range.is_none_or(|(a, b)| (a..=b).contains(&i));
+        if !in_range || options.shard.is_some_and(|s| !s.contains(i)) {
             continue;
         }
         let name = file_name(path);

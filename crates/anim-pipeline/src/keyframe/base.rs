@@ -1,6 +1,7 @@
 //! The base scene of an animation: its statements, what each name is, and where each thing
 //! sits (the default pivots and the centres that `look_at` follows).
 
+use super::expr::Val;
 use super::spec_file::{SceneNames, TargetKind};
 use anim_core::limits;
 use anim_core::math::Transform;
@@ -162,6 +163,10 @@ impl BaseScene {
 }
 
 impl SceneNames for BaseScene {
+    fn containers(&self, name: &str) -> Vec<&str> {
+        self.parents(name)
+    }
+
     fn kind_of(&self, name: &str) -> Option<TargetKind> {
         self.kinds.get(name).copied()
     }
@@ -176,6 +181,35 @@ impl SceneNames for BaseScene {
 
     fn has_material(&self, name: &str) -> bool {
         self.materials.contains(name)
+    }
+
+    fn base_value(&self, target: &str, channel: &str) -> Option<Val> {
+        let num = |v: f64| Some(Val::Num(v));
+        let vec = |v: glam::Vec3| Some(Val::Vec(v.as_dvec3()));
+        // The last statement that says it: a later definition replaces an earlier one.
+        self.statements
+            .iter()
+            .rev()
+            .find_map(|s| match (&s.kind, channel) {
+                (StatementKind::Ambient(c), "ambient") => vec(*c),
+                (StatementKind::Background(c), "background") => vec(*c),
+                (StatementKind::Light(l), _) if l.name == target => match channel {
+                    "brightness" => num(f64::from(l.brightness)),
+                    "color" => vec(l.color),
+                    _ => None,
+                },
+                (StatementKind::Camera(c), "fov") if c.name == target => num(c.fov_x_deg),
+                (StatementKind::Material(m), _) if m.name == target => match channel {
+                    "ka" => vec(m.ka),
+                    "kd" => vec(m.kd),
+                    "ks" => vec(m.ks),
+                    "reflectivity" => num(f64::from(m.reflectivity)),
+                    "opacity" => num(f64::from(m.opacity)),
+                    "ior" => num(f64::from(m.ior)),
+                    _ => None,
+                },
+                _ => None,
+            })
     }
 }
 

@@ -130,7 +130,7 @@ impl<'a> Generator<'a> {
 
         for (k, track) in anim.tracks.iter().enumerate() {
             keyed::set_parameters(&mut out, track, t, self.src, &when)?;
-            keyed::set_material(&mut out, track, t);
+            keyed::set_material(&mut out, track, t, self.src, &when)?;
             if self.is_aimed_camera(&track.target) {
                 continue;
             }
@@ -145,16 +145,36 @@ impl<'a> Generator<'a> {
             }
         }
 
+        // A target follows its parent after all its own tracks have placed it.
+        for (target, path) in self.followers() {
+            for op in self.follow(target, path, t, &when)? {
+                out.push(self.statement(StatementKind::Transform {
+                    target: NameRef {
+                        name: target.to_string(),
+                        loc: self.loc(),
+                    },
+                    ops: vec![op],
+                }));
+            }
+        }
+
         if anim.shutter > 0.0 {
             let moving = self.exposure_motion(i, t)?;
             out.extend(moving);
         }
 
-        let hidden: Vec<&str> = anim
-            .tracks
+        // The last track that keys a thing's `visible` says whether it is shown.
+        let mut shown: Vec<(&str, bool)> = Vec::new();
+        for tr in &anim.tracks {
+            if let Some(v) = tr.visible.as_ref().and_then(|v| v.at(t)) {
+                shown.retain(|(name, _)| *name != tr.target);
+                shown.push((&tr.target, v != 0.0));
+            }
+        }
+        let hidden: Vec<&str> = shown
             .iter()
-            .filter(|tr| tr.visible.as_ref().and_then(|v| v.at(t)) == Some(0.0))
-            .map(|tr| tr.target.as_str())
+            .filter(|(_, on)| !on)
+            .map(|(name, _)| *name)
             .collect();
         keyed::hide(&mut out, self.base, &hidden);
 
@@ -183,6 +203,36 @@ impl<'a> Generator<'a> {
         Ok(self
             .pose(k, t, when)?
             .ops(self.placer.pivot_at(k, t), track.axis))
+    }
+
+    /// The targets that follow a parent (each once) with the path of their `parent`, but
+    /// aimed cameras, whose pose has it.
+    fn followers(&self) -> Vec<(&'a str, &'a str)> {
+        let anim: &'a Animation = self.anim;
+        let mut out: Vec<(&str, &str)> = Vec::new();
+        for track in &anim.tracks {
+            if let Some(p) = &track.parent {
+                if !self.is_aimed_camera(&track.target)
+                    && !out.iter().any(|(t, _)| *t == track.target)
+                {
+                    out.push((&track.target, &p.path));
+                }
+            }
+        }
+        out
+    }
+
+    /// The operations by which `target` follows its parent at time `t`.
+    fn follow(
+        &self,
+        target: &str,
+        path: &str,
+        t: f64,
+        when: &dyn Fn() -> String,
+    ) -> Result<Vec<TransformOp>, Vec<Diagnostic>> {
+        self.placer
+            .follow(target, t, true)
+            .map_err(|why| vec![self.src.error(&[path], format!("{} {why}", when()))])
     }
 
     /// Where track `k` puts its target at time `t`; an error if its scale is 0 there or its
@@ -272,47 +322,79 @@ impl<'a> Generator<'a> {
                 targets.push(&t.target);
             }
         }
+        let followers = self.followers();
         for target in targets {
-            let tracks: Vec<usize> = (0..anim.tracks.len())
-                .filter(|&k| anim.tracks[k].target == target && anim.tracks[k].moves())
-                .collect();
-            let placed = |t: f64| -> Result<(Vec<TrackPose>, Vec<TransformOp>), Vec<Diagnostic>> {
-                let mut poses = Vec::new();
-                let mut ops = Vec::new();
-                for &k in &tracks {
-                    let pose = self.pose(k, t, &when)?;
-                    ops.extend(pose.ops(self.placer.pivot_at(k, t), anim.tracks[k].axis));
-                    poses.push(pose);
-                }
-                Ok((poses, ops))
-            };
-            let (centre, centre_ops) = placed(mid)?;
-            let at: Vec<(Vec<TrackPose>, Vec<TransformOp>)> = instants
+            let parent = followers
                 .iter()
-                .map(|&(_, t)| placed(t))
-                .collect::<Result<_, _>>()?;
-            if at.iter().all(|(p, _)| *p == centre) {
-                continue;
+                .find(|(t, _)| *t == target)
+                .map(|(_, p)| *p);
+            if let Some(deltas) = self.target_motion(target, parent, mid, &instants, &when)? {
+                add(target, deltas);
             }
-            let deltas = at
-                .iter()
-                .map(|(poses, ops)| match tracks.as_slice() {
-                    [k] if anim.tracks[*k].aim.is_none() => motion::delta_ops(
-                        &centre[0],
-                        &poses[0],
-                        self.placer.pivots[*k],
-                        anim.tracks[*k].axis,
-                    ),
-                    _ => {
-                        let mut delta = motion::inverse_ops(&centre_ops);
-                        delta.extend(ops.iter().copied());
-                        motion::simplify(delta)
-                    }
-                })
-                .collect();
-            add(target, deltas);
         }
         Ok(out)
+    }
+
+    /// The motion of `target` (which follows the parent at `parent`, the path of its
+    /// `parent`) at each instant, from where it is at `mid`; `None` if it stays put.
+    fn target_motion(
+        &self,
+        target: &str,
+        parent: Option<&str>,
+        mid: f64,
+        instants: &[(f64, f64)],
+        when: &dyn Fn() -> String,
+    ) -> Result<Option<Vec<Vec<TransformOp>>>, Vec<Diagnostic>> {
+        let anim = self.anim;
+        let tracks: Vec<usize> = (0..anim.tracks.len())
+            .filter(|&k| anim.tracks[k].target == target && anim.tracks[k].moves())
+            .collect();
+        // The poses of its tracks, and then the operations that place it by them and by
+        // the parent it follows.
+        type Placed = (Vec<TrackPose>, Vec<TransformOp>, Vec<TransformOp>);
+        let placed = |t: f64| -> Result<Placed, Vec<Diagnostic>> {
+            let mut poses = Vec::new();
+            let mut ops = Vec::new();
+            for &k in &tracks {
+                let pose = self.pose(k, t, when)?;
+                ops.extend(pose.ops(self.placer.pivot_at(k, t), anim.tracks[k].axis));
+                poses.push(pose);
+            }
+            let follow = match parent {
+                Some(path) => self.follow(target, path, t, when)?,
+                None => Vec::new(),
+            };
+            ops.extend(follow.iter().copied());
+            Ok((poses, ops, follow))
+        };
+        let (centre, centre_ops, centre_follow) = placed(mid)?;
+        let at: Vec<Placed> = instants
+            .iter()
+            .map(|&(_, t)| placed(t))
+            .collect::<Result<_, _>>()?;
+        if at
+            .iter()
+            .all(|(p, _, f)| *p == centre && *f == centre_follow)
+        {
+            return Ok(None);
+        }
+        let deltas = at
+            .iter()
+            .map(|(poses, ops, _)| match tracks.as_slice() {
+                [k] if anim.tracks[*k].aim.is_none() && parent.is_none() => motion::delta_ops(
+                    &centre[0],
+                    &poses[0],
+                    self.placer.pivots[*k],
+                    anim.tracks[*k].axis,
+                ),
+                _ => {
+                    let mut delta = motion::inverse_ops(&centre_ops);
+                    delta.extend(ops.iter().copied());
+                    motion::simplify(delta)
+                }
+            })
+            .collect();
+        Ok(Some(deltas))
     }
 
     /// The complete SDF text of frame `i`.

@@ -4,19 +4,22 @@
 //! `EaseIn` on a key means the motion towards the next key starts slowly. The curves are
 //! documented for users in `docs/animation.md` ("Keys and curves").
 
+use super::expr::Val;
 use glam::DVec3;
 use serde::Deserialize;
 use std::f64::consts::PI;
 
 /// How a segment between two keys is traversed. With `s ∈ [0, 1]` the fraction of the
 /// segment's time that has passed, the value is `a + (b − a)·e(s)` for an easing `e`
-/// ([`Interp::ease`]), except for the two splines, which need the neighbouring keys:
+/// ([`Interp::ease`]), except for the three splines, which need the neighbouring keys:
 ///
 /// - `Smooth`: a Catmull-Rom spline (each key's tangent is the slope between its
 ///   neighbours); no corners, but it can overshoot its keys.
 /// - `Monotone`: a monotone cubic (Fritsch–Carlson tangents, as in PCHIP): no corners where
 ///   the keys keep rising or falling, a flat tangent at every peak and dip, and never a value
 ///   outside the two keys of its segment.
+/// - `Auto`: Blender's auto-clamped handles: Catmull-Rom tangents, but flat at every peak and
+///   dip and at the ends of a channel that does not repeat (it starts and stops at rest).
 #[derive(Clone, Copy, Debug, PartialEq, Default, Deserialize)]
 pub enum Interp {
     Step,
@@ -24,6 +27,7 @@ pub enum Interp {
     Linear,
     Smooth,
     Monotone,
+    Auto,
     EaseIn,
     EaseOut,
     EaseInOut,
@@ -53,13 +57,83 @@ pub enum Interp {
     CubicBezier(f64, f64, f64, f64),
 }
 
+/// One side of a key's curve (`in:` the end of the segment arriving at the key, `out:` the
+/// start of the one leaving it): a Bézier handle `Handle(x, y)`, pointing from the key into
+/// the segment as fractions of its time and of its change in value, or a named ease whose
+/// handle is the cubic Bézier form of that family's `InOut` curve (as easings.net gives
+/// them). A segment with a side given is the CSS timing curve
+/// `CubicBezier(x₁, y₁, 1 − x₂, 1 − y₂)` of its start's `out` handle `(x₁, y₁)` and its end's
+/// `in` handle `(x₂, y₂)`.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+pub enum Side {
+    /// On the straight line: no easing on this side.
+    Linear,
+    Sine,
+    Quad,
+    Cubic,
+    Quart,
+    Expo,
+    /// Pulls back before leaving (or overshoots before arriving).
+    Back,
+    Handle(f64, f64),
+}
+
+impl Side {
+    /// The handle `(x, y)`, from the key into the segment.
+    pub fn handle(self) -> (f64, f64) {
+        match self {
+            Side::Linear => (1.0 / 3.0, 1.0 / 3.0),
+            Side::Sine => (0.37, 0.0),
+            Side::Quad => (0.45, 0.0),
+            Side::Cubic => (0.65, 0.0),
+            Side::Quart => (0.76, 0.0),
+            Side::Expo => (0.87, 0.0),
+            Side::Back => (0.68, -0.6),
+            Side::Handle(x, y) => (x, y),
+        }
+    }
+
+    /// What is wrong with the handle, if anything: time cannot run backwards.
+    pub fn problem(self) -> Option<String> {
+        let (x, y) = self.handle();
+        if !(x.is_finite() && y.is_finite()) {
+            return Some("a handle's x and y must be finite".into());
+        }
+        (!(0.0..=1.0).contains(&x))
+            .then(|| format!("a handle's x is a fraction of the segment's time, in 0..1, not {x}"))
+    }
+
+    /// The curve of a segment whose start has curve `interp` and sides `out` (of its start)
+    /// and `into` (the `in` of its end), at least one given. A side not given is the
+    /// curve's own when that is a Bézier (`Linear` is one), else there is none to take: `Err`
+    /// says so.
+    pub fn segment(
+        interp: Interp,
+        out: Option<Side>,
+        into: Option<Side>,
+    ) -> Result<Interp, String> {
+        let (own_out, own_in) = match interp {
+            Interp::Linear => (Side::Linear.handle(), Side::Linear.handle()),
+            Interp::CubicBezier(x1, y1, x2, y2) => ((x1, y1), (1.0 - x2, 1.0 - y2)),
+            other => {
+                return Err(format!(
+                    "a key's `in` and `out` shape its segments as Bézier curves, which `{other:?}` is not: leave `interp` out (or Linear, or CubicBezier)"
+                ))
+            }
+        };
+        let (x1, y1) = out.map_or(own_out, Side::handle);
+        let (x2, y2) = into.map_or(own_in, Side::handle);
+        Ok(Interp::CubicBezier(x1, y1, 1.0 - x2, 1.0 - y2))
+    }
+}
+
 /// Back's overshoot constant: about a tenth past the target (Penner's easing equations).
 const BACK: f64 = 1.70158;
 
 impl Interp {
     /// Whether this segment's curve needs the neighbouring keys (the two splines).
     pub fn is_spline(self) -> bool {
-        matches!(self, Interp::Smooth | Interp::Monotone)
+        matches!(self, Interp::Smooth | Interp::Monotone | Interp::Auto)
     }
 
     /// The eased fraction `e(s)`: 0 at `s = 0`, 1 at `s = 1` (the splines are linear here:
@@ -82,7 +156,7 @@ impl Interp {
                     0.0
                 }
             }
-            Interp::Linear | Interp::Smooth | Interp::Monotone => s,
+            Interp::Linear | Interp::Smooth | Interp::Monotone | Interp::Auto => s,
             Interp::EaseIn => s * s,
             Interp::EaseOut => 1.0 - (1.0 - s) * (1.0 - s),
             Interp::EaseInOut => s * s * (3.0 - 2.0 * s),
@@ -204,6 +278,10 @@ fn cubic_bezier(x1: f64, y1: f64, x2: f64, y2: f64, s: f64) -> f64 {
 pub trait Keyable: Copy {
     /// How many numbers the value holds.
     const COMPONENTS: usize;
+    /// As an expression sees it (`value`).
+    fn to_val(self) -> Val;
+    /// An expression's result as this kind of value (a number on every axis of a vector).
+    fn from_val(v: Val) -> Self;
     fn add(self, o: Self) -> Self;
     fn sub(self, o: Self) -> Self;
     fn mul(self, k: f64) -> Self;
@@ -213,6 +291,12 @@ pub trait Keyable: Copy {
 
 impl Keyable for f64 {
     const COMPONENTS: usize = 1;
+    fn to_val(self) -> Val {
+        Val::Num(self)
+    }
+    fn from_val(v: Val) -> Self {
+        v.num()
+    }
     fn add(self, o: Self) -> Self {
         self + o
     }
@@ -232,6 +316,12 @@ impl Keyable for f64 {
 
 impl Keyable for DVec3 {
     const COMPONENTS: usize = 3;
+    fn to_val(self) -> Val {
+        Val::Vec(self)
+    }
+    fn from_val(v: Val) -> Self {
+        v.vec()
+    }
     fn add(self, o: Self) -> Self {
         self + o
     }
@@ -387,6 +477,11 @@ fn within_keys<T: Keyable>(keys: &[Key<T>], t: f64, wraps: bool) -> T {
             let m1 = tangent(keys, k + 1, wraps);
             hermite(a.value, m0, b.value, m1, h, s)
         }
+        Interp::Auto => {
+            let m0 = clamped_tangent(keys, k, wraps);
+            let m1 = clamped_tangent(keys, k + 1, wraps);
+            hermite(a.value, m0, b.value, m1, h, s)
+        }
         Interp::Monotone => {
             let m0 = monotone_tangent(keys, k, wraps);
             let m1 = monotone_tangent(keys, k + 1, wraps);
@@ -431,6 +526,30 @@ fn tangent<T: Keyable>(keys: &[Key<T>], i: usize, wraps: bool) -> T {
         (Some((pv, pt)), None) => v.sub(pv).mul(1.0 / (t - pt)),
         (None, None) => v.mul(0.0),
     }
+}
+
+/// Auto-clamped tangent at key `i`, per component: the Catmull-Rom slope between its
+/// neighbours, but 0 at a peak or dip (the neighbours on one side of the value) and at the
+/// ends of a channel that does not wrap.
+fn clamped_tangent<T: Keyable>(keys: &[Key<T>], i: usize, wraps: bool) -> T {
+    let v = keys[i].value;
+    let mut out = v.mul(0.0);
+    let (Some((pv, pt)), Some((nv, nt))) = neighbours(keys, i, wraps) else {
+        return out;
+    };
+    for c in 0..T::COMPONENTS {
+        let (before, after) = (
+            v.component(c) - pv.component(c),
+            nv.component(c) - v.component(c),
+        );
+        let m = if before * after <= 0.0 {
+            0.0
+        } else {
+            (nv.component(c) - pv.component(c)) / (nt - pt)
+        };
+        out = out.with_component(c, m);
+    }
+    out
 }
 
 /// Fritsch–Carlson tangent at key `i`, per component: 0 at a peak, a dip or beside a flat

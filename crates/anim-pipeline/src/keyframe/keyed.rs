@@ -4,7 +4,8 @@
 
 use super::base::BaseScene;
 use super::orbit::Pose;
-use super::spec_file::{Animation, Source, Track};
+use super::ranges::{in_unit_interval, RangeCheck};
+use super::spec_file::{Animation, Blend, Channel, Source, Track};
 use super::tidy::{tidy, tidy3};
 use anim_core::diag::{Diagnostic, Loc};
 use anim_core::limits;
@@ -77,8 +78,9 @@ fn set_or_append(
 }
 
 /// Sets the keyed light and camera parameters of `track` at time `t` (`when` says which frame
-/// that is) in the definitions themselves; a field of view outside 0–180° is an error at the
-/// channel of spec `src`.
+/// that is) in the definitions themselves, each combined by the track's `blend` with what the
+/// definition holds (the base scene's value, or the earlier tracks'); a field of view outside
+/// 0–180° or a negative brightness is an error at the channel of spec `src`.
 pub fn set_parameters(
     out: &mut [Statement],
     track: &Track,
@@ -86,35 +88,41 @@ pub fn set_parameters(
     src: &Source,
     when: &dyn Fn() -> String,
 ) -> Result<(), Vec<Diagnostic>> {
-    let brightness = track.brightness.as_ref().and_then(|c| c.at(t));
+    let brightness = track.brightness.as_ref().and_then(|c| Some((c.at(t)?, c)));
     let rgb = track.color.as_ref().and_then(|c| c.at(t));
-    let fov = match track.fov.as_ref().and_then(|c| c.at(t).map(|v| (v, c))) {
-        Some((v, ch)) if !limits::fov_is_valid(v) => {
-            return Err(vec![src.error(
-                &[&ch.path],
-                format!(
-                    "{} the field of view of '{}' is {}°, outside 0–180° (a smooth curve overshoots here: add a key or use another interp)",
-                    when(),
-                    track.target,
-                    tidy(v)
-                ),
-            )]);
-        }
-        other => other.map(|(v, _)| v),
+    let fov = track.fov.as_ref().and_then(|c| Some((c.at(t)?, c)));
+    let out_of_range = |c: &Channel<f64>, what: &str, v: f64, why: &str| {
+        vec![src.error(
+            &[&c.key_path_at(t)],
+            format!(
+                "{} the {what} of '{}' is {}, {why} (a smooth curve overshoots here, or its tracks combine so: add a key or use another interp)",
+                when(),
+                track.target,
+                tidy(v)
+            ),
+        )]
     };
     for s in out.iter_mut() {
         match &mut s.kind {
             StatementKind::Light(l) if l.name == track.target => {
-                if let Some(b) = brightness {
+                if let Some((b, c)) = brightness {
+                    let b = Blend::combine(track.blend, f64::from(l.brightness), b);
+                    if b < 0.0 && track.blend.is_some() {
+                        return Err(out_of_range(c, "brightness", b, "below 0"));
+                    }
                     l.brightness = tidy(b.max(0.0)) as f32;
                 }
                 if let Some(c) = rgb {
-                    l.color = color(c);
+                    l.color = combined_colour(track.blend, l.color, c);
                 }
             }
-            StatementKind::Camera(c) if c.name == track.target => {
-                if let Some(f) = fov {
-                    c.fov_x_deg = tidy(f);
+            StatementKind::Camera(cam) if cam.name == track.target => {
+                if let Some((f, c)) = fov {
+                    let f = Blend::combine(track.blend, cam.fov_x_deg, f);
+                    if !limits::fov_is_valid(f) {
+                        return Err(out_of_range(c, "field of view", f, "outside 0–180°"));
+                    }
+                    cam.fov_x_deg = tidy(f);
                 }
             }
             _ => {}
@@ -123,17 +131,39 @@ pub fn set_parameters(
     Ok(())
 }
 
+/// `new` combined with the colour a definition holds, as frames write colours.
+fn combined_colour(blend: Option<Blend>, current: Vec3, new: DVec3) -> Vec3 {
+    let current = current.as_dvec3();
+    color(DVec3::new(
+        Blend::combine(blend, current.x, new.x),
+        Blend::combine(blend, current.y, new.y),
+        Blend::combine(blend, current.z, new.z),
+    ))
+}
+
 /// Sets the keyed values of material track `track` at time `t` in the material's
-/// definitions.
-pub fn set_material(out: &mut [Statement], track: &Track, t: f64) {
+/// definitions, each combined by the track's `blend`; a combination out of its range is an
+/// error at the channel (a single track's values are kept in range by `ranges.rs`).
+pub fn set_material(
+    out: &mut [Statement],
+    track: &Track,
+    t: f64,
+    src: &Source,
+    when: &dyn Fn() -> String,
+) -> Result<(), Vec<Diagnostic>> {
     let m = &track.material;
-    let colour = |c: &Option<super::spec_file::Channel<DVec3>>| c.as_ref().and_then(|c| c.at(t));
-    let number = |c: &Option<super::spec_file::Channel<f64>>| {
-        c.as_ref().and_then(|c| c.at(t)).map(|v| tidy(v) as f32)
-    };
+    let colour = |c: &Option<Channel<DVec3>>| c.as_ref().and_then(|c| c.at(t));
     let (ka, kd, ks) = (colour(&m.ka), colour(&m.kd), colour(&m.ks));
-    let (reflectivity, opacity, ior) =
-        (number(&m.reflectivity), number(&m.opacity), number(&m.ior));
+    let numbers: [RangeCheck; 3] = [
+        (
+            &m.reflectivity,
+            "reflectivity",
+            in_unit_interval,
+            "outside 0–1",
+        ),
+        (&m.opacity, "opacity", in_unit_interval, "outside 0–1"),
+        (&m.ior, "index of refraction", |v| v > 0.0, "at or below 0"),
+    ];
     for s in out.iter_mut() {
         let StatementKind::Material(def) = &mut s.kind else {
             continue;
@@ -141,25 +171,32 @@ pub fn set_material(out: &mut [Statement], track: &Track, t: f64) {
         if def.name != track.target {
             continue;
         }
-        if let Some(v) = ka {
-            def.ka = color(v);
+        for (v, field) in [(ka, &mut def.ka), (kd, &mut def.kd), (ks, &mut def.ks)] {
+            if let Some(v) = v {
+                *field = combined_colour(track.blend, *field, v);
+            }
         }
-        if let Some(v) = kd {
-            def.kd = color(v);
-        }
-        if let Some(v) = ks {
-            def.ks = color(v);
-        }
-        if let Some(v) = reflectivity {
-            def.reflectivity = v;
-        }
-        if let Some(v) = opacity {
-            def.opacity = v;
-        }
-        if let Some(v) = ior {
-            def.ior = v;
+        let fields = [&mut def.reflectivity, &mut def.opacity, &mut def.ior];
+        for ((channel, what, ok, range), field) in numbers.iter().zip(fields) {
+            let Some((v, c)) = channel.as_ref().and_then(|c| Some((c.at(t)?, c))) else {
+                continue;
+            };
+            let v = Blend::combine(track.blend, f64::from(*field), v);
+            if track.blend.is_some() && !ok(v) {
+                return Err(vec![src.error(
+                    &[&c.key_path_at(t)],
+                    format!(
+                        "{} the {what} of '{}' is {} once its tracks combine, {range}",
+                        when(),
+                        track.target,
+                        tidy(v)
+                    ),
+                )]);
+            }
+            *field = tidy(v) as f32;
         }
     }
+    Ok(())
 }
 
 /// Takes the things in `hidden` out of the frame: their definitions, the statements that

@@ -20,6 +20,10 @@ pub struct Locations {
     // Keyed by paths of the user's own file, not by an adversary probing collisions: the fast
     // hash, as for the scene reader's names.
     spans: FastMap<String, (Pos, u32)>,
+    /// The name written before a value's parentheses (`Expr("…")`, `Frames(12)`) or alone
+    /// (`AlongPath`), by path: serde passes over the names of some forms, which are checked
+    /// against these.
+    variants: FastMap<String, String>,
 }
 
 impl Locations {
@@ -40,6 +44,11 @@ impl Locations {
     /// The start and width of the value at `path`, e.g. `tracks[0].target`.
     pub fn get(&self, path: &str) -> Option<(Pos, u32)> {
         self.spans.get(path).copied()
+    }
+
+    /// The name written before the value at `path`, if one is: `Expr` of `Expr("…")`.
+    pub fn variant(&self, path: &str) -> Option<&str> {
+        self.variants.get(path).map(String::as_str)
     }
 
     /// The deepest (longest) path whose value starts at `pos`, with its width.
@@ -241,6 +250,12 @@ impl Scanner {
             }
             Some(c) if c.is_alphabetic() || c == '_' => {
                 let name = self.ident();
+                if name != "Some" {
+                    self.out
+                        .variants
+                        .entry(path.clone())
+                        .or_insert(name.clone());
+                }
                 self.skip_ws();
                 if self.peek() == Some('(') {
                     if name == "Some" {

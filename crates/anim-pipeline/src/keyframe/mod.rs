@@ -4,17 +4,21 @@
 //! [`spec`] reads and checks the spec, [`interp`] samples keyed values, [`rotation`] handles
 //! orientations, [`base`] knows the base scene, [`orbit`] places the turntable camera,
 //! [`motion`] turns a track into transforms (and motion during a blurred frame's exposure),
-//! [`placement`] places things at a time (centres, pivots, aims), [`keyed`] writes keyed
+//! [`placement`] places things at a time (centres, pivots, aims, parents), [`follow`] turns a
+//! parent's motion into what its followers carry, [`keyed`] writes keyed
 //! values into definitions, [`ranges`] keeps ranged values in range between frames, and
 //! [`generate`] writes the frames.
 
 pub mod base;
+pub mod expr;
+pub mod follow;
 pub mod generate;
 pub mod interp;
 pub mod keyed;
 pub mod locate;
 pub mod motion;
 pub mod orbit;
+pub mod path;
 pub mod placement;
 pub mod ranges;
 pub mod rotation;
@@ -46,6 +50,10 @@ pub struct GenerateConfig {
     /// Whether each frame file holds the whole scene, rather than including the part no
     /// frame changes from [`split::STATIC_FILE`].
     pub standalone: bool,
+    /// Write only the frames from the first to the last of these (counting from 0). Every
+    /// frame is still made, so that the static part and the list of frames are the whole
+    /// animation's and the frames written are those a full run writes.
+    pub frames: Option<(usize, usize)>,
 }
 
 /// What `anim generate` did.
@@ -61,7 +69,7 @@ pub struct GenerateReport {
     /// has, removed so they cannot be rendered by mistake (`anim render DIR` then removes
     /// their images).
     pub removed: usize,
-    pub fps: u32,
+    pub fps: spec_file::Fps,
     /// The animation's length in seconds (the last frame's time, for `end: Inclusive`).
     pub duration: f64,
     /// Warnings about the spec and the base scene.
@@ -92,7 +100,11 @@ pub fn run_generate_reporting(
     let anim = spec_file::validate(&spec_file, &base, &src)?;
     warnings.extend(anim.warnings.iter().cloned());
     for w in first_frame_warnings(&base, &anim, &src, &spec_file.scene, &spec_dir) {
-        if !warnings.iter().any(|d| d.to_string() == w.to_string()) {
+        // The base scene's own warnings are said already, at the same place.
+        if !warnings
+            .iter()
+            .any(|d| d.loc == w.loc && d.message == w.message)
+        {
             warnings.push(w);
         }
     }
@@ -124,7 +136,8 @@ pub fn run_generate_reporting(
         )]
     })?;
     let result = rebase_mesh_files(&mut base.statements, &base_dir, &dir, &src)
-        .and_then(|()| write_frames(&base, &anim, &src, &dir, config.standalone));
+        .and_then(|()| selected_frames(config.frames, &anim, &src))
+        .and_then(|chosen| write_frames(&base, &anim, &src, &dir, config.standalone, chosen));
     match result {
         Ok((written, removed)) => Ok(GenerateReport {
             dir,
@@ -156,15 +169,34 @@ fn create_dirs(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
     Ok(missing)
 }
 
-/// Checks every frame, then writes those that changed (and, unless `standalone`, the static
-/// part they include), trims frames an earlier run wrote that the animation no longer has,
-/// and records the list. Returns (written, removed).
+/// The frames `--frames A..B` asks for, within the animation's; an error when it has none of
+/// them.
+fn selected_frames(
+    range: Option<(usize, usize)>,
+    anim: &Animation,
+    src: &Source,
+) -> Result<std::ops::RangeInclusive<usize>, Vec<Diagnostic>> {
+    let last = anim.frames - 1;
+    match range {
+        None => Ok(0..=last),
+        Some((a, _)) if a > last => Err(vec![Diagnostic::file_error(
+            &src.path,
+            format!("--frames asks for frames from {a}, but the animation's last frame is {last}"),
+        )]),
+        Some((a, b)) => Ok(a..=b.min(last)),
+    }
+}
+
+/// Checks every frame in `chosen`, then writes those that changed (and, unless `standalone`,
+/// the static part they include), trims frames an earlier run wrote that the animation no
+/// longer has, and records the list. Returns (written, removed).
 fn write_frames(
     base: &BaseScene,
     anim: &Animation,
     src: &Source,
     dir: &Path,
     standalone: bool,
+    chosen: std::ops::RangeInclusive<usize>,
 ) -> Result<(usize, usize), Vec<Diagnostic>> {
     // Every frame is made and checked (loaded as the renderer will) before any is written,
     // so an invalid spec writes nothing: in parallel, as the frames are independent, and the
@@ -173,14 +205,7 @@ fn write_frames(
     // generation is deterministic, so what is written is what was checked.
     let generator = Generator::new(base, anim, src);
     let groups = (!standalone).then(|| split::by_subject(&base.statements));
-    let checked: Vec<Result<HashSet<String>, Vec<Diagnostic>>> = (0..anim.frames)
-        .into_par_iter()
-        .map(|i| check_frame(&generator, anim, src, dir, i, groups.as_ref()))
-        .collect();
-    let mut changed = HashSet::new();
-    for frame in checked {
-        changed.extend(frame?);
-    }
+    let changed = check_frames(&generator, dir, &chosen, groups.as_ref())?;
     let split = groups
         .map(|_| Split::new(&base.statements, changed))
         .filter(|split| !split.is_empty());
@@ -206,11 +231,15 @@ fn write_frames(
         }
         e
     };
-    // Writes one file unless it holds `text` already; whether it was written.
-    let mut put = |name: &str, text: &str, created: &mut Vec<PathBuf>| {
+    // Lists one file and writes it unless it holds `text` already (or no text is given: a
+    // frame outside `chosen`); whether it was written.
+    let mut put = |name: &str, text: Option<&str>, created: &mut Vec<PathBuf>| {
         let path = dir.join(name);
         manifest.push_str(name);
         manifest.push('\n');
+        let Some(text) = text else {
+            return Ok(false);
+        };
         // Unchanged files are left alone, so they keep their identity for tools that look
         // at modification times.
         let before = std::fs::read(&path).ok();
@@ -225,18 +254,24 @@ fn write_frames(
         Ok::<bool, Vec<Diagnostic>>(true)
     };
     if let Some(split) = &split {
-        put(STATIC_FILE, &generator.static_text(split), &mut created)?;
+        put(
+            STATIC_FILE,
+            Some(&generator.static_text(split)),
+            &mut created,
+        )?;
     }
     for i in 0..anim.frames {
+        let name = anim.output.sdf(i, anim.digits());
+        if !chosen.contains(&i) {
+            // Listed all the same: it is one of the animation's frames.
+            put(&name, None, &mut created)?;
+            continue;
+        }
         let statements = generator
             .frame_statements(i)
             .map_err(|e| undo(&created, e))?;
         let text = generator.write_frame(i, &statements, split.as_ref());
-        written += usize::from(put(
-            &anim.output.sdf(i, anim.digits()),
-            &text,
-            &mut created,
-        )?);
+        written += usize::from(put(&name, Some(&text), &mut created)?);
     }
     let current: HashSet<&str> = manifest.lines().collect();
     let mut removed = 0;
@@ -254,6 +289,34 @@ fn write_frames(
         undo(&created, e)
     })?;
     Ok((written, removed))
+}
+
+/// Makes every frame, checks those in `chosen` by loading them, and returns the subjects of
+/// `groups` that some frame changes; the earliest frame that fails is the one reported.
+fn check_frames(
+    generator: &Generator,
+    dir: &Path,
+    chosen: &std::ops::RangeInclusive<usize>,
+    groups: Option<&HashMap<&str, Vec<&StatementKind>>>,
+) -> Result<HashSet<String>, Vec<Diagnostic>> {
+    let (anim, src) = (generator.anim, generator.src);
+    let checked: Vec<Result<HashSet<String>, Vec<Diagnostic>>> = (0..anim.frames)
+        .into_par_iter()
+        .map(|i| {
+            if chosen.contains(&i) {
+                check_frame(generator, anim, src, dir, i, groups)
+            } else {
+                // Not written: only what it changes counts, for the static part.
+                let statements = generator.frame_statements(i)?;
+                Ok(groups.map_or_else(HashSet::new, |g| split::changed_subjects(g, &statements)))
+            }
+        })
+        .collect();
+    let mut changed = HashSet::new();
+    for frame in checked {
+        changed.extend(frame?);
+    }
+    Ok(changed)
 }
 
 /// Parses the base scene. Errors stop generation; warnings are passed on.
@@ -307,10 +370,12 @@ fn load_base(
     Ok((statements, diags))
 }
 
-/// What `anim check` would say of the first frame, located in the base scene where a base
-/// statement is the cause: an unknown material, an image that would be blank. Said once here
-/// rather than by every frame at render time. A frame that cannot be made yields nothing:
-/// writing the frames reports that.
+/// What `anim check` would say of the first frame file, said once here rather than by every
+/// frame at render time, in the base scene where a base statement is the cause: the frame's
+/// statements built as the renderer builds them (each warning at the statement's own place),
+/// what the camera would show, and then every other warning of the frame's text loaded as
+/// `anim check` loads a file, moved from the frame's line to the statement written there. A
+/// frame that cannot be made yields nothing: writing the frames reports that.
 fn first_frame_warnings(
     base: &BaseScene,
     anim: &Animation,
@@ -318,21 +383,52 @@ fn first_frame_warnings(
     scene: &SceneSource,
     spec_dir: &Path,
 ) -> Vec<Diagnostic> {
-    let Ok(statements) = Generator::new(base, anim, src).frame_statements(0) else {
+    let generator = Generator::new(base, anim, src);
+    let Ok(statements) = generator.frame_statements(0) else {
         return Vec::new();
     };
     let path = match scene {
         SceneSource::File(rel) => spec_dir.join(rel),
         SceneSource::Inline(_) => src.path.to_path_buf(),
     };
-    let Ok(loaded) = anim_core::load::build(&statements, &path, &LoadOptions::default()) else {
+    let Ok(built) = anim_core::load::build(&statements, &path, &LoadOptions::default()) else {
         return Vec::new();
     };
-    let mut warnings = loaded.diagnostics;
+    let mut warnings = built.diagnostics;
     warnings.extend(anim_core::load::probe::blank_image_warnings(
-        &loaded.jobs,
+        &built.jobs,
         &path,
     ));
+    let text = generator.write_frame(0, &statements, None);
+    // Read where the base scene is, so that its mesh files are found as written there.
+    let opts = LoadOptions {
+        material_fields: anim_core::sdf::MaterialLayout::Auto,
+        infer_transform_order: true,
+        allow_any_input: true,
+        ..LoadOptions::default()
+    };
+    if let Ok(loaded) = anim_core::load::load_str(&text, &path, &opts) {
+        // The frame's lines: its header, then one statement a line.
+        let header = text.lines().count() - statements.len();
+        for mut d in loaded.diagnostics {
+            let made_by = d.loc.as_ref().filter(|l| *l.file == *path).and_then(|l| {
+                let line = (l.line as usize).checked_sub(header + 1)?;
+                statements.get(line)
+            });
+            if let Some(s) = made_by {
+                d.loc = Some(s.loc.clone());
+                d.file = s.loc.file.to_path_buf();
+                d.source_line = None;
+            }
+            let line = |d: &Diagnostic| d.loc.as_ref().map(|l| (l.file.clone(), l.line));
+            if !warnings
+                .iter()
+                .any(|w| w.message == d.message && line(w) == line(&d))
+            {
+                warnings.push(d);
+            }
+        }
+    }
     if matches!(scene, SceneSource::Inline(_)) {
         warnings = warnings
             .into_iter()

@@ -33,14 +33,16 @@ impl TrackPose {
     /// The track's values at time `t` (neutral where it keys nothing), tidied as frames write
     /// them.
     pub fn at(track: &Track, t: f64) -> TrackPose {
+        let translate = match &track.travel {
+            Some(travel) => travel.at(t),
+            None => track
+                .translate
+                .as_ref()
+                .and_then(|c| c.at(t))
+                .unwrap_or(DVec3::ZERO),
+        };
         TrackPose {
-            translate: tidy3(
-                track
-                    .translate
-                    .as_ref()
-                    .and_then(|c| c.at(t))
-                    .unwrap_or(DVec3::ZERO),
-            ),
+            translate: tidy3(translate),
             degrees: tidy(track.rotate.as_ref().and_then(|c| c.at(t)).unwrap_or(0.0)),
             scale: tidy3(
                 track

@@ -4,7 +4,9 @@
 //! they are written; curves that overshoot (Catmull-Rom, Back, Elastic) can leave the range
 //! between them, so every frame's span of time is checked too, not only its instant.
 
-use super::spec_file::{Animation, Channel, Track};
+use super::expr::Val;
+use super::interp::Keyable;
+use super::spec_file::{Animation, Blend, Channel, Track};
 use super::tidy::tidy;
 use anim_core::limits;
 use glam::DVec3;
@@ -32,7 +34,86 @@ pub fn check_span(anim: &Animation, i: usize) -> Result<(), OutOfRange> {
         format!("at t = {} s", tidy(t0))
     };
     for track in &anim.tracks {
+        expressions_are_finite(track, &instants, &span, i)?;
         check_track(track, &instants, &span, i)?;
+    }
+    let scene = [
+        (&anim.ambient, "ambient light"),
+        (&anim.background, "background"),
+    ];
+    for (channel, what) in scene {
+        if let Some(c) = channel {
+            finite(c, &instants, &format!("the {what}"), &span, i)?;
+        }
+    }
+    Ok(())
+}
+
+/// Every expression of `track` gives finite values over the span (`sqrt(-1)` does not).
+fn expressions_are_finite(
+    track: &Track,
+    instants: &[f64],
+    span: &str,
+    i: usize,
+) -> Result<(), OutOfRange> {
+    let name = &track.target;
+    let m = &track.material;
+    let numbers = [
+        (&track.rotate, "turn"),
+        (&track.brightness, "brightness"),
+        (&track.fov, "field of view"),
+        (&m.reflectivity, "reflectivity"),
+        (&m.opacity, "opacity"),
+        (&m.ior, "index of refraction"),
+        (&track.aim.as_ref().and_then(|a| a.roll.clone()), "roll"),
+    ];
+    for (c, what) in numbers {
+        if let Some(c) = c {
+            finite(c, instants, &format!("the {what} of '{name}'"), span, i)?;
+        }
+    }
+    let vectors = [
+        (&track.translate, "translation"),
+        (&track.scale, "scale"),
+        (&track.color, "colour"),
+        (&m.ka, "ka"),
+        (&m.kd, "kd"),
+        (&m.ks, "ks"),
+    ];
+    for (c, what) in vectors {
+        if let Some(c) = c {
+            finite(c, instants, &format!("the {what} of '{name}'"), span, i)?;
+        }
+    }
+    Ok(())
+}
+
+/// An error at channel `c`'s expression where it gives a value that is not finite.
+fn finite<T: Keyable>(
+    c: &Channel<T>,
+    instants: &[f64],
+    what: &str,
+    span: &str,
+    i: usize,
+) -> Result<(), OutOfRange> {
+    let Some(d) = &c.expr else {
+        return Ok(());
+    };
+    for &t in instants {
+        let v = c.at(t).map(T::to_val);
+        if let Some(v) = v.filter(|v| !v.is_finite()) {
+            let shown = match v {
+                Val::Num(n) => format!("{n}"),
+                Val::Vec(v) => format!("({}, {}, {})", v.x, v.y, v.z),
+            };
+            return Err(OutOfRange {
+                path: d.path.clone(),
+                message: format!(
+                    "at frame {i} ({span}) {what} is {shown} at t = {} s: the expression gives no number there (a square root or logarithm of a negative number, a division by 0?)",
+                    tidy(t)
+                ),
+            });
+        }
     }
     Ok(())
 }
@@ -69,8 +150,11 @@ fn check_track(track: &Track, instants: &[f64], span: &str, i: usize) -> Result<
             "at or below 0",
         ),
     ];
+    // A value added to or multiplied with others is checked once combined, as frames write
+    // it (`keyed.rs`).
+    let layered = matches!(track.blend, Some(Blend::Add | Blend::Multiply));
     for (channel, what, ok, range) in checks {
-        let Some(c) = channel else {
+        let Some(c) = channel.as_ref().filter(|_| !layered) else {
             continue;
         };
         for &t in instants {
@@ -92,14 +176,14 @@ fn check_track(track: &Track, instants: &[f64], span: &str, i: usize) -> Result<
 }
 
 /// A channel, what it is called, whether a value is in range, and how it left the range.
-type RangeCheck<'a> = (
+pub type RangeCheck<'a> = (
     &'a Option<Channel<f64>>,
     &'static str,
     fn(f64) -> bool,
     &'static str,
 );
 
-fn in_unit_interval(v: f64) -> bool {
+pub fn in_unit_interval(v: f64) -> bool {
     (0.0..=1.0).contains(&v)
 }
 

@@ -81,7 +81,10 @@ impl Parser<'_> {
             ior: repair::AIR_IOR,
         };
         let opacity_at = self.material_extras(line, &layout, slots, &nums[9..], &mut def);
-        if let Some(at) = opacity_at.filter(|_| def.opacity == 0.0 && def.ior == 1.0) {
+        // A generated frame means what it says: its invisible material is a fade, not a
+        // layout misread.
+        let invisible = def.opacity == 0.0 && def.ior == 1.0 && !self.chain.generated;
+        if let Some(at) = opacity_at.filter(|_| invisible) {
             self.warn_invisible(line, at, &def);
         }
         self.emit_named(line, 2, StatementKind::Material(def));

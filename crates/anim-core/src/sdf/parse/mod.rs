@@ -63,6 +63,9 @@ pub struct Parsed {
     pub diagnostics: Vec<Diagnostic>,
     /// What the reader left out that the scene builder must account for.
     pub omissions: Omissions,
+    /// Whether the file is a frame `anim generate` wrote (`sdf::is_generated_frame`): it was
+    /// read, and is built, with every guess turned off.
+    pub generated: bool,
     /// The files the scene includes, to any depth, each once: where their lines are quoted
     /// from, when still the same.
     pub included: Vec<FileRead>,
@@ -120,6 +123,7 @@ pub(super) fn parse(
     flat: bool,
     chain: include::Chain,
 ) -> Parsed {
+    let generated = chain.generated;
     let mut p = Parser {
         chain,
         file: Arc::from(path),
@@ -202,6 +206,7 @@ pub(super) fn parse(
                 .collect(),
             abandoned,
         },
+        generated,
     }
 }
 

@@ -4,20 +4,22 @@
 //!
 //! The format is documented for users in `docs/animation.md`.
 
+mod across;
 mod checker;
 mod model;
+mod path;
 mod raw;
 mod source;
 mod track;
 mod validate;
 
 pub use model::{
-    Aim, AimTarget, Animation, Channel, End, MaterialChannels, NamePattern, Orbit, OrientChannel,
-    SceneNames, TargetKind, Track,
+    Aim, AimTarget, AlongPath, Animation, Blend, Channel, End, Follow, Fps, MaterialChannels,
+    NamePattern, Orbit, OrientChannel, Parent, PathMotion, SceneNames, TargetKind, Track,
 };
 pub use raw::{
-    AimSpec, KeySpec, Length, OrbitSpec, Orientation, Rgb, Scale, SceneSource, SpecFile, TrackSpec,
-    V3,
+    AimSpec, FpsSpec, KeySpec, KeyTime, Length, OrbitSpec, Orientation, Rgb, Scale, SceneSource,
+    SpecFile, TimeUnit, TrackSpec, V3,
 };
 pub use source::Source;
 pub use validate::validate;

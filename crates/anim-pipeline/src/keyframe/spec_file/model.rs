@@ -1,20 +1,44 @@
 //! The checked animation: what the generator needs, with every value valid.
 
+use crate::keyframe::expr::{Expr, Val};
 use crate::keyframe::interp::{cycled_time, sample_timed, segment, Interp, Key, Keyable, Timing};
+use crate::keyframe::path::Path;
 use anim_core::limits;
 use glam::{DQuat, DVec3};
+use std::sync::Arc;
 
-/// A keyed channel with the path of its key list (for messages about interpolated values).
+/// A keyed channel with the path of its key list (for messages about interpolated values),
+/// and the expression over it, if any.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Channel<T> {
     pub keys: Vec<Key<T>>,
     pub timing: Timing,
     pub path: String,
+    pub expr: Option<Driven>,
+}
+
+/// A channel's expression, with what it reads besides the time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Driven {
+    pub expr: Arc<Expr>,
+    /// `value` where the channel has no keys: the base scene's value (no motion, for motion).
+    pub base: Val,
+    pub fps: f64,
+    /// `wiggle`'s noise: drawn from the target's and the channel's names.
+    pub seed: u64,
+    /// The expression's text in the spec, for messages.
+    pub path: String,
 }
 
 impl<T: Keyable> Channel<T> {
+    /// The value at time `t`: the keys', then the expression's over them.
     pub fn at(&self, t: f64) -> Option<T> {
-        sample_timed(&self.keys, t, &self.timing)
+        let keyed = sample_timed(&self.keys, t, &self.timing);
+        let Some(d) = &self.expr else {
+            return keyed;
+        };
+        let value = keyed.map_or(d.base, T::to_val);
+        Some(T::from_val(d.expr.eval(t, d.fps, value, d.seed)))
     }
 }
 
@@ -119,6 +143,72 @@ impl MaterialChannels {
     }
 }
 
+/// What of a parent's motion a child follows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
+pub enum Follow {
+    /// Where the parent's centre goes.
+    Translate,
+    /// How the parent turns, about its centre.
+    Rotate,
+    /// How it scales, about its centre.
+    Scale,
+}
+
+/// A target that follows another's motion: `parent` and what it follows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Parent {
+    pub name: String,
+    pub follow: Vec<Follow>,
+    /// `tracks[i].parent`, for messages.
+    pub path: String,
+}
+
+/// A translation along a path, at the distance `progress` says (default: constant speed over
+/// the animation).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PathMotion {
+    pub path: Path,
+    pub progress: Option<Channel<f64>>,
+    /// The animation's length: the default progress goes from 0 to 1 over it.
+    pub duration: f64,
+}
+
+impl PathMotion {
+    /// The fraction of the path travelled at time `t`.
+    pub fn progress(&self, t: f64) -> f64 {
+        match &self.progress {
+            Some(c) => c.at(t).unwrap_or(0.0),
+            None if self.duration > 0.0 => t / self.duration,
+            None => 0.0,
+        }
+    }
+
+    /// Where on the path the target is at time `t`.
+    pub fn at(&self, t: f64) -> DVec3 {
+        self.path.at(self.progress(t))
+    }
+
+    /// Its speed along the path at time `t`, in units a second.
+    pub fn speed(&self, t: f64) -> f64 {
+        let h = 1e-4;
+        let f = (self.progress(t + h) - self.progress(t - h)) / (2.0 * h);
+        f.abs() * self.path.length()
+    }
+}
+
+/// `orient: AlongPath`: the target turns so that `forward` points the way the path goes, with
+/// `up` kept up, leaning into turns by `bank`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AlongPath {
+    /// In the parent's frame as the base scene places the target (for a camera: `None`, its
+    /// own view direction).
+    pub forward: Option<DVec3>,
+    pub up: DVec3,
+    pub bank: f64,
+    /// `tracks[i].orient`, for messages.
+    pub path: String,
+}
+
 /// What a name in the base scene refers to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TargetKind {
@@ -141,10 +231,36 @@ impl TargetKind {
     }
 }
 
+/// How a track's values combine with what the tracks before it on the same target (or the
+/// base scene) give the same channel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
+pub enum Blend {
+    /// This track's value.
+    Replace,
+    /// The sum.
+    Add,
+    /// The product (each part of a colour by the same part).
+    Multiply,
+}
+
+impl Blend {
+    /// `new` combined with `current` (a track without `blend` replaces).
+    pub fn combine(blend: Option<Blend>, current: f64, new: f64) -> f64 {
+        match blend {
+            None | Some(Blend::Replace) => new,
+            Some(Blend::Add) => current + new,
+            Some(Blend::Multiply) => current * new,
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Track {
     pub target: String,
     pub kind: TargetKind,
+    /// How its values combine with the earlier tracks' (`None`: not said; only the first
+    /// track keying a channel may leave it out).
+    pub blend: Option<Blend>,
     pub translate: Option<Channel<DVec3>>,
     pub rotate: Option<Channel<f64>>,
     /// Unit-free, non-zero.
@@ -156,6 +272,12 @@ pub struct Track {
     pub fov: Option<Channel<f64>>,
     /// Keyed orientation, applied about the pivot before `rotate`.
     pub orient: Option<OrientChannel>,
+    /// The translation along a `path`, instead of `translate` keys.
+    pub travel: Option<PathMotion>,
+    /// `orient: AlongPath`: facing the way the path goes.
+    pub along_path: Option<AlongPath>,
+    /// The thing whose motion the target follows, after its own tracks'.
+    pub parent: Option<Parent>,
     pub aim: Option<Aim>,
     pub material: MaterialChannels,
     /// 1 shown, 0 hidden; stepped.
@@ -165,9 +287,40 @@ pub struct Track {
 }
 
 impl Track {
+    /// The values it sets in its target's definition (not motion), each named as in the spec,
+    /// with the path of its keys or expression.
+    pub fn values(&self) -> Vec<(&'static str, &str)> {
+        let m = &self.material;
+        let numbers = [
+            ("brightness", &self.brightness),
+            ("fov", &self.fov),
+            ("reflectivity", &m.reflectivity),
+            ("opacity", &m.opacity),
+            ("ior", &m.ior),
+            ("visible", &self.visible),
+        ];
+        let colours = [
+            ("color", &self.color),
+            ("ka", &m.ka),
+            ("kd", &m.kd),
+            ("ks", &m.ks),
+        ];
+        let mut out: Vec<(&'static str, &str)> = numbers
+            .into_iter()
+            .filter_map(|(n, c)| Some((n, c.as_ref()?.path.as_str())))
+            .collect();
+        out.extend(
+            colours
+                .into_iter()
+                .filter_map(|(n, c)| Some((n, c.as_ref()?.path.as_str()))),
+        );
+        out
+    }
+
     /// Whether the track moves its target (rather than setting its parameters only).
     pub fn moves(&self) -> bool {
         self.translate.is_some()
+            || self.travel.is_some()
             || self.rotate.is_some()
             || self.scale.is_some()
             || self.orient.is_some()
@@ -268,10 +421,58 @@ pub enum End {
     Inclusive,
 }
 
+/// A frame rate, exact: `num` frames every `den` seconds (`24000/1001` is 23.976 fps). Frame
+/// times are computed from the ratio, never from a rounded rate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Fps {
+    pub num: u32,
+    pub den: u32,
+}
+
+impl Fps {
+    /// A whole number of frames per second.
+    pub fn whole(n: u32) -> Fps {
+        Fps { num: n, den: 1 }
+    }
+
+    /// `frames` frame intervals, in seconds. For a whole rate `n` this is `frames / n`, as
+    /// frame times always were.
+    pub fn seconds(self, frames: f64) -> f64 {
+        frames * f64::from(self.den) / f64::from(self.num)
+    }
+
+    /// Frames per second, rounded (for messages and players).
+    pub fn as_f64(self) -> f64 {
+        f64::from(self.num) / f64::from(self.den)
+    }
+
+    /// The frames of one second of timecode, which `Seconds(s)` lengths count: the rate
+    /// itself, but for the NTSC rates (`N·1000/1001`), whose timecode counts `N` frames a
+    /// second (two seconds at 23.976 fps are 48 frames, lasting 2.002 s).
+    pub fn timecode_rate(self) -> f64 {
+        if self.den == 1001 && self.num.is_multiple_of(1000) {
+            f64::from(self.num / 1000)
+        } else {
+            self.as_f64()
+        }
+    }
+}
+
+/// As the frame header writes it: `24`, or the exact ratio `24000/1001`.
+impl std::fmt::Display for Fps {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.den == 1 {
+            write!(f, "{}", self.num)
+        } else {
+            write!(f, "{}/{}", self.num, self.den)
+        }
+    }
+}
+
 /// A validated animation, ready to generate frames from.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Animation {
-    pub fps: u32,
+    pub fps: Fps,
     pub frames: usize,
     pub width: u32,
     pub height: u32,
@@ -299,8 +500,8 @@ impl Animation {
     /// frame (inclusive).
     pub fn duration(&self) -> f64 {
         match self.end {
-            End::Cyclic => self.frames as f64 / self.fps as f64,
-            End::Inclusive => self.frames.saturating_sub(1) as f64 / self.fps as f64,
+            End::Cyclic => self.fps.seconds(self.frames as f64),
+            End::Inclusive => self.fps.seconds(self.frames.saturating_sub(1) as f64),
         }
     }
 
@@ -318,12 +519,12 @@ impl Animation {
 
     /// Time of frame `i` in seconds.
     pub fn time(&self, i: usize) -> f64 {
-        i as f64 / self.fps as f64
+        self.fps.seconds(i as f64)
     }
 
     /// How long the shutter stays open, in seconds.
     pub fn exposure(&self) -> f64 {
-        self.shutter / self.fps as f64
+        self.fps.seconds(self.shutter)
     }
 
     /// The time `u` of the way through frame `i`'s exposure (0 at shutter open, 1 at close).
@@ -336,6 +537,8 @@ impl Animation {
 pub trait SceneNames {
     /// What `name` is, if the base scene defines it.
     fn kind_of(&self, name: &str) -> Option<TargetKind>;
+    /// The composites that list `name` among their children.
+    fn containers(&self, name: &str) -> Vec<&str>;
     /// Every targetable name, for suggestions.
     fn names(&self) -> Vec<&str>;
     /// The camera used when the spec names none.
@@ -343,4 +546,7 @@ pub trait SceneNames {
     /// Whether the base scene defines a material named `name` (a thing of the same name
     /// shadows it for tracks that key the thing's own channels).
     fn has_material(&self, name: &str) -> bool;
+    /// The value the base scene gives `channel` of `target` (of the scene for `ambient` and
+    /// `background`), as an expression reads it as `value` where no key sets it.
+    fn base_value(&self, target: &str, channel: &str) -> Option<Val>;
 }

@@ -1,9 +1,10 @@
 //! The spec as the user writes it: serde types that mirror the RON text one to one, so that
 //! ron rejects every unknown field and variant with its position.
 
-use super::model::End;
-use crate::keyframe::interp::{Cycle, Interp};
+use super::model::{Blend, End, Follow, Fps};
+use crate::keyframe::interp::{Cycle, Interp, Side};
 use crate::keyframe::rotation::EulerOrder;
+use anim_core::limits;
 use glam::DVec3;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
@@ -18,9 +19,9 @@ pub struct SpecFile {
     /// The camera to render; default: the base scene's `render` camera, else its first camera.
     #[serde(default)]
     pub camera: Option<String>,
-    /// Frames per second, a whole number (read as a number so that `24.5` gets a clear message).
+    /// Frames per second: a whole number, an NTSC rate (`23.976`) or a ratio (`"24000/1001"`).
     #[serde(default = "default_fps")]
-    pub fps: f64,
+    pub fps: FpsSpec,
     /// `Seconds(5)` or `Frames(120)`.
     pub length: Length,
     /// (width, height) in pixels.
@@ -46,10 +47,14 @@ pub struct SpecFile {
     pub orbit: Option<OrbitSpec>,
     /// Keyed ambient light (replaces the base scene's).
     #[serde(default)]
-    pub ambient: Vec<KeySpec<Rgb>>,
+    pub ambient: ChannelSpec<Rgb>,
     /// Keyed background colour (replaces the base scene's).
     #[serde(default)]
-    pub background: Vec<KeySpec<Rgb>>,
+    pub background: ChannelSpec<Rgb>,
+    /// Named values that expressions may use: a number, a vector or an expression (of `t`,
+    /// `frame`, `fps` and the values above it), in order.
+    #[serde(default)]
+    pub values: NamedValues,
     #[serde(default)]
     pub tracks: Vec<TrackSpec>,
     /// Named sets of keyed channels that tracks use with `curve: "name"`.
@@ -61,13 +66,16 @@ pub struct SpecFile {
 }
 
 impl SpecFile {
-    /// Every key time written in the spec, sorted, once each (the preview marks them).
+    /// Every key time written in the spec, in seconds, sorted, once each (the preview marks
+    /// them). Keys written in frames count at the spec's rate (24 fps where it is wrong).
     pub fn key_times(&self) -> Vec<f64> {
-        let mut times: Vec<f64> = key_times(&self.ambient)
-            .chain(key_times(&self.background))
+        let fps = self.fps.exact().unwrap_or(Fps::whole(24));
+        let mut times: Vec<f64> = key_times(&self.ambient.keys)
+            .chain(key_times(&self.background.keys))
+            .map(|at| at.seconds(fps))
             .collect();
         for t in self.tracks.iter().chain(&self.curves) {
-            times.extend(t.key_times().map(|at| at + t.offset));
+            times.extend(t.key_times().map(|at| at.seconds(fps) + t.offset));
         }
         times.retain(|t| t.is_finite());
         times.sort_by(f64::total_cmp);
@@ -76,12 +84,125 @@ impl SpecFile {
     }
 }
 
-fn key_times<T>(keys: &[KeySpec<T>]) -> impl Iterator<Item = f64> + '_ {
+fn key_times<T>(keys: &[KeySpec<T>]) -> impl Iterator<Item = KeyTime> + '_ {
     keys.iter().map(|k| k.at)
 }
 
-fn default_fps() -> f64 {
-    24.0
+fn default_fps() -> FpsSpec {
+    FpsSpec::Number(24.0)
+}
+
+/// The frame rate as written: a number (whole, or an NTSC rate such as 29.97), or a ratio
+/// `"A/B"`. Read as any number so that `24.5` gets a clear message.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FpsSpec {
+    Number(f64),
+    Ratio(String),
+}
+
+impl FpsSpec {
+    /// The exact rate, or what is wrong with it. A number with a fraction is an NTSC rate,
+    /// `N·1000/1001` written to three decimals or fewer (23.976, 29.97, 59.94); a ratio is
+    /// reduced (`48000/2002` is `24000/1001`). Either way from 1 to 1000 frames a second.
+    pub fn exact(&self) -> Result<Fps, String> {
+        let rates = limits::FPS;
+        let (lo, hi) = (f64::from(*rates.start()), f64::from(*rates.end()));
+        let expected = format!(
+            "fps must be a whole number from {lo} to {hi}, an NTSC rate (23.976, 29.97, 59.94) or a ratio \"A/B\""
+        );
+        let fps = match self {
+            FpsSpec::Number(n) if n.fract() == 0.0 && (lo..=hi).contains(n) => {
+                Fps::whole(*n as u32)
+            }
+            FpsSpec::Number(n) => {
+                let whole = (n * 1.001).round();
+                let ntsc = whole * 1000.0 / 1001.0;
+                if !((lo..=hi).contains(&whole) && (n - ntsc).abs() < 5e-4) {
+                    return Err(format!("{expected}, not {n}"));
+                }
+                Fps {
+                    num: whole as u32 * 1000,
+                    den: 1001,
+                }
+            }
+            FpsSpec::Ratio(text) => {
+                let parsed = text.split_once('/').and_then(|(a, b)| {
+                    Some((a.trim().parse::<u32>().ok()?, b.trim().parse::<u32>().ok()?))
+                });
+                let Some((a, b)) = parsed.filter(|&(a, b)| a > 0 && b > 0) else {
+                    return Err(format!("{expected}, not \"{text}\""));
+                };
+                let g = gcd(a, b);
+                Fps {
+                    num: a / g,
+                    den: b / g,
+                }
+            }
+        };
+        if (lo..=hi).contains(&fps.as_f64()) {
+            Ok(fps)
+        } else {
+            Err(format!("{expected}, not {fps} ({} fps)", fps.as_f64()))
+        }
+    }
+}
+
+fn gcd(a: u32, b: u32) -> u32 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+impl<'de> Deserialize<'de> for FpsSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Rate;
+        impl Visitor<'_> for Rate {
+            type Value = FpsSpec;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number of frames per second or a ratio \"A/B\"")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<FpsSpec, E> {
+                Ok(FpsSpec::Number(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<FpsSpec, E> {
+                Ok(FpsSpec::Number(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<FpsSpec, E> {
+                Ok(FpsSpec::Number(v as f64))
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<FpsSpec, E> {
+                Ok(FpsSpec::Ratio(v.to_string()))
+            }
+        }
+        d.deserialize_any(Rate)
+    }
+}
+
+/// A key's time: seconds, or `Frames(n)` at the spec's rate.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(untagged, expecting = "expected a number of seconds, or `Frames(n)`")]
+pub enum KeyTime {
+    Seconds(f64),
+    Counted(TimeUnit),
+}
+
+/// A time written with its unit.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+pub enum TimeUnit {
+    Frames(f64),
+    Seconds(f64),
+}
+
+impl KeyTime {
+    /// The time in seconds at `fps`.
+    pub fn seconds(self, fps: Fps) -> f64 {
+        match self {
+            KeyTime::Seconds(s) | KeyTime::Counted(TimeUnit::Seconds(s)) => s,
+            KeyTime::Counted(TimeUnit::Frames(n)) => fps.seconds(n),
+        }
+    }
 }
 
 fn default_output() -> String {
@@ -144,21 +265,28 @@ pub struct TrackSpec {
     #[serde(default)]
     pub curve: Option<String>,
     #[serde(default)]
-    pub translate: Vec<KeySpec<V3>>,
+    pub translate: ChannelSpec<V3>,
     /// Degrees about `axis`.
     #[serde(default)]
-    pub rotate: Vec<KeySpec<f64>>,
+    pub rotate: ChannelSpec<f64>,
     #[serde(default)]
     pub axis: Option<V3>,
     /// A number (uniform) or (x, y, z) per key.
     #[serde(default)]
-    pub scale: Vec<KeySpec<Scale>>,
+    pub scale: ChannelSpec<Scale>,
     /// Centre of rotation and scaling; default: the object's centre as the base scene places it.
     #[serde(default)]
     pub pivot: Option<V3>,
-    /// Full 3-D orientation keys, slerped.
+    /// Full 3-D orientation keys, slerped, or `AlongPath`: facing the way the `path` goes.
     #[serde(default)]
-    pub orient: Vec<KeySpec<Orientation>>,
+    pub orient: OrientSpec,
+    /// The translation as a path travelled at constant speed (instead of `translate` keys).
+    #[serde(default)]
+    pub path: Option<PathSpec>,
+    /// With `orient: AlongPath`: how far the target leans into turns (0: level; 1: as an
+    /// aircraft in a coordinated turn, scene units as metres).
+    #[serde(default)]
+    pub bank: Option<f64>,
     /// The order of `Euler` angles: `XYZ` turns about x first (the parent's axes).
     #[serde(default)]
     pub euler_order: Option<EulerOrder>,
@@ -170,35 +298,35 @@ pub struct TrackSpec {
     pub up: Option<V3>,
     /// With `look_at`: degrees about the line of sight.
     #[serde(default)]
-    pub roll: Vec<KeySpec<f64>>,
+    pub roll: ChannelSpec<f64>,
     /// With `look_at` on an object: the direction that faces the target (default −z).
     #[serde(default)]
     pub forward: Option<V3>,
     /// Lights only.
     #[serde(default)]
-    pub brightness: Vec<KeySpec<f64>>,
+    pub brightness: ChannelSpec<f64>,
     /// Lights only.
     #[serde(default)]
-    pub color: Vec<KeySpec<Rgb>>,
+    pub color: ChannelSpec<Rgb>,
     /// Cameras only: horizontal field of view in degrees.
     #[serde(default)]
-    pub fov: Vec<KeySpec<f64>>,
+    pub fov: ChannelSpec<f64>,
     /// Materials only: ambient, diffuse and specular colours.
     #[serde(default)]
-    pub ka: Vec<KeySpec<Rgb>>,
+    pub ka: ChannelSpec<Rgb>,
     #[serde(default)]
-    pub kd: Vec<KeySpec<Rgb>>,
+    pub kd: ChannelSpec<Rgb>,
     #[serde(default)]
-    pub ks: Vec<KeySpec<Rgb>>,
+    pub ks: ChannelSpec<Rgb>,
     /// Materials only: 0–1.
     #[serde(default)]
-    pub reflectivity: Vec<KeySpec<f64>>,
+    pub reflectivity: ChannelSpec<f64>,
     /// Materials only: 0–1, 1 opaque.
     #[serde(default)]
-    pub opacity: Vec<KeySpec<f64>>,
+    pub opacity: ChannelSpec<f64>,
     /// Materials only: index of refraction, > 0.
     #[serde(default)]
-    pub ior: Vec<KeySpec<f64>>,
+    pub ior: ChannelSpec<f64>,
     /// Shapes and composites: shown (`true`) or not, stepped.
     #[serde(default)]
     pub visible: Vec<KeySpec<bool>>,
@@ -214,25 +342,36 @@ pub struct TrackSpec {
     /// Seconds by which every key of the track plays later.
     #[serde(default)]
     pub offset: f64,
+    /// How the values this track sets combine with those of the tracks before it on the same
+    /// target (and with the base scene's).
+    #[serde(default)]
+    pub blend: Option<Blend>,
+    /// A shape, composite, light or camera whose motion the target follows.
+    #[serde(default)]
+    pub parent: Option<String>,
+    /// What of the parent's motion it follows (default all three).
+    #[serde(default)]
+    pub follow: Option<Vec<Follow>>,
 }
 
 impl TrackSpec {
     /// The times of every key the track itself writes.
-    pub fn key_times(&self) -> impl Iterator<Item = f64> + '_ {
-        key_times(&self.translate)
-            .chain(key_times(&self.rotate))
-            .chain(key_times(&self.scale))
-            .chain(key_times(&self.orient))
-            .chain(key_times(&self.roll))
-            .chain(key_times(&self.brightness))
-            .chain(key_times(&self.color))
-            .chain(key_times(&self.fov))
-            .chain(key_times(&self.ka))
-            .chain(key_times(&self.kd))
-            .chain(key_times(&self.ks))
-            .chain(key_times(&self.reflectivity))
-            .chain(key_times(&self.opacity))
-            .chain(key_times(&self.ior))
+    pub fn key_times(&self) -> impl Iterator<Item = KeyTime> + '_ {
+        key_times(&self.translate.keys)
+            .chain(key_times(&self.rotate.keys))
+            .chain(key_times(&self.scale.keys))
+            .chain(key_times(&self.orient.keys))
+            .chain(self.path.iter().flat_map(|p| key_times(&p.progress.keys)))
+            .chain(key_times(&self.roll.keys))
+            .chain(key_times(&self.brightness.keys))
+            .chain(key_times(&self.color.keys))
+            .chain(key_times(&self.fov.keys))
+            .chain(key_times(&self.ka.keys))
+            .chain(key_times(&self.kd.keys))
+            .chain(key_times(&self.ks.keys))
+            .chain(key_times(&self.reflectivity.keys))
+            .chain(key_times(&self.opacity.keys))
+            .chain(key_times(&self.ior.keys))
             .chain(key_times(&self.visible))
             .chain(match &self.look_at {
                 Some(AimSpec::Keys(k)) => k.iter().map(|k| k.at).collect::<Vec<_>>(),
@@ -266,12 +405,18 @@ pub enum AimSpec {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct KeySpec<T> {
-    /// Seconds from the start of the animation.
-    pub at: f64,
+    /// Seconds from the start of the animation, or `Frames(n)`.
+    pub at: KeyTime,
     pub value: T,
     /// How to move from this key to the next one.
     #[serde(default)]
     pub interp: Interp,
+    /// How the segment before this key arrives at it.
+    #[serde(default, rename = "in")]
+    pub ease_in: Option<Side>,
+    /// How the segment after this key leaves it.
+    #[serde(default, rename = "out")]
+    pub ease_out: Option<Side>,
 }
 
 /// `(x, y, z)` (or `[x, y, z]`).
@@ -361,4 +506,252 @@ impl<'de> Deserialize<'de> for Rgb {
         })
         .map(Rgb)
     }
+}
+
+/// A keyed channel as written: a list of keys, `Expr("…")` (the whole channel a formula) or
+/// `Expr("…", [keys])` (a formula over the keyed value). The name `Expr` itself is checked
+/// against the text ([`super::source::Source`] records it), as serde passes it over.
+#[derive(Debug)]
+pub struct ChannelSpec<T> {
+    pub keys: Vec<KeySpec<T>>,
+    pub expr: Option<String>,
+}
+
+impl<T> Default for ChannelSpec<T> {
+    fn default() -> Self {
+        ChannelSpec {
+            keys: Vec::new(),
+            expr: None,
+        }
+    }
+}
+
+impl<T> ChannelSpec<T> {
+    /// Whether it keys nothing.
+    pub fn is_empty(&self) -> bool {
+        self.keys.is_empty() && self.expr.is_none()
+    }
+
+    /// The path of its keys, given the channel's: inside `Expr("…", [keys])` they are its
+    /// second part.
+    pub fn keys_path(&self, path: &str) -> String {
+        match self.expr {
+            Some(_) => format!("{path}[1]"),
+            None => path.to_string(),
+        }
+    }
+}
+
+/// One part of a channel's list: a key, the text of an expression, or a list of keys.
+enum ChannelPart<T> {
+    Key(KeySpec<T>),
+    Text(String),
+    Keys(Vec<KeySpec<T>>),
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for ChannelPart<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Part<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> Visitor<'de> for Part<T> {
+            type Value = ChannelPart<T>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a key `(at: …, value: …)`")
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Self::Value, E> {
+                Ok(ChannelPart::Text(v.to_string()))
+            }
+            fn visit_map<A: de::MapAccess<'de>>(self, m: A) -> Result<Self::Value, A::Error> {
+                KeySpec::deserialize(de::value::MapAccessDeserializer::new(m)).map(ChannelPart::Key)
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+                let mut keys = Vec::new();
+                while let Some(k) = seq.next_element::<KeySpec<T>>()? {
+                    keys.push(k);
+                }
+                Ok(ChannelPart::Keys(keys))
+            }
+        }
+        d.deserialize_any(Part(std::marker::PhantomData))
+    }
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for ChannelSpec<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Channel<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> Visitor<'de> for Channel<T> {
+            type Value = ChannelSpec<T>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a list of keys `[(at: …, value: …), …]` or `Expr(\"…\")`")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+                let mut parts = Vec::new();
+                while let Some(p) = seq.next_element::<ChannelPart<T>>()? {
+                    parts.push(p);
+                }
+                let mut out = ChannelSpec::default();
+                let mut parts = parts.into_iter();
+                match parts.next() {
+                    Some(ChannelPart::Text(text)) => {
+                        out.expr = Some(text);
+                        match (parts.next(), parts.next()) {
+                            (None, _) => {}
+                            (Some(ChannelPart::Keys(keys)), None) => out.keys = keys,
+                            _ => return Err(de::Error::custom(EXPR_FORM)),
+                        }
+                    }
+                    Some(ChannelPart::Key(first)) => {
+                        out.keys.push(first);
+                        for p in parts {
+                            match p {
+                                ChannelPart::Key(k) => out.keys.push(k),
+                                _ => return Err(de::Error::custom("expected a key `(at: …, value: …)`: a list of keys holds keys only")),
+                            }
+                        }
+                    }
+                    Some(ChannelPart::Keys(_)) => return Err(de::Error::custom(EXPR_FORM)),
+                    None => {}
+                }
+                Ok(out)
+            }
+        }
+        d.deserialize_any(Channel(std::marker::PhantomData))
+    }
+}
+
+/// How an expression over keys is written.
+const EXPR_FORM: &str =
+    "an expression is written `Expr(\"…\")`, or `Expr(\"…\", [keys])` over keys that it reads as `value`";
+
+/// The spec's named values, in the order written.
+#[derive(Debug, Default)]
+pub struct NamedValues(pub Vec<(String, NamedValue)>);
+
+/// A named value: a number, a vector, or an expression.
+#[derive(Debug, Clone, PartialEq)]
+pub enum NamedValue {
+    Number(f64),
+    Vector(DVec3),
+    Expr(String),
+}
+
+impl<'de> Deserialize<'de> for NamedValue {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Value;
+        impl<'de> Visitor<'de> for Value {
+            type Value = NamedValue;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number, three numbers (x, y, z) or an expression in double quotes")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<NamedValue, E> {
+                Ok(NamedValue::Number(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<NamedValue, E> {
+                Ok(NamedValue::Number(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<NamedValue, E> {
+                Ok(NamedValue::Number(v as f64))
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<NamedValue, E> {
+                Ok(NamedValue::Expr(v.to_string()))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<NamedValue, A::Error> {
+                let v = TripleVisitor {
+                    what: "three numbers (x, y, z)",
+                    scalar_ok: false,
+                }
+                .visit_seq(seq)?;
+                Ok(NamedValue::Vector(v))
+            }
+        }
+        d.deserialize_any(Value)
+    }
+}
+
+impl<'de> Deserialize<'de> for NamedValues {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Values;
+        impl<'de> Visitor<'de> for Values {
+            type Value = NamedValues;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("named values `{\"name\": value, …}`")
+            }
+            fn visit_map<A: de::MapAccess<'de>>(self, mut m: A) -> Result<NamedValues, A::Error> {
+                let mut out = Vec::new();
+                while let Some((name, value)) = m.next_entry::<String, NamedValue>()? {
+                    out.push((name, value));
+                }
+                Ok(NamedValues(out))
+            }
+        }
+        d.deserialize_map(Values)
+    }
+}
+
+/// `orient` as written: orientation keys, or `AlongPath`.
+#[derive(Debug, Default)]
+pub struct OrientSpec {
+    pub keys: Vec<KeySpec<Orientation>>,
+    /// `orient: AlongPath`; the name is checked against the text, which records it.
+    pub along_path: bool,
+}
+
+impl OrientSpec {
+    pub fn is_empty(&self) -> bool {
+        self.keys.is_empty() && !self.along_path
+    }
+}
+
+impl<'de> Deserialize<'de> for OrientSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Orient;
+        impl<'de> Visitor<'de> for Orient {
+            type Value = OrientSpec;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("orientation keys `[(at: …, value: Euler(…)), …]` or `AlongPath`")
+            }
+            fn visit_unit<E: de::Error>(self) -> Result<OrientSpec, E> {
+                Ok(OrientSpec {
+                    keys: Vec::new(),
+                    along_path: true,
+                })
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<OrientSpec, A::Error> {
+                let mut keys = Vec::new();
+                while let Some(k) = seq.next_element::<KeySpec<Orientation>>()? {
+                    keys.push(k);
+                }
+                Ok(OrientSpec {
+                    keys,
+                    along_path: false,
+                })
+            }
+        }
+        d.deserialize_any(Orient)
+    }
+}
+
+/// A path: the points it passes, whether it closes, its shape, and how far along it the
+/// target is over time.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PathSpec {
+    pub points: Vec<V3>,
+    #[serde(default)]
+    pub closed: bool,
+    #[serde(default)]
+    pub spline: PathSpline,
+    /// The fraction of the path's length travelled (0 its start, 1 its end); default: from 0
+    /// at the start of the animation to 1 at its end, at constant speed.
+    #[serde(default)]
+    pub progress: ChannelSpec<f64>,
+}
+
+/// The curve through a path's points.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+pub enum PathSpline {
+    /// Catmull-Rom: through every point without corners.
+    #[default]
+    Smooth,
+    /// Straight lines from point to point.
+    Linear,
 }

@@ -90,6 +90,72 @@ impl Source {
         }
     }
 
+    /// Where character `k` of the string value at `path` stands in the spec, and how many of
+    /// the spec's characters the `width` characters from it take: escapes (`\"`) take more
+    /// than one, and a raw string `r#"…"#` may run over several lines. `None` if no string
+    /// stands at `path`.
+    pub fn in_string(&self, path: &str, k: usize, width: usize) -> Option<(Pos, u32)> {
+        let (start, _) = self.locations.get(path)?;
+        let line = self.line_text(start.line)?;
+        let from = byte_index(line, start.col);
+        let offset: usize = self
+            .text
+            .split_inclusive('\n')
+            .take(start.line as usize - 1)
+            .map(str::len)
+            .sum();
+        let rest: Vec<char> = self.text[offset + from..].chars().collect();
+        // Past the opening delimiter; `raw` strings have no escapes.
+        let (mut i, raw) = match rest.first() {
+            Some('"') => (1, false),
+            Some('r') => (rest.iter().position(|&c| c == '"')? + 1, true),
+            _ => return None,
+        };
+        let (mut line_no, mut col) = (start.line, start.col + i as u32);
+        // Steps over one character of the string's value, as written.
+        let step = |i: &mut usize, line_no: &mut u32, col: &mut u32| {
+            let len = match (raw, rest.get(*i)) {
+                (false, Some('\\')) => match rest.get(*i + 1) {
+                    Some('u') => rest[*i..]
+                        .iter()
+                        .position(|&c| c == '}')
+                        .map_or(2, |p| p + 1),
+                    _ => 2,
+                },
+                _ => 1,
+            };
+            for _ in 0..len {
+                if rest.get(*i) == Some(&'\n') {
+                    *line_no += 1;
+                    *col = 1;
+                } else {
+                    *col += 1;
+                }
+                *i += 1;
+            }
+        };
+        for _ in 0..k {
+            if i >= rest.len() {
+                break;
+            }
+            step(&mut i, &mut line_no, &mut col);
+        }
+        let pos = Pos { line: line_no, col };
+        let (mut end_line, mut end_col, mut j) = (line_no, col, i);
+        for _ in 0..width {
+            if j >= rest.len() || end_line != line_no {
+                break;
+            }
+            step(&mut j, &mut end_line, &mut end_col);
+        }
+        let taken = if end_line == line_no {
+            end_col - col
+        } else {
+            1
+        };
+        Some((pos, taken.max(1)))
+    }
+
     /// Turns ron's error into a located diagnostic in the user's terms.
     pub fn ron_error(&self, e: &ron::error::SpannedError) -> Diagnostic {
         use ron::error::Error as E;

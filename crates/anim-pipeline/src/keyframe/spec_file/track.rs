@@ -2,13 +2,15 @@
 //! channels fit it, the timing of the keys, orientations and aims.
 
 use super::checker::{
-    names_list, non_negative, non_negative3, non_zero3, number, positive, rgb, unit_interval,
-    valid_fov, Checker,
+    non_negative, non_negative3, non_zero3, number, positive, rgb, unit_interval, valid_fov,
+    ChannelAt, Checker, ValueCheck,
 };
 use super::model::{
-    Aim, AimTarget, Channel, MaterialChannels, OrientChannel, SceneNames, TargetKind, Track,
+    Aim, AimTarget, Blend, Channel, Follow, MaterialChannels, OrientChannel, Parent, SceneNames,
+    TargetKind, Track,
 };
-use super::raw::{AimSpec, KeySpec, Orientation, Scale, SpecFile, TrackSpec, V3};
+use super::raw::{AimSpec, ChannelSpec, KeySpec, Orientation, Scale, SpecFile, TrackSpec, V3};
+use crate::keyframe::expr::Val;
 use crate::keyframe::interp::{Cycle, Interp, Key, Timing};
 use crate::keyframe::locate::{field, index};
 use crate::keyframe::rotation::{euler, EulerOrder};
@@ -16,13 +18,27 @@ use anim_core::diag::suggest;
 use glam::{DQuat, DVec3};
 
 /// Where a track's channels come from: its own keys, else those of the curve it uses.
-struct Sources<'s> {
-    track: &'s TrackSpec,
-    path: String,
-    curve: Option<(&'s TrackSpec, String)>,
+pub(super) struct Sources<'s> {
+    pub(super) track: &'s TrackSpec,
+    pub(super) path: String,
+    pub(super) curve: Option<(&'s TrackSpec, String)>,
 }
 
 impl<'s> Sources<'s> {
+    /// Channel `name` as written (keys, an expression, or both) and its path in the spec: the
+    /// track's own, else its curve's.
+    pub(super) fn spec<S>(
+        &self,
+        name: &str,
+        get: impl Fn(&'s TrackSpec) -> &'s ChannelSpec<S>,
+    ) -> (&'s ChannelSpec<S>, String) {
+        let own = get(self.track);
+        match &self.curve {
+            Some((curve, path)) if own.is_empty() => (get(curve), field(path, name)),
+            _ => (own, field(&self.path, name)),
+        }
+    }
+
     /// The keys of channel `name` and their path in the spec.
     fn keys<S>(
         &self,
@@ -37,21 +53,32 @@ impl<'s> Sources<'s> {
     }
 
     /// A per-track setting: the track's own, else its curve's.
-    fn setting<T>(&self, get: impl Fn(&'s TrackSpec) -> Option<T>) -> Option<(T, String)> {
+    pub(super) fn setting<T>(
+        &self,
+        get: impl Fn(&'s TrackSpec) -> Option<T>,
+    ) -> Option<(T, String)> {
         get(self.track).map(|v| (v, self.path.clone())).or_else(|| {
             let (curve, path) = self.curve.as_ref()?;
             get(curve).map(|v| (v, path.clone()))
         })
     }
 
-    fn either(&self, keyed: impl Fn(&TrackSpec) -> bool) -> bool {
+    pub(super) fn either(&self, keyed: impl Fn(&TrackSpec) -> bool) -> bool {
         keyed(self.track) || self.curve.as_ref().is_some_and(|(c, _)| keyed(c))
     }
 }
 
 /// Which channels a kind of target accepts, by field name.
 fn fits(kind: TargetKind, channel: &str) -> bool {
-    const MOTION: [&str; 5] = ["translate", "rotate", "scale", "orient", "pivot"];
+    const MOTION: [&str; 7] = [
+        "translate",
+        "path",
+        "rotate",
+        "scale",
+        "orient",
+        "pivot",
+        "parent",
+    ];
     let moving = MOTION.contains(&channel);
     match kind {
         TargetKind::Shape | TargetKind::Composite => {
@@ -88,9 +115,10 @@ fn kinds_for(channel: &str) -> String {
 }
 
 /// Every channel field of a track, with whether it keys anything.
-fn keyed_channels(t: &TrackSpec) -> [(&'static str, bool); 17] {
+fn keyed_channels(t: &TrackSpec) -> [(&'static str, bool); 19] {
     [
         ("translate", !t.translate.is_empty()),
+        ("path", t.path.is_some()),
         ("rotate", !t.rotate.is_empty()),
         ("scale", !t.scale.is_empty()),
         ("orient", !t.orient.is_empty()),
@@ -107,6 +135,7 @@ fn keyed_channels(t: &TrackSpec) -> [(&'static str, bool); 17] {
         ("visible", !t.visible.is_empty()),
         ("roll", !t.roll.is_empty()),
         ("pivot", t.pivot.is_some()),
+        ("parent", t.parent.is_some()),
     ]
 }
 
@@ -135,6 +164,8 @@ impl Checker<'_> {
             })
             .collect();
         self.aims_fit(&tracks, names);
+        self.layers_fit(&tracks);
+        self.parents_fit(&tracks, names, orbit_camera);
         tracks
     }
 
@@ -228,21 +259,30 @@ impl Checker<'_> {
             }
         });
         let timing = self.timing(s, default_looping);
-        let translate = self.keys(s, "translate", |t| &t.translate, timing, |v: &V3| v.0);
-        let (rotate_keys, rotate_path) = s.keys("rotate", |t| &t.rotate);
-        let rotate = self.channel(rotate_keys, &rotate_path, timing, number, None);
-        let (scale_keys, scale_path) = s.keys("scale", |t| &t.scale);
-        let scale = self.channel(
-            scale_keys,
-            &scale_path,
-            timing,
-            |v: &Scale| v.0,
-            Some(non_zero3),
-        );
+        let motion = |c: &mut Self, name: &str, get: fn(&TrackSpec) -> &ChannelSpec<_>| {
+            let (spec, path) = s.spec(name, get);
+            let at = ChannelAt::new(&path, target_name(t), name, Val::Vec(DVec3::ZERO));
+            c.keyed(spec, at, timing, |v: &V3| v.0, None)
+        };
+        let translate = motion(self, "translate", |t| &t.translate);
+        let (spec, at_path) = s.spec("rotate", |t| &t.rotate);
+        let at = ChannelAt::new(&at_path, target_name(t), "rotate", Val::Num(0.0));
+        let rotate = self.keyed(spec, at, timing, number, None);
+        let (spec, at_path) = s.spec("scale", |t| &t.scale);
+        let at = ChannelAt::new(&at_path, target_name(t), "scale", Val::Vec(DVec3::ONE));
+        let scale = self.keyed(spec, at, timing, |v: &Scale| v.0, Some(non_zero3));
         let orient = self.orient(s, timing);
+        let path_motion = self.path_motion(s, timing);
+        let along_path = self.along_path(s, kind);
         let aim = self.aim(s, timing, kind);
-        let (brightness, color, fov) = self.parameters(s, timing);
-        let material = self.material(s, timing);
+        // Values added to or multiplied with others may leave their range alone: what the
+        // frames carry is checked once combined.
+        let layered = matches!(
+            s.setting(|t| t.blend),
+            Some((Blend::Add | Blend::Multiply, _))
+        );
+        let (brightness, color, fov) = self.parameters(s, timing, names, layered);
+        let material = self.material(s, timing, names, layered);
         let visible = self.visible(s, timing);
         let axis = self.axis_and_pivot(s);
         if !keyed_channels(t).iter().any(|(_, keyed)| *keyed) && s.curve.is_none() {
@@ -259,6 +299,7 @@ impl Checker<'_> {
         Some(Track {
             target: target_name(t).to_string(),
             kind,
+            blend: s.setting(|t| t.blend).map(|(b, _)| b),
             translate,
             rotate,
             axis,
@@ -268,24 +309,21 @@ impl Checker<'_> {
             color,
             fov,
             orient,
+            travel: path_motion,
+            along_path,
+            parent: s.setting(|t| t.parent.clone()).map(|(name, p)| Parent {
+                name,
+                follow: s.setting(|t| t.follow.clone()).map_or(
+                    vec![Follow::Translate, Follow::Rotate, Follow::Scale],
+                    |(f, _)| f,
+                ),
+                path: field(&p, "parent"),
+            }),
             aim,
             material,
             visible,
             path,
         })
-    }
-
-    /// A channel of 3-vectors that takes any finite value.
-    fn keys<S>(
-        &mut self,
-        s: &Sources,
-        name: &str,
-        get: impl for<'t> Fn(&'t TrackSpec) -> &'t [KeySpec<S>],
-        timing: Timing,
-        value: impl Fn(&S) -> DVec3,
-    ) -> Option<Channel<DVec3>> {
-        let (keys, path) = s.keys(name, get);
-        self.channel(keys, &path, timing, value, None)
     }
 
     /// Light and camera parameters: brightness, colour, field of view.
@@ -294,34 +332,78 @@ impl Checker<'_> {
         &mut self,
         s: &Sources,
         timing: Timing,
+        names: &dyn SceneNames,
+        layered: bool,
     ) -> (
         Option<Channel<f64>>,
         Option<Channel<DVec3>>,
         Option<Channel<f64>>,
     ) {
-        let (keys, path) = s.keys("brightness", |t| &t.brightness);
-        let brightness = self.channel(keys, &path, timing, number, Some(non_negative));
-        let (keys, path) = s.keys("color", |t| &t.color);
-        let color = self.channel(keys, &path, timing, rgb, Some(non_negative3));
-        let (keys, path) = s.keys("fov", |t| &t.fov);
-        let fov = self.channel(keys, &path, timing, number, Some(valid_fov));
+        let check = |c: ValueCheck| (!layered).then_some(c);
+        let brightness = self.value(
+            s,
+            names,
+            "brightness",
+            |t| &t.brightness,
+            timing,
+            check(non_negative),
+        );
+        let (spec, path) = s.spec("color", |t| &t.color);
+        let at = self.base_of(s, names, &path, "color");
+        let color = self.keyed(spec, at, timing, rgb, check(non_negative3));
+        let fov = self.value(s, names, "fov", |t| &t.fov, timing, check(valid_fov));
         (brightness, color, fov)
     }
 
-    fn material(&mut self, s: &Sources, timing: Timing) -> MaterialChannels {
-        let colour = |c: &mut Self, name: &str, get: fn(&TrackSpec) -> &[KeySpec<_>]| {
-            let (keys, path) = s.keys(name, get);
-            c.channel(keys, &path, timing, rgb, Some(non_negative3))
+    /// Where channel `name` of the track's target is, reading the base scene's value where no
+    /// key sets it.
+    fn base_of<'p>(
+        &self,
+        s: &Sources,
+        names: &dyn SceneNames,
+        path: &'p str,
+        name: &str,
+    ) -> ChannelAt<'p> {
+        let target = target_name(s.track);
+        let base = names.base_value(target, name).unwrap_or(Val::Num(0.0));
+        ChannelAt::new(path, target, name, base)
+    }
+
+    /// A numeric channel of the target's definition, its keys checked by `check`.
+    fn value(
+        &mut self,
+        s: &Sources,
+        names: &dyn SceneNames,
+        name: &str,
+        get: fn(&TrackSpec) -> &ChannelSpec<f64>,
+        timing: Timing,
+        check: Option<ValueCheck>,
+    ) -> Option<Channel<f64>> {
+        let (spec, path) = s.spec(name, get);
+        let at = self.base_of(s, names, &path, name);
+        self.keyed(spec, at, timing, number, check)
+    }
+
+    fn material(
+        &mut self,
+        s: &Sources,
+        timing: Timing,
+        names: &dyn SceneNames,
+        layered: bool,
+    ) -> MaterialChannels {
+        let check = |c: ValueCheck| (!layered).then_some(c);
+        let colour = |c: &mut Self, name: &str, get: fn(&TrackSpec) -> &ChannelSpec<_>| {
+            let (spec, path) = s.spec(name, get);
+            let at = c.base_of(s, names, &path, name);
+            c.keyed(spec, at, timing, rgb, check(non_negative3))
         };
         let ka = colour(self, "ka", |t| &t.ka);
         let kd = colour(self, "kd", |t| &t.kd);
         let ks = colour(self, "ks", |t| &t.ks);
-        let (keys, path) = s.keys("reflectivity", |t| &t.reflectivity);
-        let reflectivity = self.channel(keys, &path, timing, number, Some(unit_interval));
-        let (keys, path) = s.keys("opacity", |t| &t.opacity);
-        let opacity = self.channel(keys, &path, timing, number, Some(unit_interval));
-        let (keys, path) = s.keys("ior", |t| &t.ior);
-        let ior = self.channel(keys, &path, timing, number, Some(positive));
+        let unit = check(unit_interval);
+        let reflectivity = self.value(s, names, "reflectivity", |t| &t.reflectivity, timing, unit);
+        let opacity = self.value(s, names, "opacity", |t| &t.opacity, timing, unit);
+        let ior = self.value(s, names, "ior", |t| &t.ior, timing, check(positive));
         MaterialChannels {
             ka,
             kd,
@@ -406,7 +488,7 @@ impl Checker<'_> {
 
     /// Orientation keys as quaternions.
     fn orient(&mut self, s: &Sources, timing: Timing) -> Option<OrientChannel> {
-        let (keys, path) = s.keys("orient", |t| &t.orient);
+        let (keys, path) = s.keys("orient", |t| &t.orient.keys);
         if keys.is_empty() {
             return None;
         }
@@ -416,7 +498,9 @@ impl Checker<'_> {
         let mut out = Vec::with_capacity(keys.len());
         for (i, k) in keys.iter().enumerate() {
             let key_path = index(&path, i);
-            self.key_time(k.at, i.checked_sub(1).map(|p| keys[p].at), &key_path);
+            let at = k.at.seconds(self.fps);
+            let previous = i.checked_sub(1).map(|p| keys[p].at.seconds(self.fps));
+            self.key_time(at, previous, &key_path);
             self.key_curve(k, &key_path);
             if k.interp.is_spline() {
                 self.err(
@@ -436,15 +520,17 @@ impl Checker<'_> {
                 }
             };
             out.push(Key {
-                at: k.at,
+                at,
                 value,
                 interp: k.interp,
             });
         }
+        self.key_sides(keys, &path, &mut out);
         Some(Channel {
             keys: out,
             timing,
             path,
+            expr: None,
         })
     }
 
@@ -481,10 +567,11 @@ impl Checker<'_> {
                     "forward" => s.either(|t| t.forward.is_some()),
                     _ => s.either(|t| !t.roll.is_empty()),
                 };
-                if given {
+                let along = extra != "roll" && s.either(|t| t.orient.along_path);
+                if given && !along {
                     self.err(
                         &[&field(&s.path, extra), &s.path],
-                        format!("`{extra}` goes with `look_at`, which this track does not have"),
+                        format!("`{extra}` goes with `look_at` (or `orient: AlongPath`), which this track does not have"),
                     );
                 }
             }
@@ -504,6 +591,7 @@ impl Checker<'_> {
                         keys: Vec::new(),
                         timing,
                         path: path.clone(),
+                        expr: None,
                     }),
             ),
             AimSpec::Object(name) => AimTarget::Object(name.clone()),
@@ -547,8 +635,9 @@ impl Checker<'_> {
                 ),
             );
         }
-        let (keys, roll_path) = s.keys("roll", |t| &t.roll);
-        let roll = self.channel(keys, &roll_path, timing, number, None);
+        let (spec, roll_path) = s.spec("roll", |t| &t.roll);
+        let at = ChannelAt::new(&roll_path, target_name(s.track), "roll", Val::Num(0.0));
+        let roll = self.keyed(spec, at, timing, number, None);
         Some(Aim {
             target,
             up,
@@ -654,9 +743,17 @@ impl Checker<'_> {
 
     /// The orbit sets its camera's pose outright: keyed motion would fight it.
     fn not_moved_off_orbit(&mut self, s: &Sources) {
-        let moving = ["translate", "rotate", "scale", "orient", "look_at"]
-            .into_iter()
-            .find(|c| s.either(|t| keyed_channels(t).iter().any(|(n, k)| n == c && *k)));
+        let moving = [
+            "translate",
+            "path",
+            "rotate",
+            "scale",
+            "orient",
+            "look_at",
+            "parent",
+        ]
+        .into_iter()
+        .find(|c| s.either(|t| keyed_channels(t).iter().any(|(n, k)| n == c && *k)));
         if let Some(channel) = moving {
             self.err(
                 &[&field(&s.path, channel), &s.path],
@@ -666,184 +763,6 @@ impl Checker<'_> {
                 ),
             );
         }
-    }
-
-    /// What the aims need of the whole animation: an object to look at that exists, one aim
-    /// per target, and a camera that no other track turns.
-    fn aims_fit(&mut self, tracks: &[Track], names: &dyn SceneNames) {
-        for (i, track) in tracks.iter().enumerate() {
-            let Some(aim) = &track.aim else {
-                continue;
-            };
-            if let AimTarget::Object(name) = &aim.target {
-                self.aimed_at(track, aim, name, names);
-            }
-            let same: Vec<&Track> = tracks.iter().filter(|t| t.target == track.target).collect();
-            if tracks[..i]
-                .iter()
-                .any(|t| t.target == track.target && t.aim.is_some())
-            {
-                self.err(
-                    &[&aim.path],
-                    format!(
-                        "'{}' has a `look_at` in an earlier track already",
-                        track.target
-                    ),
-                );
-            }
-            // An aimed camera's eye moves by translations only: its pose is set outright.
-            let camera = track.kind == TargetKind::Camera;
-            let turned = same.iter().find(|t| {
-                t.rotate.is_some() || t.orient.is_some() || (camera && t.scale.is_some())
-            });
-            if let Some(other) = turned.filter(|t| t.path != track.path) {
-                self.err(
-                    &[&other.path],
-                    format!(
-                        "'{}' looks at its target (`look_at` in {}): this track would turn it away",
-                        track.target, track.path
-                    ),
-                );
-            }
-        }
-    }
-
-    fn aimed_at(&mut self, track: &Track, aim: &Aim, name: &str, names: &dyn SceneNames) {
-        let at = [index(&aim.path, 0), aim.path.clone()];
-        match names.kind_of(name) {
-            _ if name == track.target => {
-                self.err(&[&at[0], &at[1]], format!("'{name}' cannot look at itself"))
-            }
-            Some(TargetKind::Shape | TargetKind::Composite | TargetKind::Light) => {}
-            Some(kind) => self.err(
-                &[&at[0], &at[1]],
-                format!(
-                    "'{name}' is a {}: `look_at: Object(…)` follows a shape, composite or light",
-                    kind.noun()
-                ),
-            ),
-            None => {
-                let objects: Vec<&str> = names
-                    .names()
-                    .into_iter()
-                    .filter(|n| {
-                        matches!(
-                            names.kind_of(n),
-                            Some(TargetKind::Shape | TargetKind::Composite)
-                        )
-                    })
-                    .collect();
-                let d = self.src.error(
-                    &[&at[0], &at[1]],
-                    format!("the base scene has no object named '{name}' to look at"),
-                );
-                let d = match suggest(name, objects.iter().copied()) {
-                    Some(s) => d.with_help(format!("did you mean '{s}'?")),
-                    None if objects.len() <= 12 && !objects.is_empty() => {
-                        d.with_help(format!("its objects: {}", names_list(&objects)))
-                    }
-                    None => d,
-                };
-                if !self.full() {
-                    self.errors.push(d);
-                }
-            }
-        }
-    }
-}
-
-impl Checker<'_> {
-    /// Warns, at the key, of every last key that no frame shows: the last frame of a cyclic
-    /// animation is one step before `length`. A channel that ends where it began is a loop,
-    /// whose last key the next first frame shows, and is left alone.
-    pub fn unshown_last_keys(
-        &mut self,
-        tracks: &[Track],
-        ambient: &Option<Channel<DVec3>>,
-        background: &Option<Channel<DVec3>>,
-        last_frame: f64,
-    ) {
-        let mut late = Vec::new();
-        never_shown(&mut late, ambient, last_frame);
-        never_shown(&mut late, background, last_frame);
-        for t in tracks {
-            never_shown(&mut late, &t.translate, last_frame);
-            // A turn that ends a whole number of turns from where it began is back at its start.
-            let whole_turns = t
-                .rotate
-                .as_ref()
-                .and_then(|c| Some((c.keys.last()?.value - c.keys.first()?.value) % 360.0 == 0.0));
-            if whole_turns != Some(true) {
-                never_shown(&mut late, &t.rotate, last_frame);
-            }
-            never_shown(&mut late, &t.scale, last_frame);
-            never_shown(&mut late, &t.brightness, last_frame);
-            never_shown(&mut late, &t.color, last_frame);
-            never_shown(&mut late, &t.fov, last_frame);
-            never_shown(&mut late, &t.visible, last_frame);
-            let m = &t.material;
-            for c in [&m.ka, &m.kd, &m.ks] {
-                never_shown(&mut late, c, last_frame);
-            }
-            for c in [&m.reflectivity, &m.opacity, &m.ior] {
-                never_shown(&mut late, c, last_frame);
-            }
-            if let Some(aim) = &t.aim {
-                never_shown(&mut late, &aim.roll, last_frame);
-                if let AimTarget::Keys(k) = &aim.target {
-                    never_shown(&mut late, &Some(k.clone()), last_frame);
-                }
-            }
-            if let Some(o) = &t.orient {
-                let ends = o.keys.first().zip(o.keys.last());
-                let returns = ends.is_some_and(|(a, b)| a.value.abs_diff_eq(b.value, 1e-12));
-                let shown = o.orientation(last_frame) == o.keys.last().map(|k| k.value);
-                if let Some(last) = o.keys.last().filter(|_| !returns && !shown) {
-                    let played = last.at + o.timing.offset;
-                    if o.timing.cycle == Cycle::Hold && played > last_frame + 1e-9 {
-                        late.push((index(&o.path, o.keys.len() - 1), played));
-                    }
-                }
-            }
-        }
-        for (path, at) in late {
-            let at_path = field(&path, "at");
-            self.warn(
-                &[&at_path, &path],
-                format!(
-                    "this key at {} s comes after the last frame ({} s), so no frame shows it",
-                    crate::keyframe::tidy::tidy(at),
-                    crate::keyframe::tidy::tidy(last_frame)
-                ),
-            );
-            if let Some(w) = self.warnings.pop() {
-                self.warnings.push(w.with_help(
-                    "`end: Inclusive` adds a frame at `length` that shows the last keys; the default, `end: Cyclic`, stops one frame short so that loops do not show one pose twice",
-                ));
-            }
-        }
-    }
-}
-
-/// Adds channel `c`'s last key to `late` if no frame up to `last_frame` shows it.
-fn never_shown<T: crate::keyframe::interp::Keyable + PartialEq>(
-    late: &mut Vec<(String, f64)>,
-    c: &Option<Channel<T>>,
-    last_frame: f64,
-) {
-    let Some(c) = c else {
-        return;
-    };
-    let (Some(first), Some(last)) = (c.keys.first(), c.keys.last()) else {
-        return;
-    };
-    let played = last.at + c.timing.offset;
-    let loops_back = c.keys.len() > 1 && first.value == last.value;
-    if c.timing.cycle != Cycle::Hold || played <= last_frame + 1e-9 || loops_back {
-        return;
-    }
-    if c.at(last_frame) != Some(last.value) {
-        late.push((index(&c.path, c.keys.len() - 1), played));
     }
 }
 

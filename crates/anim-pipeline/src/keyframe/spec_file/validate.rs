@@ -2,14 +2,18 @@
 //! every name against the base scene. All problems are collected, each at its place in the
 //! spec, so that one run shows everything to fix.
 
-use super::checker::{names_list, non_negative3, rgb, Checker};
-use super::model::{Animation, End, NamePattern, Orbit, SceneNames, TargetKind};
-use super::raw::{Length, OrbitSpec, SpecFile};
+use super::checker::{names_list, non_negative3, rgb, ChannelAt, Checker};
+use super::model::{Animation, End, Fps, NamePattern, Orbit, SceneNames, TargetKind};
+use super::raw::{ChannelSpec, FpsSpec, Length, NamedValue, NamedValues, OrbitSpec, Rgb, SpecFile};
 use super::source::Source;
+use crate::keyframe::expr::{Expr, Func, Val, Var};
 use crate::keyframe::interp::Timing;
+use crate::keyframe::locate::index;
 use crate::keyframe::tidy::tidy;
 use anim_core::diag::{suggest, Diagnostic};
 use anim_core::limits;
+use glam::DVec3;
+use std::sync::Arc;
 
 /// Largest frame count accepted: far beyond any real use, small enough to catch `fps: 24000`.
 const MAX_FRAMES: f64 = 1_000_000.0;
@@ -24,34 +28,31 @@ pub fn validate(
     src: &Source,
 ) -> Result<Animation, Vec<Diagnostic>> {
     let mut c = Checker::new(src);
-    let fps = c.fps(spec.fps);
+    let fps = c.fps(&spec.fps);
+    c.fps = fps;
     let frames = c.frame_count(spec.length, fps, spec.end);
     c.duration = match spec.end {
-        End::Cyclic => frames as f64 / fps as f64,
-        End::Inclusive => frames.saturating_sub(1) as f64 / fps as f64,
+        End::Cyclic => fps.seconds(frames as f64),
+        End::Inclusive => fps.seconds(frames.saturating_sub(1) as f64),
     };
     let (width, height) = c.image_size(spec);
     let output = c.output(spec);
     let camera = c.camera(spec.camera.as_deref(), names);
     let orbit = spec.orbit.as_ref().map(|o| c.orbit(o));
     let shutter = c.shutter(spec.shutter);
-    let ambient = c.channel(
-        &spec.ambient,
-        "ambient",
-        Timing::looping(spec.looping),
-        rgb,
-        Some(non_negative3),
-    );
-    let background = c.channel(
-        &spec.background,
-        "background",
-        Timing::looping(spec.looping),
-        rgb,
-        Some(non_negative3),
-    );
+    c.named_values(&spec.values);
+    let spec_looping = spec.looping;
+    let mut scene_colour = |name: &str, spec: &ChannelSpec<Rgb>| {
+        let base = names.base_value("", name).unwrap_or(Val::Vec(DVec3::ZERO));
+        let at = ChannelAt::new(name, "", name, base);
+        let timing = Timing::looping(spec_looping);
+        c.keyed(spec, at, timing, rgb, Some(non_negative3))
+    };
+    let ambient = scene_colour("ambient", &spec.ambient);
+    let background = scene_colour("background", &spec.background);
     let orbit_camera = orbit.is_some().then_some(camera.as_str());
     let tracks = c.tracks(spec, names, orbit_camera);
-    let last_frame = frames.saturating_sub(1) as f64 / fps as f64;
+    let last_frame = fps.seconds(frames.saturating_sub(1) as f64);
     if spec.end == End::Cyclic {
         c.unshown_last_keys(&tracks, &ambient, &background, last_frame);
     }
@@ -78,20 +79,58 @@ pub fn validate(
 
 impl Checker<'_> {
     /// The frame rate; the default rate when it is wrong, so that checking can go on.
-    fn fps(&mut self, fps: f64) -> u32 {
-        let rates = limits::FPS;
-        if fps.fract() == 0.0 && (*rates.start() as f64..=*rates.end() as f64).contains(&fps) {
-            return fps as u32;
+    fn fps(&mut self, fps: &FpsSpec) -> Fps {
+        fps.exact().unwrap_or_else(|why| {
+            self.err(&["fps"], why);
+            Fps::whole(24)
+        })
+    }
+
+    /// The spec's named values, in order, each checked (and usable by those below it and by
+    /// every channel's expression).
+    fn named_values(&mut self, values: &NamedValues) {
+        let mut compiled: Vec<Expr> = Vec::new();
+        for (i, (name, value)) in values.0.iter().enumerate() {
+            let (key_path, path) = (format!("values{{key {i}}}"), index("values", i));
+            let word = name
+                .chars()
+                .next()
+                .is_some_and(|c| c.is_alphabetic() || c == '_')
+                && name.chars().all(|c| c.is_alphanumeric() || c == '_');
+            if !word {
+                self.err(
+                    &[&key_path, "values"],
+                    format!("'{name}' is not a name an expression can use: letters, digits and `_`, not starting with a digit"),
+                );
+            } else if Var::named(name).is_some() || Func::named(name).is_some() {
+                self.err(
+                    &[&key_path, "values"],
+                    format!("`{name}` is a name of the expression language already"),
+                );
+            } else if self.named_types.iter().any(|(n, _)| n == name) {
+                self.err(
+                    &[&key_path, "values"],
+                    format!("a value named '{name}' is defined already"),
+                );
+            }
+            let expr = match value {
+                NamedValue::Number(n) => Some(Expr::constant(Val::Num(*n))),
+                NamedValue::Vector(v) => Some(Expr::constant(Val::Vec(*v))),
+                NamedValue::Expr(text) => self.expression(text, &path, None),
+            };
+            let expr = expr.unwrap_or_else(|| Expr::constant(Val::Num(0.0)));
+            if !matches!(value, NamedValue::Expr(_))
+                && !expr.eval(0.0, 1.0, Val::Num(0.0), 0).is_finite()
+            {
+                self.err(
+                    &[&path, "values"],
+                    format!("the value of '{name}' must be finite"),
+                );
+            }
+            self.named_types.push((name.clone(), expr.ty));
+            compiled.push(expr);
+            self.named = Arc::new(compiled.clone());
         }
-        self.err(
-            &["fps"],
-            format!(
-                "fps must be a whole number from {} to {}, not {fps}",
-                rates.start(),
-                rates.end()
-            ),
-        );
-        24
     }
 
     /// The shutter fraction; 0 (no blur) when it is wrong, so that checking can go on.
@@ -107,7 +146,7 @@ impl Checker<'_> {
     }
 
     /// The number of frames; a usable stand-in when the length is wrong.
-    fn frame_count(&mut self, length: Length, fps: u32, end: End) -> usize {
+    fn frame_count(&mut self, length: Length, fps: Fps, end: End) -> usize {
         let frames = match length {
             Length::Frames(n) => {
                 if !(n.fract() == 0.0 && n >= 1.0) {
@@ -134,8 +173,9 @@ impl Checker<'_> {
         }
     }
 
-    fn frames_in_seconds(&mut self, s: f64, fps: u32) -> f64 {
-        let exact = s * fps as f64;
+    /// The frames in `s` seconds of timecode at `fps` (`Fps::timecode_rate`).
+    fn frames_in_seconds(&mut self, s: f64, fps: Fps) -> f64 {
+        let exact = s * fps.timecode_rate();
         let n = exact.round();
         if !s.is_finite() || s <= 0.0 {
             self.err(

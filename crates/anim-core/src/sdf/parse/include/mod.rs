@@ -58,27 +58,37 @@ impl Parser<'_> {
             return;
         }
         let written = token.text.trim_matches('"');
-        let (path, included) = match self.chain.known(written, &self.opts.includes) {
-            Some(known) => known,
-            None => {
-                let opened = match self.chain.open(written) {
-                    Ok(opened) => opened,
-                    Err(why) => return self.unusable(line, written, why),
-                };
-                let path = opened.real().to_path_buf();
-                let included = match self.opts.includes.get(&path, &self.chain) {
-                    Some(included) => included,
-                    None => {
-                        let display = self.path.parent().unwrap_or(Path::new("")).join(written);
-                        match self.read_included(line, opened, &display) {
+        let (path, included) =
+            match self
+                .chain
+                .known(written, &self.opts.includes, &self.opts.material_fields)
+            {
+                Some(known) => known,
+                None => {
+                    let opened = match self.chain.open(written) {
+                        Ok(opened) => opened,
+                        Err(why) => return self.unusable(line, written, why),
+                    };
+                    let path = opened.real().to_path_buf();
+                    let included =
+                        match self
+                            .opts
+                            .includes
+                            .get(&path, &self.chain, &self.opts.material_fields)
+                        {
                             Some(included) => included,
-                            None => return,
-                        }
-                    }
-                };
-                (path, included)
-            }
-        };
+                            None => {
+                                let display =
+                                    self.path.parent().unwrap_or(Path::new("")).join(written);
+                                match self.read_included(line, opened, &display) {
+                                    Some(included) => included,
+                                    None => return,
+                                }
+                            }
+                        };
+                    (path, included)
+                }
+            };
         let (read, limit) = self.chain.reading.bytes();
         if read > limit {
             self.error(
@@ -186,6 +196,8 @@ impl Parser<'_> {
             skipped: parsed.omissions.skipped,
             render_lines: parsed.omissions.render_lines,
             cameras_rejected: parsed.omissions.cameras_rejected,
+            layout: self.opts.material_fields.clone(),
+            generated: self.chain.generated,
             cut: cut.get(),
         });
         if !included.cut {
@@ -207,6 +219,8 @@ impl Parser<'_> {
             render_lines: shared.render_lines,
             cameras_rejected: shared.cameras_rejected,
             cut: shared.cut,
+            layout: shared.layout.clone(),
+            generated: shared.generated,
         });
         for s in &included.statements {
             if let StatementKind::Camera(c) = &s.kind {

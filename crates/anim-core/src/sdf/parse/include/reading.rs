@@ -6,6 +6,7 @@ use crate::diag::Diagnostic;
 use crate::input::{open_named, Opened};
 use crate::limits::MAX_INCLUDE_REPEATS;
 use crate::sdf::ast::{FlatShapes, Statement};
+use crate::sdf::MaterialLayout;
 use crate::util::Fnv64;
 use std::cell::{Cell, RefCell};
 use std::collections::{HashMap, HashSet};
@@ -93,6 +94,12 @@ pub(super) struct Included {
     pub(super) skipped: HashSet<String>,
     pub(super) render_lines: usize,
     pub(super) cameras_rejected: bool,
+    /// How it was read: a generated frame reads what it includes as it is read itself, with
+    /// the standard material layout whatever `--material-fields auto` would infer and without
+    /// the warnings that hint at another layout (`sdf::is_generated_frame`); a reading is used
+    /// again only for the same layout and kind of includer.
+    pub(super) layout: MaterialLayout,
+    pub(super) generated: bool,
     /// Whether a limit of the reading that read it (how deep, how much repeated) left
     /// something of it out: such a reading is not kept for another scene.
     pub(super) cut: bool,
@@ -129,7 +136,12 @@ impl IncludeCache {
 
     /// The reading of the file at `path` (real), when one is kept and every file it read
     /// still holds what it held (each checked at most once per scene, by `chain`'s reading).
-    pub(super) fn get(&self, path: &Path, chain: &Chain) -> Option<Arc<Included>> {
+    pub(super) fn get(
+        &self,
+        path: &Path,
+        chain: &Chain,
+        layout: &MaterialLayout,
+    ) -> Option<Arc<Included>> {
         let entry = self
             .entries
             .lock()
@@ -137,7 +149,10 @@ impl IncludeCache {
             .get(path)
             .cloned()??;
         let cycle = entry.files.iter().any(|f| chain.files.contains(&f.path));
-        (!cycle && entry.files.iter().all(|f| chain.reading.holds(f))).then_some(entry)
+        let same = entry.layout == *layout
+            && entry.generated == chain.generated
+            && entry.files.iter().all(|f| chain.reading.holds(f));
+        (!cycle && same).then_some(entry)
     }
 
     /// Keeps `included` if its file was read before.
@@ -258,6 +273,9 @@ pub(in crate::sdf) struct Chain {
     pub(super) deps: Rc<RefCell<Files>>,
     /// Whether a limit left something of the file being read now out.
     pub(super) cut: Rc<Cell<bool>>,
+    /// Whether the outermost file is a frame `anim generate` wrote
+    /// (`sdf::is_generated_frame`): it and everything it includes are read with no guess.
+    pub(in crate::sdf) generated: bool,
 }
 
 impl Chain {
@@ -293,6 +311,7 @@ impl Chain {
             }),
             deps: Rc::default(),
             cut: Rc::default(),
+            generated: crate::sdf::is_generated_frame(text),
         }
     }
 
@@ -320,6 +339,7 @@ impl Chain {
             reading: self.reading.clone(),
             deps: Rc::default(),
             cut: Rc::default(),
+            generated: self.generated,
         }
     }
 
@@ -337,6 +357,7 @@ impl Chain {
         &self,
         written: &str,
         cache: &IncludeCache,
+        layout: &MaterialLayout,
     ) -> Option<(PathBuf, Arc<Included>)> {
         if self.files.len() >= crate::limits::MAX_INCLUDE_DEPTH {
             return None;
@@ -347,7 +368,7 @@ impl Chain {
             .borrow()
             .get(&self.named(written))?
             .clone();
-        let included = cache.get(&real, self)?;
+        let included = cache.get(&real, self, layout)?;
         Some((real, included))
     }
 
