@@ -196,6 +196,8 @@ impl Parser<'_> {
             skipped: parsed.omissions.skipped,
             render_lines: parsed.omissions.render_lines,
             cameras_rejected: parsed.omissions.cameras_rejected,
+            layout: self.opts.material_fields.clone(),
+            generated: self.chain.generated,
             cut: cut.get(),
             layout: self.opts.material_fields.clone(),
             generated: self.chain.generated,
