@@ -199,8 +199,6 @@ impl Parser<'_> {
             layout: self.opts.material_fields.clone(),
             generated: self.chain.generated,
             cut: cut.get(),
-            layout: self.opts.material_fields.clone(),
-            generated: self.chain.generated,
         });
         if !included.cut {
             self.opts.includes.put(path, &included);

@@ -103,12 +103,6 @@ pub(super) struct Included {
     /// Whether a limit of the reading that read it (how deep, how much repeated) left
     /// something of it out: such a reading is not kept for another scene.
     pub(super) cut: bool,
-    /// How it was read: a generated frame reads what it includes as it is read itself, with
-    /// the standard material layout whatever `--material-fields auto` would infer and without
-    /// the warnings that hint at another layout (`sdf::is_generated_frame`); a reading is used
-    /// again only for the same layout and kind of includer.
-    pub(super) layout: MaterialLayout,
-    pub(super) generated: bool,
 }
 
 impl Included {
