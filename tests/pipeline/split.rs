@@ -203,3 +203,68 @@ fn a_changed_static_part_renders_its_frames_again() {
     .unwrap();
     assert!(summary(&frames).contains(": 120 rendered, 0 skipped"));
 }
+
+/// Issue 45 (10b): a keyed shape written before many still shapes of its material left them
+/// all in every frame. Shapes that only share a material trade places freely, so they are
+/// static whatever the order; statements that refer to the keyed shape (a composite listing
+/// it, then a transform of that composite) stay in the frames, and the frames render as the
+/// whole files do.
+#[test]
+fn still_shapes_after_a_keyed_one_stay_in_the_static_part() {
+    const STILL: usize = 100_000;
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let mut base = String::from(
+        "define material m 0.1 0.1 0.1 0.5 0.5 0.5 0 0 0 1\n\
+         define light l 0 5 0 1 1 1 1\n\
+         define shape sphere mover 0 0 -5 0.5 m\n\
+         define shape composite group mover\n\
+         transform group translate 0 0.5 0\n",
+    );
+    for i in 0..STILL {
+        let (x, y) = ((i % 400) as f64 * 0.01 - 2.0, (i / 400) as f64 * 0.01 - 1.5);
+        base += &format!("define shape sphere s{i} {x} {y} -8 0.004 m\n");
+    }
+    base += "define camera cam 60 0 0 0 0 0 -1 0 1 0\n";
+    std::fs::write(dir.join("base.sdf"), &base).unwrap();
+    std::fs::write(
+        dir.join("spec.ron"),
+        "(scene: File(\"base.sdf\"), camera: \"cam\", length: Frames(4), resolution: (8, 8),\n\
+          tracks: [(target: \"mover\", translate: [(at: 0, value: (0, 0, 0)), (at: 0.1, value: (1, 0, 0))])])\n",
+    )
+    .unwrap();
+    let (split, whole) = (dir.join("split"), dir.join("whole"));
+    generate(&dir.join("spec.ron"), &split, false);
+    let statics = std::fs::read_to_string(split.join("static.sdfi")).unwrap();
+    let still = |t: &str| t.lines().filter(|l| l.contains("sphere s")).count();
+    assert_eq!(still(&statics), STILL);
+    let frames = files(&split, "sdf");
+    assert_eq!(frames.len(), 4);
+    for f in &frames {
+        let text = std::fs::read_to_string(f).unwrap();
+        assert_eq!(still(&text), 0, "{}", f.display());
+        // What refers to the keyed shape keeps its place after it.
+        let kept = [
+            "define shape sphere mover",
+            "define shape composite group",
+            "transform group",
+        ];
+        let at: Vec<usize> = kept.iter().map(|k| text.find(k).expect(k)).collect();
+        assert!(at.windows(2).all(|w| w[0] < w[1]), "{text}");
+        assert!(!statics.contains("composite group"), "{statics}");
+        assert!(text.len() < 1000, "{} bytes", text.len());
+    }
+    generate(&dir.join("spec.ron"), &whole, true);
+    let (split_images, whole_images) = (dir.join("si"), dir.join("wi"));
+    render(&split, &split_images);
+    render(&whole, &whole_images);
+    let (a, b) = (files(&split_images, "png"), files(&whole_images, "png"));
+    assert_eq!(a.len(), 4);
+    for (x, y) in a.iter().zip(&b) {
+        assert!(
+            std::fs::read(x).unwrap() == std::fs::read(y).unwrap(),
+            "{} differs between split and whole frames",
+            x.display()
+        );
+    }
+}

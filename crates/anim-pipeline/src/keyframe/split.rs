@@ -7,10 +7,15 @@
 //! background, the render lines), and a subject is static when every frame holds exactly the
 //! base scene's statements about it, in the base scene's order. A frame is then its static
 //! statements (included first) followed by the others in the frame's own order. That moves
-//! static statements ahead of keyed ones written before them in the base scene, which changes
-//! nothing unless the two are about a common name (a composite listing a child defined after
-//! it, a shape using a material defined after it): such a static statement is kept in the
-//! frames too, so the frames mean exactly what the whole files would.
+//! static statements ahead of keyed ones written before them in the base scene. Two statements
+//! can trade places unless one of them defines or places a name the other defines, places or
+//! refers to (a composite listing a child defined after it, a shape using a material defined
+//! after it, a transform of a shape after its definition): such a static statement is kept in
+//! the frames too, so the frames mean exactly what the whole files would. Two statements that
+//! only refer to a common name (shapes drawn with one material, composites listing one
+//! child) read it as the statements before both define it, whichever comes first, so they
+//! trade places freely: a keyed shape defined before many still shapes of its material keeps
+//! none of them in the frames.
 
 use anim_core::sdf::ast::{Statement, StatementKind};
 use std::collections::{HashMap, HashSet};
@@ -24,29 +29,29 @@ const AMBIENT: &str = "\u{0}ambient";
 const BACKGROUND: &str = "\u{0}background";
 const RENDER: &str = "\u{0}render";
 
-/// What a statement is about, then the other names it refers to.
-fn names(kind: &StatementKind) -> Vec<&str> {
+/// What a statement is about (its subject, first) with the other names it defines or
+/// places, and the names it only refers to.
+fn names(kind: &StatementKind) -> (Vec<&str>, Vec<&str>) {
     match kind {
-        StatementKind::Material(m) => vec![&m.name],
-        StatementKind::Shape { name, material, .. } => vec![name, &material.name],
-        StatementKind::Composite { name, children } => {
-            let mut all = vec![name.as_str()];
-            all.extend(children.iter().map(|c| c.name.as_str()));
-            all
-        }
-        StatementKind::Light(l) => vec![&l.name],
-        StatementKind::Ambient(_) | StatementKind::AmbientAdd(_) => vec![AMBIENT],
-        StatementKind::Background(_) => vec![BACKGROUND],
-        StatementKind::Camera(c) => vec![&c.name],
-        StatementKind::Lens(l) => vec![&l.camera.name],
-        StatementKind::Transform { target, .. } => vec![&target.name],
-        StatementKind::Motion(m) => vec![&m.target.name],
-        StatementKind::Render(r) => vec![RENDER, &r.camera.name],
+        StatementKind::Material(m) => (vec![&m.name], vec![]),
+        StatementKind::Shape { name, material, .. } => (vec![name], vec![&material.name]),
+        StatementKind::Composite { name, children } => (
+            vec![name],
+            children.iter().map(|c| c.name.as_str()).collect(),
+        ),
+        StatementKind::Light(l) => (vec![&l.name], vec![]),
+        StatementKind::Ambient(_) | StatementKind::AmbientAdd(_) => (vec![AMBIENT], vec![]),
+        StatementKind::Background(_) => (vec![BACKGROUND], vec![]),
+        StatementKind::Camera(c) => (vec![&c.name], vec![]),
+        StatementKind::Lens(l) => (vec![&l.camera.name], vec![]),
+        StatementKind::Transform { target, .. } => (vec![&target.name], vec![]),
+        StatementKind::Motion(m) => (vec![&m.target.name], vec![]),
+        StatementKind::Render(r) => (vec![RENDER], vec![&r.camera.name]),
     }
 }
 
 fn subject(kind: &StatementKind) -> &str {
-    names(kind)[0]
+    names(kind).0[0]
 }
 
 /// The statements about each subject, in order (of the base scene, for
@@ -93,16 +98,24 @@ impl Split {
         // A static statement after a kept one about a common name stays in the frames (see
         // the module doc); that can keep another, so until nothing changes.
         loop {
-            let mut kept_names: HashSet<&str> = HashSet::new();
+            // What the kept statements so far define or place, and what they refer to.
+            let mut kept_defined: HashSet<&str> = HashSet::new();
+            let mut kept_read: HashSet<&str> = HashSet::new();
             let mut grew = false;
             for s in base {
-                let names = names(&s.kind);
-                if !changed.contains(names[0]) && names.iter().any(|n| kept_names.contains(n)) {
-                    changed.insert(names[0].to_string());
+                let (defined, read) = names(&s.kind);
+                let subject = defined[0];
+                let conflicts = defined
+                    .iter()
+                    .any(|n| kept_defined.contains(n) || kept_read.contains(n))
+                    || read.iter().any(|n| kept_defined.contains(n));
+                if !changed.contains(subject) && conflicts {
+                    changed.insert(subject.to_string());
                     grew = true;
                 }
-                if changed.contains(names[0]) {
-                    kept_names.extend(names.iter().copied());
+                if changed.contains(subject) {
+                    kept_defined.extend(defined);
+                    kept_read.extend(read);
                 }
             }
             if !grew {
