@@ -24,6 +24,7 @@
 //! - `rigs`: paths at constant speed, `orient: AlongPath`, parents.
 //! - `tangents`: a key's `in` and `out` sides, and the clamped spline `Auto`.
 //! - `shots`: the example shots of round two (candle, rig, flythrough) do what they show.
+//! - `spec_bounds`: numbers a spec gives beyond what a frame can hold, refused at the number.
 //! - `incremental`: frames traced from the frame before, to the byte the frames alone, whatever
 //!   the thread count.
 //! - `service`: the one way from a scene file to images in memory, which `anim render` and
@@ -46,6 +47,7 @@ mod optics;
 mod rigs;
 mod service;
 mod shots;
+mod spec_bounds;
 mod split;
 mod tangents;
 mod timing;

@@ -10,7 +10,7 @@ mod lexer;
 mod parse;
 pub mod repair;
 
-pub use lexer::{image_names, raw_lines, scene_key, ImageName};
+pub use lexer::{image_names, raw_lines, scene_key, ImageName, MAX_MAGNITUDE};
 pub use parse::{
     default_output, mesh_files, references, FileRead, IncludeCache, Omissions, Parsed, Reference,
 };

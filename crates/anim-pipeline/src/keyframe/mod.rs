@@ -10,6 +10,7 @@
 //! [`generate`] writes the frames.
 
 pub mod base;
+pub mod bounds;
 pub mod expr;
 pub mod follow;
 pub mod generate;

@@ -6,8 +6,11 @@
 //! leave the range between them, so every frame's span of time is checked too, not only its
 //! instant.
 
+use super::bounds::{self, shown};
 use super::expr::Val;
 use super::interp::Keyable;
+use super::interp::{cycled_time, Cycle};
+use super::locate::{field, index};
 use super::spec_file::{Animation, Blend, Channel, Focus, Track};
 use super::tidy::tidy;
 use anim_core::limits;
@@ -36,7 +39,7 @@ pub fn check_span(anim: &Animation, i: usize) -> Result<(), OutOfRange> {
         format!("at t = {} s", tidy(t0))
     };
     for track in &anim.tracks {
-        expressions_are_finite(track, &instants, &span, i)?;
+        values_in_range(track, &instants, &span, i)?;
         check_track(track, &instants, &span, i)?;
     }
     let scene = [
@@ -51,8 +54,8 @@ pub fn check_span(anim: &Animation, i: usize) -> Result<(), OutOfRange> {
     Ok(())
 }
 
-/// Every expression of `track` gives finite values over the span (`sqrt(-1)` does not).
-fn expressions_are_finite(
+/// Every channel of `track` gives values a frame can hold over the span (`sqrt(-1)` does not).
+fn values_in_range(
     track: &Track,
     instants: &[f64],
     span: &str,
@@ -99,7 +102,9 @@ fn expressions_are_finite(
     Ok(())
 }
 
-/// An error at channel `c`'s expression where it gives a value that is not finite.
+/// An error where channel `c` gives a value a frame cannot hold: no number at all (an
+/// expression's), or one beyond [`bounds::MAX_MAGNITUDE`] (an expression's, or keys that
+/// repeat with `RepeatOffset` so often that their sum outgrows it).
 fn finite<T: Keyable>(
     c: &Channel<T>,
     instants: &[f64],
@@ -107,26 +112,64 @@ fn finite<T: Keyable>(
     span: &str,
     i: usize,
 ) -> Result<(), OutOfRange> {
-    let Some(d) = &c.expr else {
-        return Ok(());
-    };
     for &t in instants {
-        let v = c.at(t).map(T::to_val);
-        if let Some(v) = v.filter(|v| !v.is_finite()) {
-            let shown = match v {
-                Val::Num(n) => format!("{n}"),
-                Val::Vec(v) => format!("({}, {}, {})", v.x, v.y, v.z),
-            };
-            return Err(OutOfRange {
+        let Some(v) = c.at(t).map(T::to_val) else {
+            continue;
+        };
+        let parts = match v {
+            Val::Num(n) => vec![n],
+            Val::Vec(v) => v.to_array().to_vec(),
+        };
+        let Some(why) = parts.iter().find_map(|&x| bounds::refusal("values", x)) else {
+            continue;
+        };
+        let shown = match v {
+            Val::Num(n) => shown(n),
+            Val::Vec(v) => format!("({}, {}, {})", shown(v.x), shown(v.y), shown(v.z)),
+        };
+        let at = format!(
+            "at frame {i} ({span}) {what} is {shown} at t = {} s",
+            tidy(t)
+        );
+        return Err(match (&c.expr, v.is_finite()) {
+            (Some(d), false) => OutOfRange {
                 path: d.path.clone(),
-                message: format!(
-                    "at frame {i} ({span}) {what} is {shown} at t = {} s: the expression gives no number there (a square root or logarithm of a negative number, a division by 0?)",
-                    tidy(t)
-                ),
-            });
-        }
+                message: format!("{at}: the expression gives no number there (a square root or logarithm of a negative number, a division by 0?)"),
+            },
+            (Some(d), true) => OutOfRange {
+                path: d.path.clone(),
+                message: format!("{at}: {why}"),
+            },
+            (None, _) => repeated_too_often(c, t, &at, &why),
+        });
     }
     Ok(())
+}
+
+/// Keys within range give values beyond it by repeating with `RepeatOffset`, each repeat
+/// adding the keys' change (the error is then at the last key's time, which sets the
+/// period), or by a curve that overshoots them.
+fn repeated_too_often<T: Keyable>(c: &Channel<T>, t: f64, at: &str, why: &str) -> OutOfRange {
+    let (first, last) = match (c.keys.first(), c.keys.last()) {
+        (Some(first), Some(last)) => (first.at, last.at),
+        _ => (0.0, 0.0),
+    };
+    let repeats = cycled_time(first, last, t, &c.timing).1;
+    if c.timing.cycle != Cycle::RepeatOffset || repeats == 0 {
+        return OutOfRange {
+            path: c.key_path_at(t),
+            message: format!("{at}: {why}. {OVERSHOOT_HELP}"),
+        };
+    }
+    OutOfRange {
+        path: field(&index(&c.path, c.keys.len() - 1), "at"),
+        message: format!(
+            "{at}, after {} repeats of its keys every {} s (`cycle: RepeatOffset` adds each repeat to the last): {why}; a longer period or a `cycles` count keeps it in range",
+            // Counted here, as the cycle count saturates.
+            shown(((t - c.timing.offset - first) / (last - first)).floor()),
+            shown(last - first)
+        ),
+    }
 }
 
 fn check_track(track: &Track, instants: &[f64], span: &str, i: usize) -> Result<(), OutOfRange> {

@@ -4,6 +4,7 @@
 use super::model::{Channel, Driven, Fps};
 use super::raw::{ChannelSpec, KeySpec};
 use super::source::Source;
+use crate::keyframe::bounds::{self, shown};
 use crate::keyframe::expr::{Expr, ExprError, Scope, Ty, Val};
 use crate::keyframe::interp::{Key, Keyable, Side, Timing};
 use crate::keyframe::locate::{field, index};
@@ -246,11 +247,8 @@ impl<'a> Checker<'a> {
             self.key_curve(k, &key_path);
             let v = value(&k.value).into3();
             let value_path = field(&key_path, "value");
-            if !v.is_finite() {
-                self.err(
-                    &[&value_path, &key_path],
-                    format!("the {what} value must be finite"),
-                );
+            if let Some(why) = bounds::refusal3(&format!("the {what} value"), v) {
+                self.err(&[&value_path, &key_path], why);
             } else if let Some(problem) = check.and_then(|c| c(v)) {
                 self.err(&[&value_path, &key_path], format!("{what} {problem}"));
             }
@@ -316,29 +314,34 @@ impl<'a> Checker<'a> {
     pub fn key_time(&mut self, at: f64, previous: Option<f64>, key_path: &str) {
         let paths = [field(key_path, "at"), key_path.to_string()];
         let paths = [paths[0].as_str(), paths[1].as_str()];
-        if !at.is_finite() {
-            self.err(
-                &paths,
-                "a key's time must be a finite number of seconds".into(),
-            );
+        if let Some(why) = bounds::refusal("a key's time in seconds", at) {
+            self.err(&paths, why);
         } else if at < 0.0 {
             self.err(
                 &paths,
-                format!("the key at {at} s is before the start of the animation (0 s)"),
+                format!(
+                    "the key at {} s is before the start of the animation (0 s)",
+                    shown(at)
+                ),
             );
         } else if at > self.duration + 1e-9 {
             self.err(
                 &paths,
                 format!(
-                    "the key at {at} s is after the end of the animation ({} s)",
-                    self.duration
+                    "the key at {} s is after the end of the animation ({} s)",
+                    shown(at),
+                    shown(self.duration)
                 ),
             );
         }
         if let Some(p) = previous.filter(|&p| at <= p) {
             self.err(
                 &paths,
-                format!("keys must be in time order: this key at {at} s follows a key at {p} s"),
+                format!(
+                    "keys must be in time order: this key at {} s follows a key at {} s",
+                    shown(at),
+                    shown(p)
+                ),
             );
         }
     }

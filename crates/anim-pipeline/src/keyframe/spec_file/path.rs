@@ -5,6 +5,7 @@ use super::checker::{number, ChannelAt, Checker};
 use super::model::{AlongPath, PathMotion, TargetKind};
 use super::raw::PathSpline;
 use super::track::Sources;
+use crate::keyframe::bounds;
 use crate::keyframe::expr::Val;
 use crate::keyframe::interp::Timing;
 use crate::keyframe::locate::{field, index};
@@ -32,11 +33,12 @@ impl Checker<'_> {
             );
             return None;
         }
-        if let Some(i) = points.iter().position(|p| !p.is_finite()) {
-            self.err(
-                &[&index(&points_path, i), &points_path],
-                "a path's points must be finite".into(),
-            );
+        let refused = points
+            .iter()
+            .enumerate()
+            .find_map(|(i, p)| Some((i, bounds::refusal3("a path's point", *p)?)));
+        if let Some((i, why)) = refused {
+            self.err(&[&index(&points_path, i), &points_path], why);
             return None;
         }
         let curve = Path::new(points, spec.closed, spec.spline == PathSpline::Smooth);
@@ -75,8 +77,8 @@ impl Checker<'_> {
                     "`bank` leans a target that turns along its path: give it `orient: AlongPath`"
                         .into(),
                 );
-            } else if !b.is_finite() {
-                self.err(&[&at, p], "`bank` must be a finite number".into());
+            } else if let Some(why) = bounds::refusal("`bank`", *b) {
+                self.err(&[&at, p], why);
             }
         }
         if !along {

@@ -10,6 +10,7 @@ use super::model::{
     TargetKind, Track,
 };
 use super::raw::{AimSpec, ChannelSpec, KeySpec, Orientation, Scale, SpecFile, TrackSpec, V3};
+use crate::keyframe::bounds::{self, shown};
 use crate::keyframe::expr::Val;
 use crate::keyframe::interp::{Cycle, Interp, Key, Timing};
 use crate::keyframe::locate::{field, index};
@@ -477,7 +478,11 @@ impl Checker<'_> {
                 if !(n.fract() == 0.0 && (1.0..=f64::from(u32::MAX)).contains(&n)) {
                     self.err(
                         &[&at[0], &at[1]],
-                        format!("cycles must be a whole number, at least 1, not {n}"),
+                        format!(
+                            "cycles must be a whole number from 1 to {}, not {}",
+                            u32::MAX,
+                            shown(n)
+                        ),
                     );
                     None
                 } else {
@@ -486,14 +491,12 @@ impl Checker<'_> {
             }
         };
         let offset = s.track.offset + s.curve.as_ref().map_or(0.0, |(c, _)| c.offset);
-        if !offset.is_finite() {
-            self.err(
-                &[&field(&s.path, "offset"), &s.path],
-                "the offset must be a finite number of seconds".into(),
-            );
+        let refused = bounds::refusal("the offset in seconds", offset);
+        if let Some(why) = &refused {
+            self.err(&[&field(&s.path, "offset"), &s.path], why.clone());
         }
         Timing {
-            offset: if offset.is_finite() { offset } else { 0.0 },
+            offset: if refused.is_none() { offset } else { 0.0 },
             cycle,
             count,
         }
@@ -551,21 +554,29 @@ impl Checker<'_> {
         match o {
             Orientation::Euler(x, y, z) => {
                 let v = DVec3::new(x, y, z);
-                v.is_finite()
-                    .then(|| euler(v, order))
-                    .ok_or_else(|| "Euler angles must be finite".to_string())
-            }
-            Orientation::AxisAngle(axis, degrees) => match axis.0.try_normalize() {
-                Some(a) if degrees.is_finite() => {
-                    Ok(DQuat::from_axis_angle(a, degrees.to_radians()))
+                match bounds::refusal3("the Euler angles", v) {
+                    None => Ok(euler(v, order)),
+                    Some(why) => Err(why),
                 }
-                _ => Err("AxisAngle needs a non-zero axis and a finite angle".into()),
-            },
+            }
+            Orientation::AxisAngle(axis, degrees) => {
+                let refused = bounds::refusal3("the axis", axis.0)
+                    .or_else(|| bounds::refusal("the angle", degrees));
+                match (refused, axis.0.try_normalize()) {
+                    (Some(why), _) => Err(why),
+                    (None, Some(a)) => Ok(DQuat::from_axis_angle(a, degrees.to_radians())),
+                    (None, None) => Err("AxisAngle needs a non-zero axis".into()),
+                }
+            }
             Orientation::Quat { x, y, z, w } => {
+                let refused = [x, y, z, w]
+                    .into_iter()
+                    .find_map(|p| bounds::refusal("each part of a quaternion", p));
                 let q = DQuat::from_xyzw(x, y, z, w);
-                match q.length() {
-                    l if l.is_finite() && l > 1e-12 => Ok(q / l),
-                    _ => Err("a quaternion must be finite and not zero".into()),
+                match (refused, q.length()) {
+                    (Some(why), _) => Err(why),
+                    (None, l) if l > 0.0 => Ok(q / l),
+                    _ => Err("a quaternion must not be zero".into()),
                 }
             }
         }
@@ -593,8 +604,8 @@ impl Checker<'_> {
         let path = field(&path, "look_at");
         let target = match spec {
             AimSpec::Point(p) => {
-                if !p.0.is_finite() {
-                    self.err(&[&path], "the point looked at must be finite".into());
+                if let Some(why) = bounds::refusal3("the point looked at", p.0) {
+                    self.err(&[&path], why);
                 }
                 AimTarget::Point(p.0)
             }
@@ -712,9 +723,9 @@ impl Checker<'_> {
             }
         }
         if let Some((pivot, p)) = s.setting(|t| t.pivot) {
-            if !pivot.0.is_finite() {
+            if let Some(why) = bounds::refusal3("the pivot", pivot.0) {
                 let at = at(&p, "pivot");
-                self.err(&[&at[0], &at[1]], "the pivot must be finite".into());
+                self.err(&[&at[0], &at[1]], why);
             }
         }
         axis.map_or(DVec3::Y, |(a, _)| a.0)

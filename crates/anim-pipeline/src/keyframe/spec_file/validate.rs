@@ -6,6 +6,7 @@ use super::checker::{names_list, non_negative3, rgb, ChannelAt, Checker};
 use super::model::{Animation, End, Fps, NamePattern, Orbit, SceneNames, TargetKind};
 use super::raw::{ChannelSpec, FpsSpec, Length, NamedValue, NamedValues, OrbitSpec, Rgb, SpecFile};
 use super::source::Source;
+use crate::keyframe::bounds::{self, shown};
 use crate::keyframe::expr::{Expr, Func, Val, Var};
 use crate::keyframe::interp::Timing;
 use crate::keyframe::locate::index;
@@ -294,38 +295,29 @@ impl Checker<'_> {
     }
 
     fn orbit(&mut self, o: &OrbitSpec) -> Orbit {
-        if !(o.radius.is_finite() && o.radius > 0.0) {
+        if let Some(why) = bounds::refusal("the orbit radius", o.radius) {
+            self.err(&["orbit.radius", "orbit"], why);
+        } else if o.radius <= 0.0 {
             self.err(
                 &["orbit.radius", "orbit"],
                 format!(
                     "the orbit radius must be a positive number, not {}",
-                    o.radius
+                    shown(o.radius)
                 ),
             );
         }
-        let finite_numbers = [
-            (
-                o.height,
-                "orbit.height",
-                "the orbit height must be a finite number",
-            ),
-            (o.turns, "orbit.turns", "turns must be a finite number"),
-            (
-                o.start_angle,
-                "orbit.start_angle",
-                "start_angle must be a finite number",
-            ),
+        let numbers = [
+            (o.height, "orbit.height", "the orbit height"),
+            (o.turns, "orbit.turns", "turns"),
+            (o.start_angle, "orbit.start_angle", "start_angle"),
         ];
-        for (value, path, message) in finite_numbers {
-            if !value.is_finite() {
-                self.err(&[path, "orbit"], message.into());
+        for (value, path, what) in numbers {
+            if let Some(why) = bounds::refusal(what, value) {
+                self.err(&[path, "orbit"], why);
             }
         }
-        if !o.center.0.is_finite() {
-            self.err(
-                &["orbit.center", "orbit"],
-                "the orbit centre must be finite".into(),
-            );
+        if let Some(why) = bounds::refusal3("the orbit centre", o.center.0) {
+            self.err(&["orbit.center", "orbit"], why);
         }
         let look_at = o.look_at.map_or(o.center.0, |v| v.0);
         if !look_at.is_finite() {
