@@ -111,6 +111,16 @@ fn extreme_numbers_are_refused_at_the_number_with_the_range() {
             range,
         ),
         (
+            track("look_at: Point((0, 0, 0)), up: (0, 1e308, 0)"),
+            "(0, 1e308",
+            range,
+        ),
+        (
+            track("axis: (0, 1e308, 0), rotate: [(at: 0, value: 0), (at: 0.1, value: 90)]"),
+            "(0, 1e308",
+            range,
+        ),
+        (
             track("path: (points: [(0, 0, 0), (1e308, 0, 0)])"),
             "(1e308",
             range,

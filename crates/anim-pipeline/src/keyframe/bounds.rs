@@ -28,6 +28,13 @@ pub fn refusal3(what: &str, v: glam::DVec3) -> Option<String> {
     v.to_array().into_iter().find_map(|x| refusal(what, x))
 }
 
+/// Why `v`, given as the direction `what`, is refused: out of range, or of no length.
+pub fn direction_refusal(what: &str, v: glam::DVec3) -> Option<String> {
+    refusal3(what, v).or_else(|| {
+        (v.length_squared() == 0.0).then(|| format!("{what} must be a non-zero direction"))
+    })
+}
+
 /// `v` as a message shows it: plain up to a dozen digits, else in scientific notation
 /// (`1e308`, not three hundred digits).
 pub fn shown(v: f64) -> String {
@@ -66,5 +73,13 @@ mod tests {
             Some("x must lie between -1e12 and 1e12, not 1e308")
         );
         assert_eq!(refusal("x", 3.0), None);
+        let zero = direction_refusal("`up`", glam::DVec3::ZERO);
+        assert_eq!(zero.as_deref(), Some("`up` must be a non-zero direction"));
+        // Not refused for its length overflowing, but for its part out of range.
+        let huge = direction_refusal("`up`", glam::DVec3::new(0.0, 1e308, 0.0));
+        assert_eq!(
+            huge.as_deref(),
+            Some("`up` must lie between -1e12 and 1e12, not 1e308")
+        );
     }
 }

@@ -141,3 +141,47 @@ impl Split {
         self.static_subjects.contains(subject(&s.kind))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use anim_core::sdf::{parse_source_whole, LoadOptions};
+    use std::path::Path;
+
+    /// The subjects left static when `keyed` are changed in the scene `text`.
+    fn statics(text: &str, keyed: &[&str]) -> Vec<String> {
+        let parsed = parse_source_whole(text, Path::new("t.sdf"), &LoadOptions::default());
+        let changed = keyed.iter().map(|k| k.to_string()).collect();
+        let split = Split::new(&parsed.statements, changed);
+        let mut out: Vec<String> = parsed
+            .statements
+            .iter()
+            .filter(|s| split.is_static(s))
+            .map(|s| subject(&s.kind).to_string())
+            .collect();
+        out.dedup();
+        out
+    }
+
+    const SCENE: &str = "define material m 0.1 0.1 0.1 0.5 0.5 0.5 0 0 0 1\n\
+                         define shape sphere keyed 0 0 -5 1 m\n\
+                         define shape sphere a 1 0 -5 1 m\n\
+                         define shape composite group keyed a\n\
+                         transform group translate 0 1 0\n\
+                         define shape sphere b 2 0 -5 1 m\n";
+
+    #[test]
+    fn statements_that_only_share_a_reference_trade_places() {
+        // `a` and `b` read `m` as `keyed` does; `group` lists `keyed` and its transform
+        // places `group`, so both keep their places after `keyed`.
+        assert_eq!(statics(SCENE, &["keyed"]), ["m", "a", "b"]);
+    }
+
+    #[test]
+    fn what_refers_to_a_keyed_definition_stays_after_it() {
+        // Every shape reads the keyed material; `group` lists `keyed`, then `group` is placed.
+        assert_eq!(statics(SCENE, &["m"]), Vec::<String>::new());
+        // A keyed child keeps the composite listing it and the transform of that composite.
+        assert_eq!(statics(SCENE, &["a"]), ["m", "keyed", "b"]);
+    }
+}

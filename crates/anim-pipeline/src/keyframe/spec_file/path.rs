@@ -100,11 +100,8 @@ impl Checker<'_> {
         }
         let direction = |c: &mut Self, what: &str, v: Option<(super::raw::V3, String)>| {
             let (v, p) = v?;
-            if !(v.0.is_finite() && v.0.length_squared() > 0.0) {
-                c.err(
-                    &[&field(&p, what), &p],
-                    format!("`{what}` must be a non-zero direction"),
-                );
+            if let Some(why) = bounds::direction_refusal(&format!("`{what}`"), v.0) {
+                c.err(&[&field(&p, what), &p], why);
                 return None;
             }
             Some(v.0)

@@ -632,11 +632,8 @@ impl Checker<'_> {
             let Some((v, p)) = v else {
                 return default;
             };
-            if !(v.0.is_finite() && v.0.length_squared() > 0.0) {
-                c.err(
-                    &[&field(&p, what), &p],
-                    format!("`{what}` must be a non-zero direction"),
-                );
+            if let Some(why) = bounds::direction_refusal(&format!("`{what}`"), v.0) {
+                c.err(&[&field(&p, what), &p], why);
                 return default;
             }
             v.0
@@ -707,12 +704,9 @@ impl Checker<'_> {
         let axis = s.setting(|t| t.axis);
         let at = |p: &str, f: &str| [field(p, f), p.to_string()];
         if let Some((a, p)) = &axis {
-            if !(a.0.is_finite() && a.0.length_squared() > 0.0) {
+            if let Some(why) = bounds::direction_refusal("the rotation axis", a.0) {
                 let at = at(p, "axis");
-                self.err(
-                    &[&at[0], &at[1]],
-                    "the rotation axis must be a non-zero vector".into(),
-                );
+                self.err(&[&at[0], &at[1]], why);
             }
             if !s.either(|t| !t.rotate.is_empty()) {
                 let at = at(p, "axis");
