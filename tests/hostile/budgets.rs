@@ -134,3 +134,63 @@ fn worker_threads_that_cannot_start_say_why() {
         "{stderr}"
     );
 }
+
+/// An OBJ file of `n` × `n` vertices on a grid, two triangles to each square of it.
+fn grid_obj(n: usize) -> String {
+    let mut text = String::with_capacity(n * n * 40);
+    for j in 0..n {
+        for i in 0..n {
+            text.push_str(&format!("v {i} {j} 0\n"));
+        }
+    }
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let a = j * n + i + 1;
+            let (b, c, d) = (a + 1, a + n, a + n + 1);
+            text.push_str(&format!("f {a} {b} {d}\nf {a} {d} {c}\n"));
+        }
+    }
+    text
+}
+
+/// An OBJ file of `n` triangles, each with its own three vertices.
+fn soup_obj(n: usize) -> String {
+    let mut text = String::with_capacity(n * 60);
+    for t in 0..n {
+        let (x, y) = (t % 1000, t / 1000);
+        text.push_str(&format!(
+            "v {x} {y} 0\nv {x}.5 {y} 0\nv {x} {y}.5 0\nf -3 -2 -1\n"
+        ));
+    }
+    text
+}
+
+/// A 300,000-triangle mesh under an address-space limit too small to read it: the located
+/// "needs about ... MiB" message at the statement naming it, exit code 1 and no signal, where
+/// reading it once aborted (whether its triangles share their vertices or not). The same
+/// mesh reads under a limit that holds it.
+#[test]
+fn a_300k_triangle_mesh_beyond_the_memory_ends_with_the_memory_message() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    // 388 × 388 vertices make 2 · 387² = 299,538 triangles.
+    let meshes = [
+        ("grid.obj", grid_obj(388), 299_538),
+        ("soup.obj", soup_obj(300_000), 300_000),
+    ];
+    for (name, text, triangles) in meshes {
+        std::fs::write(dir.join(name), text).unwrap();
+        let scene = format!("{HEAD}define shape obj mesh {name} m\nrender c out.png 8 6\n");
+        std::fs::write(dir.join("scene.sdf"), scene).unwrap();
+        for kib in [150_000, 200_000, 250_000, 300_000] {
+            let (code, stderr, _) = limited(dir, kib, "check scene.sdf");
+            assert_eq!(code, Some(1), "{name} at {kib} KiB: {stderr}");
+            let message = format!("scene.sdf:4:1: error: mesh file `{name}` needs about ");
+            assert!(stderr.contains(&message), "{name} at {kib} KiB: {stderr}");
+            let count = format!("to read and build its {triangles} triangles, more than the ");
+            assert!(stderr.contains(&count), "{name} at {kib} KiB: {stderr}");
+        }
+        let (code, stderr, _) = limited(dir, 600_000, "check scene.sdf");
+        assert_eq!(code, Some(0), "{name} at 600000 KiB: {stderr}");
+    }
+}

@@ -140,6 +140,30 @@ pub fn scene_memory(shapes: u64) -> u64 {
     shapes.saturating_mul(SCENE_BYTES_PER_SHAPE)
 }
 
+/// Address space one triangle of an OBJ mesh takes at the peak of its reading and building,
+/// and one vertex (a position, or a position, texture coordinate and normal that a face pairs
+/// differently from the others): the reader's copy of the file's faces, its vertex map and
+/// output arrays as they grow, the mesh's own arrays, the box of every triangle and the
+/// hierarchy being built over them. Measured as the smallest `ulimit -v` under which `anim
+/// check` reads a mesh, less what it takes for a scene of one sphere, over meshes whose
+/// triangles share their vertices and meshes whose triangles each have their own
+/// (BENCHMARKS.md, "Mesh memory"), rounded up. A mesh that would need more than the memory
+/// budget is refused after the first pass over its file counted it, before it is read.
+pub const MESH_BYTES_PER_TRIANGLE: u64 = 512;
+
+/// See [`MESH_BYTES_PER_TRIANGLE`].
+pub const MESH_BYTES_PER_VERTEX: u64 = 96;
+
+/// Bytes needed to read and build a mesh of `vertices` vertices and `triangles` triangles.
+pub fn mesh_memory(vertices: u64, triangles: u64) -> u64 {
+    triangles
+        .saturating_mul(MESH_BYTES_PER_TRIANGLE)
+        .saturating_add(vertices.saturating_mul(MESH_BYTES_PER_VERTEX))
+}
+
+/// What to tell the author of a scene the memory budget refuses.
+pub const RAISE_MEMORY: &str = "--max-memory raises the limit";
+
 /// Objects (shapes and composites) visited while flattening one job's tree: a tree of
 /// composites holding nothing expands to no shapes but can still take forever to walk.
 pub const MAX_WALK: u64 = 2_000_000;

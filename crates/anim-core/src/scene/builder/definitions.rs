@@ -356,18 +356,18 @@ impl Builder<'_> {
                 return;
             }
         };
-        let max_input = self.opts.max_input;
+        let (max_input, max_memory) = (self.opts.max_input, self.opts.max_memory);
         let loaded = self
             .opts
             .meshes
             .load(opened.file(), opened.real(), max_input, |f| {
-                crate::shape::mesh::load_open(f, &file, max_input).map(Arc::new)
+                crate::shape::mesh::load_open(f, &file, max_input, max_memory).map(Arc::new)
             });
         match loaded {
             Ok(mesh) => m.set(mesh),
             Err(d) if d.loc.is_none() => {
                 let message = format!("mesh file `{}` {}", m.file, d.message);
-                self.error(At::Statement(stmt), message, None);
+                self.error(At::Statement(stmt), message, d.help);
             }
             Err(d) => self.push(*d),
         }

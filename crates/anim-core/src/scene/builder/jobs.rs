@@ -680,7 +680,7 @@ const DOUBLING: &str =
     "a composite listing another twice, level after level, doubles the scene each time";
 
 /// How to allow a bigger scene.
-const RAISE: &str = "--max-memory raises the limit";
+const RAISE: &str = limits::RAISE_MEMORY;
 
 /// A camera definition with its transform applied (the eye as a point, dir and up as
 /// vectors) and its lens, if the definitions `d` give it one of some aperture. The lens is

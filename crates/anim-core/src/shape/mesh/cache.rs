@@ -131,7 +131,7 @@ mod tests {
         let real = path.canonicalize().unwrap();
         cache.load(&file, &real, u64::MAX, |f| {
             reads.fetch_add(1, Ordering::SeqCst);
-            super::super::load_open(f, path, u64::MAX).map(Arc::new)
+            super::super::load_open(f, path, u64::MAX, u64::MAX).map(Arc::new)
         })
     }
 

@@ -9,6 +9,7 @@
 use super::{Mesh, MeshError};
 use crate::diag::{Diagnostic, Loc, Severity};
 use crate::limits::{MAX_MESH_TRIANGLES, MAX_OBJ_LINE_BYTES};
+use crate::util::human_bytes;
 use glam::Vec3;
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read, Seek as _};
@@ -16,9 +17,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 /// Loads the mesh of the OBJ file at `path`, a file the user names (a scene's meshes are
-/// opened confined, by the scene builder, and read by [`load_open`]). What is not a regular
-/// file (a pipe would wait for a writer, a device could feed a line without end) is refused
-/// unread.
+/// opened confined, by the scene builder, and read by [`load_open`]), within the default
+/// memory budget. What is not a regular file (a pipe would wait for a writer, a device could
+/// feed a line without end) is refused unread.
 pub fn load(path: &Path, max_input: u64) -> Result<Mesh, Box<Diagnostic>> {
     let opened = crate::input::open_named(path, path, true).map_err(|refusal| {
         let why = match refusal {
@@ -30,15 +31,22 @@ pub fn load(path: &Path, max_input: u64) -> Result<Mesh, Box<Diagnostic>> {
             format!("cannot be read: {why}"),
         ))
     })?;
-    load_open(opened.file(), path, max_input)
+    let budget = crate::limits::default_memory_budget();
+    load_open(opened.file(), path, max_input, budget)
 }
 
 /// Loads the mesh of the open OBJ file `file`, named `path` in messages: every reading of it
 /// (the check, `tobj`, a line quoted again) is of this one open file. A problem on a line
 /// points at the OBJ file's own line and column; a problem with the whole file (it cannot
-/// be read, it holds no triangles) has no location and a message that follows the file's
-/// name ("… holds no triangles").
-pub fn load_open(file: &File, path: &Path, max_input: u64) -> Result<Mesh, Box<Diagnostic>> {
+/// be read, it holds no triangles, it would need more than `max_memory` bytes to read and
+/// build: `limits::mesh_memory`) has no location and a message that follows the file's name
+/// ("… holds no triangles").
+pub fn load_open(
+    file: &File,
+    path: &Path,
+    max_input: u64,
+    max_memory: u64,
+) -> Result<Mesh, Box<Diagnostic>> {
     let cannot = |e: String| Box::new(Diagnostic::file_error(path, format!("cannot be read: {e}")));
     let meta = file.metadata().map_err(|e| cannot(e.to_string()))?;
     if !meta.is_file() {
@@ -56,6 +64,19 @@ pub fn load_open(file: &File, path: &Path, max_input: u64) -> Result<Mesh, Box<D
             path,
             MeshError::NoTriangles.to_string(),
         )));
+    }
+    // Counted by the pass, refused before the reading that costs the memory.
+    let needed = crate::limits::mesh_memory(scan.vertices_bound(), scan.triangles as u64);
+    if needed > max_memory {
+        let message = format!(
+            "needs about {} of memory to read and build its {} triangles, more than the {} allowed",
+            human_bytes(needed),
+            scan.triangles,
+            human_bytes(max_memory)
+        );
+        return Err(Box::new(
+            Diagnostic::file_error(path, message).with_help(crate::limits::RAISE_MEMORY),
+        ));
     }
     let options = tobj::LoadOptions {
         triangulate: true,
@@ -309,6 +330,13 @@ struct Scan {
 impl Scan {
     fn vertices_hint(&self) -> usize {
         usize::try_from(self.counts[0]).unwrap_or(0)
+    }
+
+    /// The vertices the mesh is built with, as the file's elements count them: the reader
+    /// makes one for each pairing of a position with a texture coordinate and a normal, as
+    /// many as the most numerous of the three in a file that pairs them one to one.
+    fn vertices_bound(&self) -> u64 {
+        self.counts.iter().copied().max().unwrap_or(0)
     }
 }
 
@@ -799,6 +827,27 @@ mod tests {
                 "{d:?}"
             );
         }
+    }
+
+    /// A mesh is refused after the pass that counts it when the budget cannot hold what
+    /// `limits::mesh_memory` says it needs, and read when it can.
+    #[test]
+    fn a_mesh_beyond_the_memory_budget_is_refused_before_it_is_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("quad.obj");
+        std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+        let needed = crate::limits::mesh_memory(4, 2);
+        let file = File::open(&path).unwrap();
+        let mesh = load_open(&file, &path, u64::MAX, needed).unwrap();
+        assert_eq!(mesh.triangle_count(), 2);
+        let d = load_open(&file, &path, u64::MAX, needed - 1).unwrap_err();
+        let expected = format!(
+            "needs about {} of memory to read and build its 2 triangles, more than the {} allowed",
+            human_bytes(needed),
+            human_bytes(needed - 1)
+        );
+        assert_eq!((d.loc, d.message), (None, expected));
+        assert_eq!(d.help.as_deref(), Some(crate::limits::RAISE_MEMORY));
     }
 
     #[test]
