@@ -170,10 +170,15 @@ pub fn open_named(path: &Path, scene: &Path, any: bool) -> Result<Opened, Refusa
         }
     };
     let opened = file.metadata().map_err(Refusal::Io)?;
-    // The real path, and proof that it names the file opened: the same device and inode.
-    let real = path.canonicalize().ok().filter(|real| {
-        std::fs::metadata(real).is_ok_and(|m| m.dev() == opened.dev() && m.ino() == opened.ino())
-    });
+    // The real path of the file opened, as the system names its descriptor (else the path
+    // resolved now), and proof that it names that very file: the same device and inode, read
+    // without following a link, so a link swapped in at that path since proves nothing.
+    let real = real_path_of(&file)
+        .or_else(|| path.canonicalize().ok())
+        .filter(|real| {
+            std::fs::symlink_metadata(real)
+                .is_ok_and(|m| m.dev() == opened.dev() && m.ino() == opened.ino())
+        });
     let Some(real) = real else {
         return Err(if !allowed(&would_be(path)) {
             Refusal::Outside
@@ -195,6 +200,14 @@ pub fn open_named(path: &Path, scene: &Path, any: bool) -> Result<Opened, Refusa
         return Err(Refusal::NotRegular);
     }
     Ok(Opened { file, real })
+}
+
+/// The path the system gives the open `file` (`/proc/self/fd`), where it gives one: where the
+/// file was when it was opened, whatever its name has been changed to since.
+fn real_path_of(file: &File) -> Option<PathBuf> {
+    use std::os::fd::AsRawFd;
+    let real = std::fs::read_link(format!("/proc/self/fd/{}", file.as_raw_fd())).ok()?;
+    real.is_absolute().then_some(real)
 }
 
 /// Where `path` would be if it existed: each component that exists resolved as the system
