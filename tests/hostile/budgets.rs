@@ -182,7 +182,9 @@ fn a_300k_triangle_mesh_beyond_the_memory_ends_with_the_memory_message() {
         std::fs::write(dir.join(name), text).unwrap();
         let scene = format!("{HEAD}define shape obj mesh {name} m\nrender c out.png 8 6\n");
         std::fs::write(dir.join("scene.sdf"), scene).unwrap();
-        for kib in [150_000, 200_000, 250_000, 300_000] {
+        // Not lower: near 150000 KiB the worker threads' stacks may not fit beside the
+        // reading, and the run ends with that message instead (also exit 1, no signal).
+        for kib in [200_000, 250_000, 300_000] {
             let (code, stderr, _) = limited(dir, kib, "check scene.sdf");
             assert_eq!(code, Some(1), "{name} at {kib} KiB: {stderr}");
             let message = format!("scene.sdf:4:1: error: mesh file `{name}` needs about ");
