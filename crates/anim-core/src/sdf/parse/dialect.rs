@@ -24,18 +24,23 @@ const STATEMENT_STARTS: [&str; 10] = [
 /// The length of the number that token `t` starts with, when the rest of it is the first
 /// word of a statement (`0.70ambient`).
 fn glued_start(t: &Token) -> Option<usize> {
-    let b = t.text.as_bytes();
-    let could = b
-        .first()
-        .is_some_and(|c| c.is_ascii_digit() || matches!(c, b'.' | b'-' | b'+'))
-        && b.last().is_some_and(u8::is_ascii_lowercase);
-    if !could {
+    if !may_be_glued(t) {
         return None;
     }
     STATEMENT_STARTS.iter().find_map(|word| {
         let number = t.text.strip_suffix(word)?;
         (!number.is_empty() && parse_number(number).is_ok()).then_some(number.len())
     })
+}
+
+/// Whether token `t` starts like a number and ends like a word: the byte test that every
+/// token of every line passes through, so that the rest is asked of almost none.
+#[inline]
+fn may_be_glued(t: &Token) -> bool {
+    let b = t.text.as_bytes();
+    b.first()
+        .is_some_and(|c| c.is_ascii_digit() || matches!(c, b'.' | b'-' | b'+'))
+        && b.last().is_some_and(u8::is_ascii_lowercase)
 }
 
 impl Parser<'_> {
@@ -45,7 +50,7 @@ impl Parser<'_> {
     /// `None` when no number does (almost every line: nothing is copied).
     pub(super) fn split_statements<'t>(&mut self, line: &Line<'t>) -> Option<Vec<Line<'t>>> {
         let glued = |tokens: &[Token], i: usize| {
-            (i > 0 && !is_name_position(tokens, i))
+            (i > 0 && may_be_glued(&tokens[i]) && !is_name_position(tokens, i))
                 .then(|| glued_start(&tokens[i]))
                 .flatten()
         };
