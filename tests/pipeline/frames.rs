@@ -178,7 +178,7 @@ fn every_image_format_is_recorded_skipped_held_and_sharded_alike() {
 
 /// A triangle `size` from its centre (on the view axis, 5 in front of the eye) to each side,
 /// as an OBJ file.
-fn triangle_obj(size: f64) -> String {
+pub(crate) fn triangle_obj(size: f64) -> String {
     format!("v -{size} -{size} -5\nv {size} -{size} -5\nv 0 {size} -5\nf 1 2 3\n")
 }
 
@@ -465,98 +465,6 @@ fn generate_is_deterministic_atomic_and_trims_old_frames() {
     assert!(!frames_dir.join("frame_0011.sdf").exists());
     assert!(frames_dir.join("frame_0011.png").exists());
     assert!(frames_dir.join("frame_0007.sdf").exists());
-}
-
-/// A base scene beside its mesh, and a spec in another folder that animates it, in `root`.
-fn mesh_project(root: &Path) {
-    let scenes = root.join("scenes/meshes");
-    std::fs::create_dir_all(&scenes).expect("mkdir");
-    std::fs::write(scenes.join("tri.obj"), triangle_obj(2.0)).expect("obj");
-    std::fs::write(
-        root.join("scenes/base.sdf"),
-        "define material white 0.2 0.2 0.2 0.8 0.8 0.8 0 0 0 1\n\
-         define shape obj tri meshes/tri.obj white\n\
-         define light sun 0 0 10 1 1 1 1\n\
-         define camera cam 60\n",
-    )
-    .expect("base");
-    std::fs::create_dir_all(root.join("specs")).expect("mkdir");
-    std::fs::write(
-        root.join("specs/spin.ron"),
-        "(scene: File(\"../scenes/base.sdf\"), camera: \"cam\", length: Frames(2), \
-         resolution: (16, 12),\n tracks: [(target: \"tri\", rotate: [(at: 0, value: 0), (at: 0.05, value: 10)])])",
-    )
-    .expect("spec");
-}
-
-#[test]
-fn frames_find_the_base_scenes_mesh_files_wherever_they_are_written() {
-    let project = tempfile::tempdir().expect("tempdir");
-    mesh_project(project.path());
-    let elsewhere = tempfile::tempdir().expect("tempdir");
-    // The default folder beside the spec, and one on another branch of the file system.
-    let default_dir = project.path().join("specs/frames/spin");
-    let other_dir = elsewhere.path().join("out/frames");
-    for out in [None, Some(&other_dir)] {
-        let mut cmd = Command::cargo_bin("anim").expect("binary");
-        cmd.arg("generate")
-            .arg(project.path().join("specs/spin.ron"));
-        if let Some(o) = out {
-            cmd.arg("-o").arg(o);
-        }
-        let done = cmd.output().expect("run");
-        assert!(
-            done.status.success(),
-            "{}",
-            String::from_utf8_lossy(&done.stderr)
-        );
-        let frames = out.unwrap_or(&default_dir);
-        // Rendered from the project: the mesh is inside the current directory, wherever the
-        // frames are (the frames may read only inside their folder or the current one).
-        let done = Command::cargo_bin("anim")
-            .expect("binary")
-            .current_dir(project.path())
-            .arg("render")
-            .arg(frames)
-            .output()
-            .expect("run");
-        assert!(
-            done.status.success(),
-            "{}",
-            String::from_utf8_lossy(&done.stderr)
-        );
-        // The triangle covers the image centre: lit, not background black.
-        let img = image::open(frames.join("frame_0000.png"))
-            .expect("image")
-            .to_rgb8();
-        assert!(img.get_pixel(8, 6).0[0] > 100, "{:?}", img.get_pixel(8, 6));
-    }
-}
-
-#[test]
-fn a_mesh_path_the_frames_cannot_spell_is_an_error_that_leaves_nothing() {
-    // The frames' way back to the mesh passes through a folder whose name has a space, which
-    // an SDF file name cannot hold.
-    let dir = tempfile::tempdir().expect("tempdir");
-    let project = dir.path().join("two words");
-    mesh_project(&project);
-    let out = dir.path().join("frames/spin");
-    let done = Command::cargo_bin("anim")
-        .expect("binary")
-        .arg("generate")
-        .arg(project.join("specs/spin.ron"))
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .expect("run");
-    assert!(!done.status.success());
-    let said = String::from_utf8_lossy(&done.stderr);
-    assert!(
-        said.contains("the mesh file `meshes/tri.obj` cannot be named from the frame directory"),
-        "{said}"
-    );
-    assert!(said.contains("spin.ron:1:"), "{said}");
-    assert!(!dir.path().join("frames").exists());
 }
 
 #[test]

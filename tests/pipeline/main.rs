@@ -19,6 +19,8 @@
 //!   check that says what `anim check` would.
 //! - `timing`: keys at `Frames(n)`, fractional frame rates, `--frames A..B`.
 //! - `layering`: tracks on one value combined by `blend`, or refused without it.
+//! - `meshes`: the meshes frames name, copied into the frame folder from outside it, so that
+//!   the frames render from any current directory.
 //! - `optics`: keyed light radii, spot cones and lenses, `focus: Object` (a rack focus), and
 //!   their example shots rendered and encoded.
 //! - `rigs`: paths at constant speed, `orient: AlongPath`, parents.
@@ -43,6 +45,7 @@ mod holds;
 mod incremental;
 mod keyframe_spec;
 mod layering;
+mod meshes;
 mod optics;
 mod rigs;
 mod service;

@@ -50,7 +50,7 @@ pub fn run(config: &PreviewConfig, pool: &ThreadPool) -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    let mut project = Project {
+    let project = Project {
         input: config.input.clone(),
         frames_dir: temp.path().join("frames"),
         load: config.load.clone(),
@@ -62,11 +62,6 @@ pub fn run(config: &PreviewConfig, pool: &ThreadPool) -> ExitCode {
             eprintln!("{e}");
             return ExitCode::FAILURE;
         }
-    }
-    if project.is_spec() {
-        // The frames in the temporary folder name the base scene's meshes, which were
-        // confined when `anim generate` read the base scene.
-        project.load.allow_any_input = true;
     }
     let shared = Arc::new(Shared::default());
     {

@@ -7,7 +7,8 @@
 //! [`placement`] places things at a time (centres, pivots, aims, parents), [`follow`] turns a
 //! parent's motion into what its followers carry, [`keyed`] writes keyed
 //! values into definitions, [`ranges`] keeps ranged values in range between frames, and
-//! [`generate`] writes the frames.
+//! [`generate`] writes the frames, [`meshes`] puts the meshes they name where they can read
+//! them.
 
 pub mod base;
 pub mod bounds;
@@ -17,6 +18,7 @@ pub mod generate;
 pub mod interp;
 pub mod keyed;
 pub mod locate;
+pub mod meshes;
 pub mod motion;
 pub mod orbit;
 pub mod path;
@@ -122,11 +124,10 @@ pub fn run_generate_reporting(
             spec_dir.join("frames").join(stem)
         }
     };
-    let base_dir = match &spec_file.scene {
-        SceneSource::File(rel) => spec_dir.join(rel).parent().map(Path::to_path_buf),
-        SceneSource::Inline(_) => None,
-    }
-    .unwrap_or_else(|| spec_dir.clone());
+    let scene_path = match &spec_file.scene {
+        SceneSource::File(rel) => spec_dir.join(rel),
+        SceneSource::Inline(_) => src.path.to_path_buf(),
+    };
     // The frame directory exists while the frames are checked, because the paths of their
     // mesh files climb out of it; a run that fails removes the directories it made, so an
     // invalid spec leaves nothing behind.
@@ -136,9 +137,23 @@ pub fn run_generate_reporting(
             format!("cannot create the frame directory: {e}"),
         )]
     })?;
-    let result = rebase_mesh_files(&mut base.statements, &base_dir, &dir, &src)
-        .and_then(|()| selected_frames(config.frames, &anim, &src))
-        .and_then(|chosen| write_frames(&base, &anim, &src, &dir, config.standalone, chosen));
+    let manifest_path = dir.join(MANIFEST);
+    let mut placed = meshes::Placed::default();
+    let result = read_manifest(&manifest_path)
+        .map_err(|e| {
+            let why = format!("cannot read the list of generated frames: {e}");
+            vec![Diagnostic::file_error(&manifest_path, why)]
+        })
+        .and_then(|previous| {
+            placed =
+                meshes::place_meshes(&mut base.statements, &scene_path, &dir, &previous, &src)?;
+            let chosen = selected_frames(config.frames, &anim, &src)?;
+            let listed = Listed {
+                previous,
+                copies: &placed.listed,
+            };
+            write_frames(&base, &anim, &src, &dir, config.standalone, chosen, &listed)
+        });
     match result {
         Ok((written, removed)) => Ok(GenerateReport {
             dir,
@@ -150,6 +165,7 @@ pub fn run_generate_reporting(
             warnings,
         }),
         Err(e) => {
+            placed.undo();
             // Deepest first; a directory that holds anything is not removed.
             for d in &created {
                 let _ = std::fs::remove_dir(d);
@@ -198,6 +214,7 @@ fn write_frames(
     dir: &Path,
     standalone: bool,
     chosen: std::ops::RangeInclusive<usize>,
+    listed: &Listed,
 ) -> Result<(usize, usize), Vec<Diagnostic>> {
     // Every frame is made and checked (loaded as the renderer will) before any is written,
     // so an invalid spec writes nothing: in parallel, as the frames are independent, and the
@@ -214,15 +231,8 @@ fn write_frames(
         vec![Diagnostic::file_error(path, format!("{what}: {e}"))]
     };
     let manifest_path = dir.join(MANIFEST);
-    let previous = read_manifest(&manifest_path).map_err(|e| {
-        fail(
-            &manifest_path,
-            "cannot read the list of generated frames",
-            e,
-        )
-    })?;
     let mut written = 0;
-    let mut manifest = String::new();
+    let mut manifest: String = listed.copies.iter().map(|c| format!("{c}\n")).collect();
     // Files this run adds: a run that fails (a full disk) takes them away again, so that no
     // frame is left that no list names.
     let mut created: Vec<PathBuf> = Vec::new();
@@ -276,14 +286,22 @@ fn write_frames(
     }
     let current: HashSet<&str> = manifest.lines().collect();
     let mut removed = 0;
-    for stale in previous.iter().filter(|f| !current.contains(f.as_str())) {
+    for stale in listed
+        .previous
+        .iter()
+        .filter(|f| !current.contains(f.as_str()))
+    {
         let path = dir.join(stale);
         match std::fs::remove_file(&path) {
-            // The static part is not a frame.
-            Ok(()) => removed += usize::from(stale != STATIC_FILE),
+            // The static part and the copies of meshes are not frames.
+            Ok(()) => removed += usize::from(stale != STATIC_FILE && !meshes::is_copy(stale)),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
             Err(e) => return Err(undo(&created, fail(&path, "cannot remove an old frame", e))),
         }
+    }
+    if listed.copies.is_empty() {
+        // Gone when the last copy in it went, unless it holds files of the user's.
+        let _ = std::fs::remove_dir(dir.join(meshes::COPY_DIR));
     }
     write_atomically(&manifest_path, |w| w.write_all(manifest.as_bytes())).map_err(|e| {
         let e = fail(&manifest_path, "cannot record the generated frames", e);
@@ -439,48 +457,6 @@ fn first_frame_warnings(
     warnings
 }
 
-/// Points the base scene's OBJ files (`define shape obj`, relative to the base scene) at the
-/// same files from the frame directory, where the frames are read. Each mesh was loaded with
-/// the base scene, so it exists; a path that cannot be expressed is an error at the spec.
-fn rebase_mesh_files(
-    statements: &mut [anim_core::sdf::ast::Statement],
-    base_dir: &Path,
-    frame_dir: &Path,
-    src: &Source,
-) -> Result<(), Vec<Diagnostic>> {
-    use anim_core::scene::Geometry;
-    use anim_core::sdf::ast::StatementKind;
-    for s in statements {
-        let StatementKind::Shape {
-            geometry: Geometry::Mesh(m),
-            ..
-        } = &mut s.kind
-        else {
-            continue;
-        };
-        let rebased = anim_core::util::path_from(frame_dir, &base_dir.join(&m.file));
-        match rebased.as_ref().map(|p| p.to_str()) {
-            // A file name the SDF reader would split into two words cannot be written.
-            Ok(Some(p)) if !p.contains(char::is_whitespace) => m.file = p.to_string(),
-            _ => {
-                let why = match rebased {
-                    Err(e) => e.to_string(),
-                    Ok(p) => format!("its path from there, `{}`, is not one word", p.display()),
-                };
-                return Err(vec![src.error(
-                    &["scene[0]", "scene"],
-                    format!(
-                        "the mesh file `{}` cannot be named from the frame directory `{}`: {why}",
-                        m.file,
-                        frame_dir.display()
-                    ),
-                )]);
-            }
-        }
-    }
-    Ok(())
-}
-
 /// Moves a diagnostic about an inline scene from the scene text's own line:col to where that
 /// text stands in the spec (exact for raw strings and strings without escapes).
 fn shift_into_spec(mut d: Diagnostic, src: &Source) -> Diagnostic {
@@ -525,13 +501,8 @@ fn check_frame(
     let statements = generator.frame_statements(i)?;
     let text = generator.write_frame(i, &statements, None);
     let path: Arc<Path> = Arc::from(dir.join(anim.output.sdf(i, anim.digits())).as_path());
-    // The meshes were confined when the base scene was read; from the frame directory their
-    // paths may climb out of it.
-    let opts = LoadOptions {
-        allow_any_input: true,
-        ..LoadOptions::default()
-    };
-    if let Err(diags) = anim_core::load::load_str(&text, &path, &opts) {
+    // Confined as `anim render DIR` confines it: the meshes it names are inside its folder.
+    if let Err(diags) = anim_core::load::load_str(&text, &path, &LoadOptions::default()) {
         // A frame that does not load is a bug or a combination the spec checks missed;
         // show the loader's own words with the frame text they are about.
         let mut out = vec![Diagnostic::file_error(
@@ -553,13 +524,25 @@ fn check_frame(
 /// whose bytes are still exactly the ones it wrote.
 const MANIFEST: &str = ".anim-generated";
 
+/// The generated files a run knows of besides its frames.
+struct Listed<'a> {
+    /// The earlier run's list: what this run may replace or remove.
+    previous: Vec<String>,
+    /// The copies of meshes this run's frames name ([`meshes::place_meshes`]).
+    copies: &'a [String],
+}
+
 /// The files listed by an earlier run's manifest (none without one).
 fn read_manifest(path: &Path) -> std::io::Result<Vec<String>> {
     match std::fs::read_to_string(path) {
         Ok(text) => Ok(text
             .lines()
-            // Only plain names in the directory itself, whatever the file says.
-            .filter(|f| !f.is_empty() && Path::new(f).file_name() == Some(f.as_ref()))
+            // Only plain names in the directory itself, or copies of meshes in their folder,
+            // whatever the file says.
+            .filter(|f| {
+                !f.is_empty()
+                    && (Path::new(f).file_name() == Some(f.as_ref()) || meshes::is_copy(f))
+            })
             .map(str::to_string)
             .collect()),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Vec::new()),
