@@ -179,3 +179,57 @@ fn a_period_too_short_for_its_repeats_is_refused_at_the_key_time() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// The spec's own fields (shutter, rate, length) at the ends of the floats are refused with
+/// their numbers written short, at the field.
+#[test]
+fn extreme_shutters_rates_and_lengths_are_refused_with_short_numbers() {
+    let with = |fields: &str| {
+        format!("(scene: File(\"base.sdf\"), camera: \"cam\", resolution: (8, 8),\n{fields})\n")
+    };
+    for (fields, marker, says) in [
+        (
+            "length: Frames(3), shutter: 1e300",
+            "1e300",
+            "shutter must be 0 (no motion blur) or a fraction of the frame interval greater than 0 and at most 1, not 1e300",
+        ),
+        (
+            "length: Frames(3), shutter: -1e300",
+            "-1e300",
+            "not -1e300",
+        ),
+        ("length: Frames(3), fps: 1e300", "1e300", "or a ratio \"A/B\", not 1e300"),
+        ("length: Frames(3), fps: 1e-300", "1e-300", "or a ratio \"A/B\", not 1e-300"),
+        (
+            "length: Seconds(1e300)",
+            "Seconds",
+            "2.4e301 frames is more than the 1000000 allowed",
+        ),
+        (
+            "length: Seconds(1e-300)",
+            "Seconds",
+            "1e-300 s at 24 fps is less than one frame",
+        ),
+        (
+            "length: Frames(18446744073709551615)",
+            "Frames",
+            "1.84467440737e19 frames is more than the 1000000 allowed",
+        ),
+        (
+            "length: Frames(1e-300)",
+            "Frames",
+            "the number of frames must be a whole number, at least 1, not 1e-300",
+        ),
+    ] {
+        let text = with(fields);
+        let stderr = refused(&text);
+        let (line, _) = position(&text, marker);
+        let located = format!("spec.ron:{line}:");
+        assert!(
+            stderr
+                .lines()
+                .any(|l| l.contains(&located) && l.contains(": error: ") && l.contains(says)),
+            "expected {located}… {says}\nfor {text}\ngot {stderr}"
+        );
+    }
+}

@@ -391,27 +391,28 @@ impl Timing {
 }
 
 /// Where time `t` falls in a channel's keys once cycled: a time within the keys' span (or
-/// outside it, where the end values hold) and how many whole periods came before.
-pub fn cycled_time(first: f64, last: f64, t: f64, timing: &Timing) -> (f64, i64) {
+/// outside it, where the end values hold) and how many whole periods came before (a whole
+/// number, as a float: a tiny period repeats more often than any integer type counts).
+pub fn cycled_time(first: f64, last: f64, t: f64, timing: &Timing) -> (f64, f64) {
     let t = t - timing.offset;
     let period = last - first;
     if timing.cycle == Cycle::Hold || period <= 0.0 {
-        return (t, 0);
+        return (t, 0.0);
     }
     if timing.wraps() {
         // Written as it always was, so that looping channels keep their exact values.
-        return (first + (t - first).rem_euclid(period), 0);
+        return (first + (t - first).rem_euclid(period), 0.0);
     }
     let cycles = ((t - first) / period).floor();
     let limit = timing.count.map_or(f64::INFINITY, f64::from);
     if timing.count.is_some() && cycles < 0.0 {
-        return (first, 0);
+        return (first, 0.0);
     }
     if cycles >= limit {
         // Held where the last cycle ended: a ping-pong with an even count ends at the start.
         let last_cycle = limit - 1.0;
         let back = timing.cycle == Cycle::PingPong && last_cycle.rem_euclid(2.0) == 1.0;
-        return (if back { first } else { last }, last_cycle as i64);
+        return (if back { first } else { last }, last_cycle);
     }
     let within = (t - first) - cycles * period;
     let backwards = timing.cycle == Cycle::PingPong && cycles.rem_euclid(2.0) == 1.0;
@@ -420,7 +421,7 @@ pub fn cycled_time(first: f64, last: f64, t: f64, timing: &Timing) -> (f64, i64)
     } else {
         first + within
     };
-    (local, cycles as i64)
+    (local, cycles)
 }
 
 /// The value of a keyed channel at time `t` (seconds): repeating when `looping`. See
@@ -442,8 +443,8 @@ pub fn sample_timed<T: Keyable>(keys: &[Key<T>], t: f64, timing: &Timing) -> Opt
     }
     let (t, cycles) = cycled_time(first.at, last.at, t, timing);
     let value = within_keys(keys, t, timing.wraps());
-    if timing.cycle == Cycle::RepeatOffset && cycles != 0 {
-        return Some(value.add(last.value.sub(first.value).mul(cycles as f64)));
+    if timing.cycle == Cycle::RepeatOffset && cycles != 0.0 {
+        return Some(value.add(last.value.sub(first.value).mul(cycles)));
     }
     Some(value)
 }

@@ -155,7 +155,7 @@ fn repeated_too_often<T: Keyable>(c: &Channel<T>, t: f64, at: &str, why: &str) -
         _ => (0.0, 0.0),
     };
     let repeats = cycled_time(first, last, t, &c.timing).1;
-    if c.timing.cycle != Cycle::RepeatOffset || repeats == 0 {
+    if c.timing.cycle != Cycle::RepeatOffset || repeats == 0.0 {
         return OutOfRange {
             path: c.key_path_at(t),
             message: format!("{at}: {why}. {OVERSHOOT_HELP}"),
@@ -165,8 +165,7 @@ fn repeated_too_often<T: Keyable>(c: &Channel<T>, t: f64, at: &str, why: &str) -
         path: field(&index(&c.path, c.keys.len() - 1), "at"),
         message: format!(
             "{at}, after {} repeats of its keys every {} s (`cycle: RepeatOffset` adds each repeat to the last): {why}; a longer period or a `cycles` count keeps it in range",
-            // Counted here, as the cycle count saturates.
-            shown(((t - c.timing.offset - first) / (last - first)).floor()),
+            shown(repeats),
             shown(last - first)
         ),
     }

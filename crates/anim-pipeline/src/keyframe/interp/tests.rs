@@ -252,3 +252,25 @@ proptest! {
         prop_assert!(v >= lo - slack && v <= hi + slack, "{v} outside {lo}..{hi}");
     }
 }
+
+#[test]
+fn cycles_are_counted_past_any_integer_for_a_tiny_period() {
+    // 1 s of keys repeating every 1e-300 s: 1e300 whole periods before t = 1, which an i64
+    // count would have stopped at 2^63.
+    let timing = Timing {
+        offset: 0.0,
+        cycle: Cycle::RepeatOffset,
+        count: None,
+    };
+    let (_, cycles) = cycled_time(0.0, 1e-300, 1.0, &timing);
+    assert!((cycles / 1e300 - 1.0).abs() < 1e-9, "{cycles}");
+    // A count caps them where the last cycle ended.
+    let counted = Timing {
+        count: Some(u32::MAX),
+        ..timing
+    };
+    assert_eq!(
+        cycled_time(0.0, 1e-300, 1.0, &counted).1,
+        f64::from(u32::MAX) - 1.0
+    );
+}

@@ -88,10 +88,10 @@ impl OrientChannel {
                 }
             }
         };
-        if self.timing.cycle == crate::keyframe::interp::Cycle::RepeatOffset && cycles != 0 {
+        if self.timing.cycle == crate::keyframe::interp::Cycle::RepeatOffset && cycles != 0.0 {
             // Each repetition starts where the last ended: the whole cycle's turn, again.
             let (axis, angle) = (last.value * first.value.inverse()).to_axis_angle();
-            let placed = DQuat::from_axis_angle(axis, angle * cycles as f64) * q;
+            let placed = DQuat::from_axis_angle(axis, angle * cycles) * q;
             return Some(placed.normalize());
         }
         Some(q)

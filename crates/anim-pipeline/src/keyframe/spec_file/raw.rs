@@ -2,6 +2,7 @@
 //! ron rejects every unknown field and variant with its position.
 
 use super::model::{Blend, End, Follow, Fps};
+use crate::keyframe::bounds::shown;
 use crate::keyframe::interp::{Cycle, Interp, Side};
 use crate::keyframe::rotation::EulerOrder;
 use anim_core::limits;
@@ -118,7 +119,7 @@ impl FpsSpec {
                 let whole = (n * 1.001).round();
                 let ntsc = whole * 1000.0 / 1001.0;
                 if !((lo..=hi).contains(&whole) && (n - ntsc).abs() < 5e-4) {
-                    return Err(format!("{expected}, not {n}"));
+                    return Err(format!("{expected}, not {}", shown(*n)));
                 }
                 Fps {
                     num: whole as u32 * 1000,

@@ -141,7 +141,11 @@ impl Checker<'_> {
         }
         self.err(
             &["shutter"],
-            format!("shutter must be {}, not {shutter}", limits::SHUTTER_RULE),
+            format!(
+                "shutter must be {}, not {}",
+                limits::SHUTTER_RULE,
+                shown(shutter)
+            ),
         );
         0.0
     }
@@ -153,7 +157,10 @@ impl Checker<'_> {
                 if !(n.fract() == 0.0 && n >= 1.0) {
                     self.err(
                         &LENGTH_PATHS,
-                        format!("the number of frames must be a whole number, at least 1, not {n}"),
+                        format!(
+                            "the number of frames must be a whole number, at least 1, not {}",
+                            shown(n)
+                        ),
                     );
                 }
                 n
@@ -164,7 +171,10 @@ impl Checker<'_> {
         if frames > MAX_FRAMES {
             self.err(
                 &LENGTH_PATHS,
-                format!("{frames} frames is more than the {MAX_FRAMES} allowed"),
+                format!(
+                    "{} frames is more than the {MAX_FRAMES} allowed",
+                    shown(frames)
+                ),
             );
         }
         if frames.is_finite() {
@@ -181,19 +191,23 @@ impl Checker<'_> {
         if !s.is_finite() || s <= 0.0 {
             self.err(
                 &LENGTH_PATHS,
-                format!("the length must be a positive number of seconds, not {s}"),
+                format!(
+                    "the length must be a positive number of seconds, not {}",
+                    shown(s)
+                ),
             );
         } else if n < 1.0 {
             self.err(
                 &LENGTH_PATHS,
-                format!("{s} s at {fps} fps is less than one frame"),
+                format!("{} s at {fps} fps is less than one frame", shown(s)),
             );
         } else if (exact - n).abs() > 1e-6 {
             // Rounding silently would make the video longer or shorter than asked.
             self.err(
                 &LENGTH_PATHS,
                 format!(
-                    "{s} s at {fps} fps is {} frames: the length must be a whole number of frames (e.g. Frames({n}))",
+                    "{} s at {fps} fps is {} frames: the length must be a whole number of frames (e.g. Frames({n}))",
+                    shown(s),
                     tidy(exact)
                 ),
             );
