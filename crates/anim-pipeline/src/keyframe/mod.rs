@@ -227,21 +227,11 @@ fn write_frames(
     let split = groups
         .map(|_| Split::new(&base.statements, changed))
         .filter(|split| !split.is_empty());
-    let fail = |path: &Path, what: &str, e: std::io::Error| {
-        vec![Diagnostic::file_error(path, format!("{what}: {e}"))]
-    };
-    let manifest_path = dir.join(MANIFEST);
     let mut written = 0;
     let mut manifest: String = listed.copies.iter().map(|c| format!("{c}\n")).collect();
     // Files this run adds: a run that fails (a full disk) takes them away again, so that no
     // frame is left that no list names.
     let mut created: Vec<PathBuf> = Vec::new();
-    let undo = |created: &[PathBuf], e: Vec<Diagnostic>| {
-        for path in created {
-            let _ = std::fs::remove_file(path);
-        }
-        e
-    };
     // Lists one file and writes it unless it holds `text` already (or no text is given: a
     // frame outside `chosen`); whether it was written.
     let mut put = |name: &str, text: Option<&str>, created: &mut Vec<PathBuf>| {
@@ -258,7 +248,7 @@ fn write_frames(
             return Ok(false);
         }
         write_atomically(&path, |w| w.write_all(text.as_bytes()))
-            .map_err(|e| undo(created, fail(&path, "cannot write the frame", e)))?;
+            .map_err(|e| undo(created, io_error(&path, "cannot write the frame", e)))?;
         if before.is_none() {
             created.push(path);
         }
@@ -284,6 +274,19 @@ fn write_frames(
         let text = generator.write_frame(i, &statements, split.as_ref());
         written += usize::from(put(&name, Some(&text), &mut created)?);
     }
+    let removed = trim_and_record(dir, listed, &manifest, &created)?;
+    Ok((written, removed))
+}
+
+/// Removes what the earlier run listed and this one does not (`manifest`), then records
+/// `manifest`; returns how many frames went. A failure takes away the files this run
+/// `created`.
+fn trim_and_record(
+    dir: &Path,
+    listed: &Listed,
+    manifest: &str,
+    created: &[PathBuf],
+) -> Result<usize, Vec<Diagnostic>> {
     let current: HashSet<&str> = manifest.lines().collect();
     let mut removed = 0;
     for stale in listed
@@ -296,18 +299,36 @@ fn write_frames(
             // The static part and the copies of meshes are not frames.
             Ok(()) => removed += usize::from(stale != STATIC_FILE && !meshes::is_copy(stale)),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(e) => return Err(undo(&created, fail(&path, "cannot remove an old frame", e))),
+            Err(e) => {
+                return Err(undo(
+                    created,
+                    io_error(&path, "cannot remove an old frame", e),
+                ))
+            }
         }
     }
     if listed.copies.is_empty() {
         // Gone when the last copy in it went, unless it holds files of the user's.
         let _ = std::fs::remove_dir(dir.join(meshes::COPY_DIR));
     }
+    let manifest_path = dir.join(MANIFEST);
     write_atomically(&manifest_path, |w| w.write_all(manifest.as_bytes())).map_err(|e| {
-        let e = fail(&manifest_path, "cannot record the generated frames", e);
-        undo(&created, e)
+        let e = io_error(&manifest_path, "cannot record the generated frames", e);
+        undo(created, e)
     })?;
-    Ok((written, removed))
+    Ok(removed)
+}
+
+/// Takes away the files a failed run `created`, and passes its error on.
+fn undo(created: &[PathBuf], e: Vec<Diagnostic>) -> Vec<Diagnostic> {
+    for path in created {
+        let _ = std::fs::remove_file(path);
+    }
+    e
+}
+
+fn io_error(path: &Path, what: &str, e: std::io::Error) -> Vec<Diagnostic> {
+    vec![Diagnostic::file_error(path, format!("{what}: {e}"))]
 }
 
 /// Makes every frame, checks those in `chosen` by loading them, and returns the subjects of
