@@ -502,7 +502,22 @@ mod tests {
 
     #[test]
     fn the_reference_takes_the_anti_aliasing_the_scene_affords() {
-        let plain = distributed::Distributed::default();
-        assert_eq!(reference_setting(&plain).0, REFERENCE_FLAGS);
+        let of = |extra: &str| {
+            // A file without a render line renders its first camera.
+            let text = format!(
+                "define camera eye 60 0 1 5 0 0 -1 0 1 0\ndefine light key 0 5 0 1 1 1 1{extra}\n"
+            );
+            let loaded = anim_core::load::load_str(
+                &text,
+                Path::new("t.sdf"),
+                &anim_core::sdf::LoadOptions::default(),
+            )
+            .unwrap_or_else(|d| panic!("{}", d[0]));
+            let job = loaded.jobs.into_iter().next().unwrap();
+            reference_setting(&Distributed::of(&job)).0
+        };
+        assert_eq!(of(""), REFERENCE_FLAGS);
+        assert_eq!(of(" radius 1"), AREA_REFERENCE_FLAGS);
+        assert_eq!(of("\nlens eye 0.1 5"), "-A");
     }
 }
