@@ -267,10 +267,13 @@ pub struct BenchArgs {
     /// Adaptive settings to measure, as error targets in 8-bit levels (e.g. `--error 2,3,4`).
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_error_target)]
     pub error: Vec<f32>,
-    /// A POV-Ray anti-aliasing setting to time instead of the preset's (repeat for several),
-    /// e.g. `--pov-setting "+A0.1 +AM2 +R3"`.
-    #[arg(long = "pov-setting", value_name = "FLAGS")]
-    pub pov_settings: Vec<String>,
+    /// A POV-Ray setting to time instead of the preset's (repeat for several): command-line
+    /// flags, e.g. `--pov-setting "+A0.1 +AM2 +R3"`, and for scenes with spherical lights or a
+    /// lens, how POV-Ray samples its area lights and focal blur: `area=N` (N×N grid, default 9),
+    /// `adaptive=N` (area light's adaptive level; default off), `blur=N` (blur_samples, default
+    /// 32), `confidence=X` (0.9), `variance=X` (1/128), e.g. `--pov-setting "-A area=9 adaptive=1"`.
+    #[arg(long = "pov-setting", value_name = "FLAGS", value_parser = PovSetting::parse, allow_hyphen_values = true)]
+    pub pov_settings: Vec<PovSetting>,
     /// Time every run N times, all runs of a scene in turn (A B A B), and keep each run's
     /// median.
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
@@ -338,11 +341,7 @@ impl BenchArgs {
             c.settings = uniform.chain(adaptive).collect();
         }
         if !self.pov_settings.is_empty() {
-            c.pov_settings = self
-                .pov_settings
-                .iter()
-                .map(|f| PovSetting::new(f))
-                .collect();
+            c.pov_settings = self.pov_settings.clone();
         }
         c.turns = self.turns as usize;
         if self.whole_process {

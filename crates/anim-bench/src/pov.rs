@@ -1,35 +1,50 @@
 //! POV-Ray's points on the bench: the same scenes through the converters of the shared tools
-//! folder (`sdf2pov.py`, `povtonemap.py`).
+//! folder (`sdf2pov.py`, `povtonemap.py`), completed with the area lights and focal blur they
+//! do not write ([`distributed`]).
 //!
 //! Time is POV-Ray's normal one-pass render (Phong scene, 8-bit PNG), as the CPU time of the
 //! child process (user + system, from GNU `time -f %U+%S`). Error needs the tone mapping
 //! anim uses, which POV-Ray cannot do itself: three grey HDR channel passes at the same
 //! setting, merged with `c/(c+1)` by `povtonemap.py`, compared with the same merge of POV's
-//! own converged render (`+A0.0 +AM2 +R5`).
+//! own converged render ([`reference_setting`]).
+
+pub mod distributed;
 
 use super::{
     cache_key, last_lines, metrics, read_rgb8, run_child, timed_process, BenchConfig, BenchScene,
     Reference, Renderer, Row, Timing, WorkDir, TIME,
 };
+use distributed::{Distributed, Sampling};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
-/// One POV-Ray anti-aliasing setting.
+/// One POV-Ray setting: anti-aliasing flags, and how finely area lights and focal blur sample.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PovSetting {
-    /// Its command-line flags, as written in the report.
+    /// As written: POV-Ray's command-line flags and [`Sampling`]'s `NAME=VALUE` words.
     pub flags: String,
-    /// The plot line it belongs to: no anti-aliasing (`no AA`), or adaptive method N (`AMN`).
+    /// The plot line it belongs to: no anti-aliasing (`no AA`), or adaptive method N (`AMN`),
+    /// followed by `, adaptive N` when it names an area light's adaptive level.
     pub mode: String,
+    /// The flags given to POV-Ray: `flags` without the sampling words.
+    pub args: Vec<String>,
+    pub sampling: Sampling,
 }
 
 impl PovSetting {
     /// The setting of `flags`, in the plot line of its anti-aliasing: on with the last `+A` or
     /// `+A<threshold>` that no `-A` follows, by method 1 unless a `+AM<n>` says otherwise.
-    pub fn new(flags: &str) -> PovSetting {
-        let words: Vec<&str> = flags.split_whitespace().collect();
-        let switch = |w: &&str| {
+    /// `Err` names a sampling word whose value is out of range.
+    pub fn parse(flags: &str) -> Result<PovSetting, String> {
+        let mut sampling = Sampling::default();
+        let mut args = Vec::new();
+        for word in flags.split_whitespace() {
+            if !sampling.read_word(word)? {
+                args.push(word.to_string());
+            }
+        }
+        let switch = |w: &String| {
             let threshold = |rest: &str| rest.chars().all(|c| c.is_ascii_digit() || c == '.');
             match (w.strip_prefix("+A"), w.strip_prefix("-A")) {
                 (Some(rest), _) if threshold(rest) => Some(true),
@@ -37,39 +52,67 @@ impl PovSetting {
                 _ => None,
             }
         };
-        let on = words.iter().rev().find_map(switch).unwrap_or(false);
-        let method = words
+        let on = args.iter().rev().find_map(switch).unwrap_or(false);
+        let method = args
             .iter()
             .rev()
             .find_map(|w| w.strip_prefix("+AM"))
             .unwrap_or("1");
-        PovSetting {
-            flags: flags.to_string(),
-            mode: if on {
-                format!("AM{method}")
-            } else {
-                "no AA".to_string()
-            },
+        let mut mode = if on {
+            format!("AM{method}")
+        } else {
+            "no AA".to_string()
+        };
+        if let Some(level) = sampling.adaptive {
+            mode += &format!(", adaptive {level}");
         }
+        Ok(PovSetting {
+            flags: flags.to_string(),
+            mode,
+            args,
+            sampling,
+        })
     }
+}
+
+/// Settings of flags known to be valid.
+fn presets(flags: &[&str]) -> Vec<PovSetting> {
+    flags
+        .iter()
+        .map(|f| PovSetting::parse(f).expect("a preset POV-Ray setting reads"))
+        .collect()
 }
 
 /// Every setting of a full run.
 pub fn standard_settings() -> Vec<PovSetting> {
-    ["-A", "+A0.3", "+A0.1", "+A0.3 +AM2 +R3", "+A0.1 +AM2 +R3"]
-        .map(PovSetting::new)
-        .to_vec()
+    presets(&["-A", "+A0.3", "+A0.1", "+A0.3 +AM2 +R3", "+A0.1 +AM2 +R3"])
 }
 
 /// The quick run's: no anti-aliasing and the finest of each method.
 pub fn quick_settings() -> Vec<PovSetting> {
-    ["-A", "+A0.1", "+A0.1 +AM2 +R3"]
-        .map(PovSetting::new)
-        .to_vec()
+    presets(&["-A", "+A0.1", "+A0.1 +AM2 +R3"])
 }
 
-/// POV-Ray's converged image.
+/// POV-Ray's converged image of a scene of point lights and a pinhole.
 pub const REFERENCE_FLAGS: &str = "+A0.0 +AM2 +R5";
+
+/// Its anti-aliasing under a [`distributed::REFERENCE`] area light, whose 1089 shadow rays a
+/// sample put [`REFERENCE_FLAGS`]' subdivision of every pixel out of reach: subdivision to the
+/// same depth only where neighbouring samples differ (scripts/compare-pov.sh's threshold).
+pub const AREA_REFERENCE_FLAGS: &str = "+A0.02 +AM2 +R5";
+
+/// The flags and sampling of POV-Ray's converged image of a scene. Focal blur spreads its own
+/// rays over each pixel, so a lens takes no anti-aliasing on top.
+pub fn reference_setting(scene: &Distributed) -> (&'static str, Sampling) {
+    let flags = if scene.has_lens() {
+        "-A"
+    } else if scene.is_empty() {
+        REFERENCE_FLAGS
+    } else {
+        AREA_REFERENCE_FLAGS
+    };
+    (flags, distributed::REFERENCE)
+}
 
 /// What running POV-Ray needs, all found.
 #[derive(Clone, Debug)]
@@ -117,7 +160,7 @@ impl Tools {
 }
 
 /// The POV-Ray command for one render of `pov` into `out`.
-fn povray(config: &BenchConfig, flags: &str, pov: &Path, out: &Path, hdr: bool) -> Command {
+fn povray(config: &BenchConfig, args: &[String], pov: &Path, out: &Path, hdr: bool) -> Command {
     let mut cmd = Command::new("povray");
     cmd.arg("-D")
         .arg(format!("+WT{}", config.threads.max(1)))
@@ -126,15 +169,32 @@ fn povray(config: &BenchConfig, flags: &str, pov: &Path, out: &Path, hdr: bool) 
         .arg(format!("+H{}", config.height))
         .arg(if hdr { "+FH" } else { "+FN" })
         .arg(format!("+O{}", out.display()))
-        .args(flags.split_whitespace())
+        .args(args)
         .arg(pov);
     cmd
 }
 
-/// Converted scenes of one bench scene: the Phong scene and the three channel passes.
+/// Converted scenes of one bench scene: the Phong scene and the three channel passes, as the
+/// converter wrote them, and what completes them at a setting.
 struct Converted {
-    phong: PathBuf,
-    channels: [PathBuf; 3],
+    phong: String,
+    channels: [String; 3],
+    distributed: Distributed,
+}
+
+impl Converted {
+    /// The three channel passes at `sampling`, written into `work`.
+    fn channels_at(&self, sampling: &Sampling, work: &Path) -> Result<[PathBuf; 3], String> {
+        let paths = ["r", "g", "b"].map(|c| work.join(format!("scene_{c}.pov")));
+        for (text, path) in self.channels.iter().zip(&paths) {
+            write(path, &self.distributed.complete(text, sampling)?)?;
+        }
+        Ok(paths)
+    }
+}
+
+fn write(path: &Path, text: &str) -> Result<(), String> {
+    std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 fn convert(
@@ -143,54 +203,65 @@ fn convert(
     config: &BenchConfig,
     work: &Path,
 ) -> Result<Converted, String> {
+    let distributed = Distributed::of(&scene.job);
+    // The converter reads the file itself; a scene with what it cannot read is given to it
+    // without that, from the work folder.
+    let sdf = if distributed.is_empty() {
+        scene.file.clone()
+    } else {
+        let path = work.join("scene.sdf");
+        write(
+            &path,
+            &distributed::strip(&String::from_utf8_lossy(&scene.bytes)),
+        )?;
+        path
+    };
     let size = [
         "--width".to_string(),
         config.width.to_string(),
         "--height".to_string(),
         config.height.to_string(),
     ];
-    let phong = work.join("scene.pov");
-    run_child(
-        Command::new("python3")
-            .arg(&tools.sdf2pov)
-            .arg(&scene.file)
-            .args(&size)
-            .arg("-o")
-            .arg(&phong),
-    )?;
-    let channels = ["r", "g", "b"].map(|c| work.join(format!("scene_{c}.pov")));
-    for (c, path) in ["r", "g", "b"].iter().zip(&channels) {
-        run_child(
-            Command::new("python3")
-                .arg(&tools.sdf2pov)
-                .arg(&scene.file)
-                .args(&size)
-                .args(["--channel", c])
-                .arg("-o")
-                .arg(path),
-        )?;
+    let converted = |channel: Option<&str>| -> Result<String, String> {
+        let out = work.join("converted.pov");
+        let mut cmd = Command::new("python3");
+        cmd.arg(&tools.sdf2pov).arg(&sdf).args(&size);
+        if let Some(c) = channel {
+            cmd.args(["--channel", c]);
+        }
+        run_child(cmd.arg("-o").arg(&out))?;
+        std::fs::read_to_string(&out).map_err(|e| format!("cannot read {}: {e}", out.display()))
+    };
+    let phong = converted(None)?;
+    let mut channels: [String; 3] = Default::default();
+    for (c, text) in ["r", "g", "b"].iter().zip(&mut channels) {
+        *text = converted(Some(c))?;
     }
-    Ok(Converted { phong, channels })
+    Ok(Converted {
+        phong,
+        channels,
+        distributed,
+    })
 }
 
-/// The tone-mapped 8-bit image of POV-Ray at `flags`, written to `png`.
+/// The tone-mapped 8-bit image of POV-Ray at `args` and `sampling`, written to `png`.
 fn tone_mapped(
     tools: &Tools,
     conv: &Converted,
     config: &BenchConfig,
-    flags: &str,
+    (args, sampling): (&[String], &Sampling),
     work: &Path,
     png: &Path,
 ) -> Result<Vec<u8>, String> {
+    let passes = conv.channels_at(sampling, work)?;
     // The three passes run at once: at bench sizes most of a POV-Ray process is its front
     // end waiting (about 0.7 s), not tracing, and these passes are not the timed ones.
     let hdrs: Vec<PathBuf> = (0..3).map(|i| work.join(format!("pass{i}.hdr"))).collect();
-    let children: Vec<_> = conv
-        .channels
+    let children: Vec<_> = passes
         .iter()
         .zip(&hdrs)
         .map(|(pov, hdr)| {
-            povray(config, flags, pov, hdr, true)
+            povray(config, args, pov, hdr, true)
                 .stdout(Stdio::null())
                 .stderr(Stdio::piped())
                 .spawn()
@@ -237,14 +308,16 @@ fn stat(text: &str, label: &str) -> Option<u64> {
     })
 }
 
-/// POV-Ray ready to time one scene: the converted scenes and the converged reference, in a
-/// work folder of intermediate files removed with the session (the reference is cached
-/// outside it).
+/// POV-Ray ready to time one scene: the converted scenes (the Phong one written at every
+/// setting) and the converged reference, in a work folder of intermediate files removed with
+/// the session (the reference is cached outside it).
 pub struct Session<'a> {
     tools: &'a Tools,
     scene: &'a BenchScene,
     config: &'a BenchConfig,
     conv: Converted,
+    /// The Phong scene of each setting, in the order of the settings.
+    timed_scenes: Vec<PathBuf>,
     ref_rgb: Vec<u8>,
     pub reference: Reference,
     work: WorkDir,
@@ -260,21 +333,39 @@ impl<'a> Session<'a> {
     ) -> Result<Session<'a>, String> {
         let work = WorkDir::new(config, "pov", scene)?;
         let conv = convert(tools, scene, config, &work.0)?;
+        let mut timed_scenes = Vec::new();
+        for (i, s) in config.pov_settings.iter().enumerate() {
+            let path = work.0.join(format!("setting{i}.pov"));
+            write(&path, &conv.distributed.complete(&conv.phong, &s.sampling)?)?;
+            timed_scenes.push(path);
+        }
+        let (ref_flags, ref_sampling) = reference_setting(&conv.distributed);
+        let ref_args: Vec<String> = ref_flags.split_whitespace().map(String::from).collect();
+        let mut ref_label = ref_flags.to_string();
         let script = std::fs::read(&tools.sdf2pov).unwrap_or_default();
-        let key = cache_key(&[
-            &scene.bytes,
-            &script,
-            tools.version.as_bytes(),
-            REFERENCE_FLAGS.as_bytes(),
-            &config.width.to_le_bytes(),
-            &config.height.to_le_bytes(),
-        ]);
+        let mut parts: Vec<Vec<u8>> = vec![
+            scene.bytes.clone(),
+            script,
+            tools.version.as_bytes().to_vec(),
+            ref_flags.as_bytes().to_vec(),
+            config.width.to_le_bytes().to_vec(),
+            config.height.to_le_bytes().to_vec(),
+        ];
+        // What completes the converter's scenes enters the key only where there is any, so
+        // that the cached references of the other scenes stay valid.
+        if !conv.distributed.is_empty() {
+            ref_label += &format!(" {}", conv.distributed.words(&ref_sampling));
+            for text in &conv.channels {
+                parts.push(conv.distributed.complete(text, &ref_sampling)?.into_bytes());
+            }
+        }
+        let key = cache_key(&parts.iter().map(Vec::as_slice).collect::<Vec<_>>());
         let ref_path = config
             .cache_dir
             .join(format!("{}-pov-{key:016x}.png", scene.name));
         let mut reference = Reference {
             renderer: Renderer::PovRay,
-            setting: REFERENCE_FLAGS.to_string(),
+            setting: ref_label.clone(),
             wall_s: None,
             path: ref_path.clone(),
         };
@@ -289,11 +380,18 @@ impl<'a> Session<'a> {
             }
             None => {
                 progress(&format!(
-                    "{}: rendering the POV-Ray reference ({REFERENCE_FLAGS}, 3 channel passes)",
+                    "{}: rendering the POV-Ray reference ({ref_label}, 3 channel passes)",
                     scene.name
                 ));
                 let start = Instant::now();
-                let rgb = tone_mapped(tools, &conv, config, REFERENCE_FLAGS, &work.0, &ref_path)?;
+                let rgb = tone_mapped(
+                    tools,
+                    &conv,
+                    config,
+                    (&ref_args, &ref_sampling),
+                    &work.0,
+                    &ref_path,
+                )?;
                 reference.wall_s = Some(start.elapsed().as_secs_f64());
                 rgb
             }
@@ -303,6 +401,7 @@ impl<'a> Session<'a> {
             scene,
             config,
             conv,
+            timed_scenes,
             ref_rgb,
             reference,
             work,
@@ -316,8 +415,8 @@ impl<'a> Session<'a> {
         let out = self.work.0.join("timed.png");
         let report = self.work.0.join("time.txt");
         let mut timed = Vec::new();
-        for s in &self.config.pov_settings {
-            let cmd = povray(self.config, &s.flags, &self.conv.phong, &out, false);
+        for (s, pov) in self.config.pov_settings.iter().zip(&self.timed_scenes) {
+            let cmd = povray(self.config, &s.args, pov, &out, false);
             let (stderr, timing) = timed_process(&cmd, &report)?;
             // POV-Ray counts the samples of anti-aliasing only; without it, one per pixel.
             let spp = match stat(&stderr, "Samples:") {
@@ -339,7 +438,7 @@ impl<'a> Session<'a> {
                 self.tools,
                 &self.conv,
                 self.config,
-                &s.flags,
+                (&s.args, &s.sampling),
                 &self.work.0,
                 &png,
             )?;
@@ -376,7 +475,7 @@ mod tests {
 
     #[test]
     fn a_setting_is_drawn_in_the_line_of_its_method() {
-        let mode = |flags: &str| PovSetting::new(flags).mode;
+        let mode = |flags: &str| PovSetting::parse(flags).unwrap().mode;
         assert_eq!(mode("-A"), "no AA");
         assert_eq!(mode(""), "no AA");
         assert_eq!(mode("+A0.3"), "AM1");
@@ -385,6 +484,40 @@ mod tests {
         // The last switch counts; a method alone does not turn anti-aliasing on.
         assert_eq!(mode("+A0.1 -A"), "no AA");
         assert_eq!(mode("+AM2 +R3"), "no AA");
-        assert_eq!(PovSetting::new("+A0.1 +AM2 +R3").flags, "+A0.1 +AM2 +R3");
+        assert_eq!(
+            PovSetting::parse("+A0.1 +AM2 +R3").unwrap().flags,
+            "+A0.1 +AM2 +R3"
+        );
+    }
+
+    #[test]
+    fn sampling_words_are_kept_from_povrays_command_line() {
+        let s = PovSetting::parse("-A area=9 adaptive=1 blur=16").unwrap();
+        assert_eq!(s.args, ["-A"]);
+        assert_eq!(s.mode, "no AA, adaptive 1");
+        assert_eq!((s.sampling.area, s.sampling.blur), (9, 16));
+        assert_eq!(PovSetting::parse("+A0.3 blur=8").unwrap().mode, "AM1");
+        assert!(PovSetting::parse("-A area=0").is_err());
+    }
+
+    #[test]
+    fn the_reference_takes_the_anti_aliasing_the_scene_affords() {
+        let of = |extra: &str| {
+            // A file without a render line renders its first camera.
+            let text = format!(
+                "define camera eye 60 0 1 5 0 0 -1 0 1 0\ndefine light key 0 5 0 1 1 1 1{extra}\n"
+            );
+            let loaded = anim_core::load::load_str(
+                &text,
+                Path::new("t.sdf"),
+                &anim_core::sdf::LoadOptions::default(),
+            )
+            .unwrap_or_else(|d| panic!("{}", d[0]));
+            let job = loaded.jobs.into_iter().next().unwrap();
+            reference_setting(&Distributed::of(&job)).0
+        };
+        assert_eq!(of(""), REFERENCE_FLAGS);
+        assert_eq!(of(" radius 1"), AREA_REFERENCE_FLAGS);
+        assert_eq!(of("\nlens eye 0.1 5"), "-A");
     }
 }

@@ -87,7 +87,7 @@ pub fn markdown(report: &BenchReport) -> String {
     };
     let _ = writeln!(
         out,
-        "# anim bench: time against error\n\n{}×{}, {} threads. Error in 8-bit levels (after `c/(c+1)` and rounding) against each renderer's own converged image: anim uniform {} spp, POV-Ray `{}` (three HDR channel passes, tone-mapped alike). {clock}.{turns}\n",
+        "# anim bench: time against error\n\n{}×{}, {} threads. Error in 8-bit levels (after `c/(c+1)` and rounding) against each renderer's own converged image: anim uniform {} spp, POV-Ray `{}` (three HDR channel passes, tone-mapped alike; a scene with area lights or focal blur names its own below). {clock}.{turns}\n",
         report.width,
         report.height,
         report.threads,
