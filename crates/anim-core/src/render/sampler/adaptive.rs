@@ -8,8 +8,9 @@
 //!    a mirror showing a flat wall as much as for the wall, so secondary rays alone do not
 //!    force more samples; an edge in the reflection shows as contrast. Every other pixel
 //!    drops its centre sample and takes scrambled Sobol samples, at least as many as its
-//!    neighbourhood contrast calls for (`pattern::min_samples`), then doubling until the
-//!    estimated error of its tone-mapped mean is at most `error` levels, or `max_spp`.
+//!    neighbourhood contrast calls for (`pattern::min_samples`; more where motion, a lens or
+//!    a spherical light spreads them: [`at_least`]), then doubling until the estimated error
+//!    of its tone-mapped mean is at most `error` levels, or `max_spp`.
 //!
 //! The neighbourhood test is what catches features thinner than the base spacing: a sliver
 //! seen by one centre marks all eight pixels around it. Pass 2 reads only the finished pass 1
@@ -27,8 +28,10 @@
 //! goes on with those whose samples all agreed but whose neighbours show otherwise
 //! (docs/scene-language.md §10).
 
-use super::first_pass::{around, FirstPass, KeptCentres};
-use super::pattern::{self, tone3, Moments, PixelPattern, MOTION_MIN_SAMPLES, PRIOR_SAMPLES};
+use super::first_pass::{around, FirstPass, KeptCentres, Refinement};
+use super::pattern::{
+    self, tone3, Moments, PixelPattern, MOTION_MIN_SAMPLES, PRIOR_SAMPLES, SPREAD_MIN_SAMPLES,
+};
 use super::{coverage, Frame, Kept, Sampled};
 use crate::render::compile::NO_HIT;
 use crate::render::counts::RayCounts;
@@ -334,7 +337,7 @@ impl Adaptive<'_> {
         st: &mut TraceState,
     ) -> Pixel {
         let (w, max_spp) = (self.frame.size.0, self.max_spp);
-        let Some((contrast, moving)) = first.refinement(x, y).filter(|_| max_spp > 1) else {
+        let Some(refinement) = first.refinement(x, y).filter(|_| max_spp > 1) else {
             let (centre, prim) = first.centres[y * w + x];
             return Pixel {
                 mean: Vec3::from(centre),
@@ -343,10 +346,7 @@ impl Adaptive<'_> {
                 estimate: f32::NAN,
             };
         };
-        let mut at_least = pattern::min_samples(contrast, self.error, max_spp);
-        if moving {
-            at_least = at_least.max(MOTION_MIN_SAMPLES).min(max_spp);
-        }
+        let at_least = at_least(refinement, self.error, max_spp);
         let prior = first.prior(x, y);
         let pattern = PixelPattern::new(x as u32, y as u32);
         let mut m = Moments::default();
@@ -407,7 +407,12 @@ impl Adaptive<'_> {
             return false;
         }
         // The first pass's contrast around a pixel that motion touches (levels).
-        let Some((contrast, true)) = first.refinement(x, y) else {
+        let Some(Refinement {
+            contrast,
+            moving: true,
+            ..
+        }) = first.refinement(x, y)
+        else {
             return false;
         };
         let (w, h) = self.frame.size;
@@ -448,6 +453,21 @@ impl Adaptive<'_> {
     }
 }
 
+/// Samples a pixel refined as `refinement` says takes before its own error estimate may stop
+/// it, with target `error` and at most `max_spp`: what its neighbourhood's contrast calls for
+/// (`pattern::min_samples`), and more where its samples spread over the exposure
+/// (`MOTION_MIN_SAMPLES`) or over its lens or light points (`SPREAD_MIN_SAMPLES`).
+fn at_least(refinement: Refinement, error: f32, max_spp: u32) -> u32 {
+    let mut n = pattern::min_samples(refinement.contrast, error, max_spp);
+    if refinement.moving {
+        n = n.max(MOTION_MIN_SAMPLES);
+    }
+    if refinement.spread {
+        n = n.max(SPREAD_MIN_SAMPLES);
+    }
+    n.min(max_spp)
+}
+
 /// Where pass 2 of a frame of a shot writes: per pixel its value, its coverage, the samples
 /// it took, the estimate of its error and the first later frame that changes what its samples met.
 struct Refining<'a> {
@@ -484,5 +504,35 @@ impl PassesRest {
             taken: vec![0; pixels],
             recheck_until: vec![0; with_motion],
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::sampler::pattern::MIN_SAMPLES;
+
+    /// A penumbra pixel among centres that agree (no contrast around it) has nothing in its
+    /// neighbourhood to ask for samples, and its first samples may all see the whole light:
+    /// it still takes the spread minimum before its estimate may stop it.
+    #[test]
+    fn a_pixel_spread_over_lens_or_light_points_takes_the_spread_minimum_however_calm() {
+        let calm = |moving, spread| Refinement {
+            contrast: 0.0,
+            moving,
+            spread,
+        };
+        assert_eq!(at_least(calm(false, false), 2.0, 32), MIN_SAMPLES);
+        assert_eq!(at_least(calm(true, false), 2.0, 32), MOTION_MIN_SAMPLES);
+        assert_eq!(at_least(calm(true, true), 2.0, 32), SPREAD_MIN_SAMPLES);
+        // Never more than the pixel may take.
+        assert_eq!(at_least(calm(true, true), 2.0, 8), 8);
+        // A strong edge around it asks for more than the minimum, as anywhere:
+        // (0.2·100/2)^(4/3) ≈ 21.5, rounded up to 32.
+        let edge = Refinement {
+            contrast: 100.0,
+            ..calm(true, true)
+        };
+        assert_eq!(at_least(edge, 2.0, 64), 32);
     }
 }
