@@ -50,6 +50,18 @@ pub const MOTION_MIN_SAMPLES: u32 = 8;
 /// the bench's target (BENCHMARKS.md, "Soft shadows, spots and depth of field").
 pub const SPREAD_MIN_SAMPLES: u32 = 16;
 
+/// A pixel spread over lens or light points is refined to the frame's error target divided by
+/// this. Its error estimate is the spread of its own samples' mean, and where a bright sliver of
+/// the lens or a light is seen by few of them the estimate runs low: at the frame's target the
+/// depth-of-field bench scene stayed well above it in RMSE while only its blurred pixels were
+/// off. Only those pixels pay (BENCHMARKS.md, "Soft shadows, spots and depth of field").
+pub const SPREAD_ERROR_DIVISOR: f32 = 4.0;
+
+/// A pixel spread over lens or light points may take this many times `--max-spp`, which caps
+/// every other pixel: a quarter of the error calls for about sixteen times the samples, and a
+/// blur's pixels reached the old cap before the old target.
+pub const SPREAD_SPP_FACTOR: u32 = 4;
+
 /// Largest contrast (8-bit levels) between a pixel's centre sample and its 8 neighbours'
 /// for the pixel to be flat and keep its centre sample, if all nine hit the same surface.
 /// Smooth shading changes by about a level from pixel to pixel; a shadow or highlight edge,
