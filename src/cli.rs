@@ -83,11 +83,12 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", value_parser = parse_samples)]
     pub spp: Option<u32>,
     /// Adaptive sampling: target error of each pixel that needs more than one sample, in
-    /// 8-bit levels (default 2). Given explicitly, it also overrides a render statement's
-    /// sample count.
+    /// 8-bit levels (default 2); a pixel blurred by the lens or in a soft shadow is held to a
+    /// quarter of it. Given explicitly, it also overrides a render statement's sample count.
     #[arg(long, value_name = "E", value_parser = parse_error_target, conflicts_with = "spp")]
     pub error: Option<f32>,
-    /// Adaptive sampling: most samples one pixel may take (default 32).
+    /// Adaptive sampling: most samples one pixel may take (default 32); a pixel blurred by
+    /// the lens or in a soft shadow may take 4 times as many.
     #[arg(long, value_name = "N", value_parser = parse_samples, conflicts_with = "spp")]
     pub max_spp: Option<u32>,
     /// Worker threads (default: one per core). The output does not depend on it.

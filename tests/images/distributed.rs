@@ -4,7 +4,8 @@
 //! image where the whole light is visible and in the umbra, and its penumbra is as wide as the
 //! cones from the floor to the light and to the ball say; a spot is the point light inside its
 //! inner cone and ambient only outside its outer cone; a lens keeps the plane in focus as sharp
-//! as the pinhole and blurs another plane over its circle of confusion.
+//! as the pinhole and blurs another plane over its circle of confusion, and adaptive sampling
+//! through it is as bright as the converged image over a blurred shadow's rim.
 
 use crate::common;
 use common::*;
@@ -319,4 +320,44 @@ fn a_lens_keeps_the_plane_in_focus_sharp_and_blurs_another_over_its_circle_of_co
         let sharp = falls_through(&pinhole, y, 0.1) - falls_through(&pinhole, y, 0.9);
         assert!(sharp <= 2.0, "row {y}: pinhole edge {sharp:.2}");
     }
+}
+
+/// A blurred pixel's samples meet points across its circle of confusion, beyond the nine
+/// centres around it: taking the light as seen wherever those centres' shadow rays saw it
+/// would light the samples that reach into a shadow, and brighten the blurred rim of every
+/// shadow. Adaptive sampling's mean is unbiased: over the pixels where the lens changes the
+/// image, its difference from the converged render is within three standard errors of zero.
+#[test]
+fn adaptive_sampling_through_a_lens_does_not_brighten_the_rim_of_a_blurred_shadow() {
+    // Focused far beyond the floor, which the lens blurs over several pixels.
+    let lens = "lens eye 1 40";
+    let pinhole = render_ppm(&shadow_scene("", ""), &["--spp", "16"]);
+    let converged = render_ppm(&shadow_scene("", lens), &["--spp", "1024"]);
+    let adaptive = render_ppm(&shadow_scene("", lens), &[]);
+    let mut diffs = Vec::new();
+    for y in 0..H {
+        for x in 0..W {
+            let (p, c, a) = (
+                pinhole.at(x, y)[0],
+                converged.at(x, y)[0],
+                adaptive.at(x, y)[0],
+            );
+            if p.abs_diff(c) > 2 {
+                diffs.push(f64::from(a) - f64::from(c));
+            }
+        }
+    }
+    let n = diffs.len() as f64;
+    assert!(
+        n > 500.0,
+        "only {n} pixels where the lens changes the image"
+    );
+    let mean = diffs.iter().sum::<f64>() / n;
+    let var = diffs.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    let standard_error = (var / n).sqrt();
+    assert!(
+        mean.abs() <= 3.0 * standard_error,
+        "over {n} blurred pixels the adaptive render is {mean:+.3} levels off the converged one \
+         (standard error {standard_error:.3})"
+    );
 }

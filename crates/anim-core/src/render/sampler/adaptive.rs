@@ -8,8 +8,10 @@
 //!    a mirror showing a flat wall as much as for the wall, so secondary rays alone do not
 //!    force more samples; an edge in the reflection shows as contrast. Every other pixel
 //!    drops its centre sample and takes scrambled Sobol samples, at least as many as its
-//!    neighbourhood contrast calls for (`pattern::min_samples`), then doubling until the
-//!    estimated error of its tone-mapped mean is at most `error` levels, or `max_spp`.
+//!    neighbourhood contrast calls for (`pattern::min_samples`; more where motion, a lens or
+//!    a spherical light spreads them: [`at_least`]), then doubling until the estimated error
+//!    of its tone-mapped mean is at most `error` levels, or `max_spp` (a pixel spread over
+//!    lens or light points is held to less error and may take more: [`goal`]).
 //!
 //! The neighbourhood test is what catches features thinner than the base spacing: a sliver
 //! seen by one centre marks all eight pixels around it. Pass 2 reads only the finished pass 1
@@ -27,8 +29,11 @@
 //! goes on with those whose samples all agreed but whose neighbours show otherwise
 //! (docs/scene-language.md §10).
 
-use super::first_pass::{around, FirstPass, KeptCentres};
-use super::pattern::{self, tone3, Moments, PixelPattern, MOTION_MIN_SAMPLES, PRIOR_SAMPLES};
+use super::first_pass::{around, FirstPass, KeptCentres, Refinement};
+use super::pattern::{
+    self, tone3, Moments, PixelPattern, MOTION_MIN_SAMPLES, PRIOR_SAMPLES, SPREAD_ERROR_DIVISOR,
+    SPREAD_MIN_SAMPLES, SPREAD_SPP_FACTOR,
+};
 use super::{coverage, Frame, Kept, Sampled};
 use crate::render::compile::NO_HIT;
 use crate::render::counts::RayCounts;
@@ -250,9 +255,9 @@ impl Adaptive<'_> {
                     }
                     let n = taken[i] as u32;
                     (*out, *cov) = (refined[i], refined_coverage[i]);
-                    if self.rechecks(first, &tones, (x, y), n) {
+                    if let Some(goal) = self.rechecks(first, &tones, (x, y), n) {
                         let prior = first.prior(x, y);
-                        (*out, *cov) = self.resume((*out, *cov), n, (x, y), prior, &mut st);
+                        (*out, *cov) = self.resume((*out, *cov), n, (x, y), goal, prior, &mut st);
                     }
                     *until = st.scratch.take_footprint();
                 }
@@ -334,7 +339,7 @@ impl Adaptive<'_> {
         st: &mut TraceState,
     ) -> Pixel {
         let (w, max_spp) = (self.frame.size.0, self.max_spp);
-        let Some((contrast, moving)) = first.refinement(x, y).filter(|_| max_spp > 1) else {
+        let Some(refinement) = first.refinement(x, y).filter(|_| max_spp > 1) else {
             let (centre, prim) = first.centres[y * w + x];
             return Pixel {
                 mean: Vec3::from(centre),
@@ -343,10 +348,8 @@ impl Adaptive<'_> {
                 estimate: f32::NAN,
             };
         };
-        let mut at_least = pattern::min_samples(contrast, self.error, max_spp);
-        if moving {
-            at_least = at_least.max(MOTION_MIN_SAMPLES).min(max_spp);
-        }
+        let (error, max_spp) = goal(refinement, self.error, max_spp);
+        let at_least = at_least(refinement, self.error, max_spp);
         let prior = first.prior(x, y);
         let pattern = PixelPattern::new(x as u32, y as u32);
         let mut m = Moments::default();
@@ -356,7 +359,7 @@ impl Adaptive<'_> {
             m.add(radiance);
             hits += u32::from(hit);
             // Checked at powers of two only: there every prefix is a full net.
-            if m.n >= at_least && m.n.is_power_of_two() && m.error() <= self.error {
+            if m.n >= at_least && m.n.is_power_of_two() && m.error() <= error {
                 break;
             }
         }
@@ -390,9 +393,9 @@ impl Adaptive<'_> {
                 let mut st = self.frame.trace_state(true);
                 for (x, (out, cov)) in row.iter_mut().zip(coverage_row).enumerate() {
                     let n = taken[y * w + x] as u32;
-                    if self.rechecks(first, &tones, (x, y), n) {
+                    if let Some(goal) = self.rechecks(first, &tones, (x, y), n) {
                         let prior = first.prior(x, y);
-                        (*out, *cov) = self.resume((*out, *cov), n, (x, y), prior, &mut st);
+                        (*out, *cov) = self.resume((*out, *cov), n, (x, y), goal, prior, &mut st);
                     }
                 }
                 st.scratch.counts
@@ -401,15 +404,20 @@ impl Adaptive<'_> {
     }
 
     /// Whether pass 3 goes on with pixel (x, y), which took `n` samples in pass 2 (`tones`:
-    /// pass 2's image tone-mapped).
-    fn rechecks(&self, first: &FirstPass, tones: &[Vec3A], (x, y): (usize, usize), n: u32) -> bool {
-        if n == 0 || n > MOTION_MIN_SAMPLES || n >= self.max_spp {
-            return false;
-        }
+    /// pass 2's image tone-mapped): if so, to what error target and at most how many samples.
+    fn rechecks(
+        &self,
+        first: &FirstPass,
+        tones: &[Vec3A],
+        (x, y): (usize, usize),
+        n: u32,
+    ) -> Option<(f32, u32)> {
         // The first pass's contrast around a pixel that motion touches (levels).
-        let Some((contrast, true)) = first.refinement(x, y) else {
-            return false;
-        };
+        let refinement = first.refinement(x, y).filter(|r| r.moving)?;
+        let (error, max_spp) = goal(refinement, self.error, self.max_spp);
+        if n == 0 || n > MOTION_MIN_SAMPLES || n >= max_spp {
+            return None;
+        }
         let (w, h) = self.frame.size;
         let tone = tones[y * w + x];
         let mut differs = 0.0f32;
@@ -418,16 +426,17 @@ impl Adaptive<'_> {
                 differs = differs.max((*t - tone).abs().max_element());
             }
         }
-        255.0 * differs > contrast + 2.0 * self.error
+        (255.0 * differs > refinement.contrast + 2.0 * error).then_some((error, max_spp))
     }
 
     /// Pixel (x, y), whose `n` samples had mean `mean` and coverage `covered`, taking more of
-    /// its own pattern.
+    /// its own pattern until their error is at most `error` or they are `max_spp`.
     fn resume(
         &self,
         (mean, covered): (Vec3, f32),
         n: u32,
         (x, y): (usize, usize),
+        (error, max_spp): (f32, u32),
         prior: PixelPrior,
         st: &mut TraceState,
     ) -> (Vec3, f32) {
@@ -435,17 +444,47 @@ impl Adaptive<'_> {
         let mut m = Moments::resume(Vec3A::from(mean), n);
         // Exact: the coverage of n ≤ 255 samples is a count over n.
         let mut hits = (covered * n as f32).round() as u32;
-        while m.n < self.max_spp {
+        while m.n < max_spp {
             let (radiance, hit) = self.sample((x, y), &pattern, m.n, &prior, st);
             m.add(radiance);
             hits += u32::from(hit);
-            if m.n.is_power_of_two() && m.error() <= self.error {
+            if m.n.is_power_of_two() && m.error() <= error {
                 break;
             }
         }
         st.scratch.counts.primary += (m.n - n) as u64;
         (Vec3::from(m.mean()), coverage(hits, m.n))
     }
+}
+
+/// The error target and the most samples of a pixel refined as `refinement` says, in a frame
+/// whose target is `error` and whose cap is `max_spp`: a pixel spread over lens or light points
+/// is held to `SPREAD_ERROR_DIVISOR` times less error and may take `SPREAD_SPP_FACTOR` times
+/// the samples, so only the pixels of a blur or a penumbra pay for them. The neighbourhood's
+/// contrast still asks for its samples at the frame's target ([`at_least`]): what it guards
+/// against, a feature thinner than the centres' spacing, does not depend on the lens or light.
+fn goal(refinement: Refinement, error: f32, max_spp: u32) -> (f32, u32) {
+    if refinement.spread {
+        let cap = max_spp.saturating_mul(SPREAD_SPP_FACTOR);
+        (error / SPREAD_ERROR_DIVISOR, cap)
+    } else {
+        (error, max_spp)
+    }
+}
+
+/// Samples a pixel refined as `refinement` says takes before its own error estimate may stop
+/// it, with target `error` and at most `max_spp`: what its neighbourhood's contrast calls for
+/// (`pattern::min_samples`), and more where its samples spread over the exposure
+/// (`MOTION_MIN_SAMPLES`) or over its lens or light points (`SPREAD_MIN_SAMPLES`).
+fn at_least(refinement: Refinement, error: f32, max_spp: u32) -> u32 {
+    let mut n = pattern::min_samples(refinement.contrast, error, max_spp);
+    if refinement.moving {
+        n = n.max(MOTION_MIN_SAMPLES);
+    }
+    if refinement.spread {
+        n = n.max(SPREAD_MIN_SAMPLES);
+    }
+    n.min(max_spp)
 }
 
 /// Where pass 2 of a frame of a shot writes: per pixel its value, its coverage, the samples
@@ -484,5 +523,52 @@ impl PassesRest {
             taken: vec![0; pixels],
             recheck_until: vec![0; with_motion],
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::sampler::pattern::MIN_SAMPLES;
+
+    /// A penumbra pixel among centres that agree (no contrast around it) has nothing in its
+    /// neighbourhood to ask for samples, and its first samples may all see the whole light:
+    /// it still takes the spread minimum before its estimate may stop it.
+    #[test]
+    fn a_pixel_spread_over_lens_or_light_points_takes_the_spread_minimum_however_calm() {
+        let calm = |moving, spread| Refinement {
+            contrast: 0.0,
+            moving,
+            spread,
+        };
+        assert_eq!(at_least(calm(false, false), 2.0, 32), MIN_SAMPLES);
+        assert_eq!(at_least(calm(true, false), 2.0, 32), MOTION_MIN_SAMPLES);
+        assert_eq!(at_least(calm(true, true), 2.0, 32), SPREAD_MIN_SAMPLES);
+        // Never more than the pixel may take.
+        assert_eq!(at_least(calm(true, true), 2.0, 8), 8);
+        // A strong edge around it asks for more than the minimum, as anywhere:
+        // (0.2·100/2)^(4/3) ≈ 21.5, rounded up to 32.
+        let edge = Refinement {
+            contrast: 100.0,
+            ..calm(true, true)
+        };
+        assert_eq!(at_least(edge, 2.0, 64), 32);
+    }
+
+    /// Only a pixel spread over lens or light points is held to the smaller target and the
+    /// larger cap, with or without motion; the others keep the frame's.
+    #[test]
+    fn a_spread_pixel_is_held_to_a_quarter_of_the_error_and_four_times_the_samples() {
+        let refinement = |moving, spread| Refinement {
+            contrast: 0.0,
+            moving,
+            spread,
+        };
+        assert_eq!(goal(refinement(false, false), 2.0, 32), (2.0, 32));
+        assert_eq!(goal(refinement(true, false), 2.0, 32), (2.0, 32));
+        assert_eq!(goal(refinement(false, true), 2.0, 32), (0.5, 128));
+        assert_eq!(goal(refinement(true, true), 1.0, 16), (0.25, 64));
+        // A cap that cannot grow further stays the largest count.
+        assert_eq!(goal(refinement(false, true), 2.0, u32::MAX).1, u32::MAX);
     }
 }

@@ -52,6 +52,19 @@ pub(super) struct Mark {
     blur: f32,
 }
 
+/// Why a pixel is refined ([`FirstPass::refinement`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Refinement {
+    /// The largest tone-mapped difference (8-bit levels) between its centre and those around
+    /// it (or along its streak under a moving camera).
+    pub contrast: f32,
+    /// Motion touches it, or its value hangs on its lens or light points.
+    pub moving: bool,
+    /// Its value hangs on its lens or light points: a penumbra around it, or a blur that
+    /// reaches it ([`FirstPass::spread_pixels`]).
+    pub spread: bool,
+}
+
 /// What the first pass saw, per pixel (row-major).
 pub(super) struct FirstPass<'f> {
     frame: &'f Frame<'f>,
@@ -283,14 +296,12 @@ impl<'f> FirstPass<'f> {
             .reduce(RayCounts::default, RayCounts::sum)
     }
 
-    /// Whether pixel (x, y) is refined, and if so the largest tone-mapped difference (8-bit
-    /// levels) between its centre and those around it and whether motion (or a penumbra, or
-    /// a blur: [`FirstPass::spread_pixels`]) touches it; `None` if it is flat and keeps its
-    /// centre sample. Flat: all nine centres around it hit one surface within
+    /// Whether pixel (x, y) is refined, and if so why ([`Refinement`]); `None` if it is flat
+    /// and keeps its centre sample. Flat: all nine centres around it hit one surface within
     /// `FLAT_CONTRAST` levels, no centre ray around it met something moving, under a moving
     /// camera the image is flat along its streak, and its value hangs on no lens or light
     /// point.
-    pub fn refinement(&self, x: usize, y: usize) -> Option<(f32, bool)> {
+    pub fn refinement(&self, x: usize, y: usize) -> Option<Refinement> {
         let (w, h) = self.frame.size;
         let prim = self.centres[y * w + x].1;
         let tone = self.tones[y * w + x];
@@ -320,9 +331,22 @@ impl<'f> FirstPass<'f> {
         other_surface |= streak.other_surface;
         // A pixel whose value hangs on its lens or light points spreads its samples over more
         // dimensions than its position, as one that motion touches does over time.
-        moving |= self.spread.get(y * w + x).copied().unwrap_or(false);
+        let spread = self.spread(x, y);
+        moving |= spread;
         let flat = !moving && !other_surface && 255.0 * contrast.max(streak.bias) <= FLAT_CONTRAST;
-        (!flat).then_some((255.0 * contrast.max(streak.contrast), moving))
+        (!flat).then_some(Refinement {
+            contrast: 255.0 * contrast.max(streak.contrast),
+            moving,
+            spread,
+        })
+    }
+
+    /// Whether pixel (x, y)'s value hangs on its lens or light points.
+    fn spread(&self, x: usize, y: usize) -> bool {
+        self.spread
+            .get(y * self.frame.size.0 + x)
+            .copied()
+            .unwrap_or(false)
     }
 
     /// The centres along the streak from (x, y) to `ends` that the camera's motion draws:
@@ -361,6 +385,11 @@ impl<'f> FirstPass<'f> {
     /// shadow edge inside the pixel that none of the nine centres' trees met is lost, as the
     /// flat test loses a sliver between centres (docs/benchmarks-history.md §4.4).
     pub fn prior(&self, x: usize, y: usize) -> PixelPrior {
+        // A lens sends a blurred pixel's samples to points of its circle of confusion, beyond
+        // the centres around it, so what their shadow rays saw does not speak for them.
+        if self.frame.draws.lens() && self.spread(x, y) {
+            return PixelPrior::NONE;
+        }
         let (w, h) = self.frame.size;
         let mut seen = 0;
         for near in around(x, y, (w, h)) {
@@ -379,7 +408,10 @@ impl<'f> FirstPass<'f> {
     /// take as known of the lights, and, kept, its centre. Then its pixel is the same,
     /// whatever changed around it, as long as its own samples' rays meet the same things.
     pub fn decides_alike(&self, other: &FirstPass, x: usize, y: usize) -> bool {
-        let refinement = |p: &FirstPass| p.refinement(x, y).map(|(c, m)| (c.to_bits(), m));
+        let refinement = |p: &FirstPass| {
+            p.refinement(x, y)
+                .map(|r| (r.contrast.to_bits(), r.moving, r.spread))
+        };
         let prior = |p: &FirstPass| {
             let prior = p.prior(x, y);
             let near = prior.near.map(|n| {

@@ -40,6 +40,28 @@ pub const PRIOR_SAMPLES: u32 = MIN_SAMPLES;
 /// brings them within half a level (docs/benchmarks-history.md §14.2).
 pub const MOTION_MIN_SAMPLES: u32 = 8;
 
+/// Fewest samples of a pixel whose value hangs on its lens or light points (a penumbra, a
+/// blur). Their points of the lens and of each light are stratified like the positions, so n
+/// samples all miss only what covers less than about 1/n of the lens or the light: the sliver
+/// of a light that an occluder hides at a penumbra's lit end, a small bright shape at the
+/// edge of a circle of confusion. There all samples agree and the error estimate says the
+/// pixel is done. At `MOTION_MIN_SAMPLES` such pixels of a penumbra were off by levels while
+/// estimated at a fraction of one; at 16 the soft-shadow bench scene's penumbra is within
+/// the bench's target (BENCHMARKS.md, "Soft shadows, spots and depth of field").
+pub const SPREAD_MIN_SAMPLES: u32 = 16;
+
+/// A pixel spread over lens or light points is refined to the frame's error target divided by
+/// this. Its error estimate is the spread of its own samples' mean, and where a bright sliver of
+/// the lens or a light is seen by few of them the estimate runs low: at the frame's target the
+/// depth-of-field bench scene stayed well above it in RMSE while only its blurred pixels were
+/// off. Only those pixels pay (BENCHMARKS.md, "Soft shadows, spots and depth of field").
+pub const SPREAD_ERROR_DIVISOR: f32 = 4.0;
+
+/// A pixel spread over lens or light points may take this many times `--max-spp`, which caps
+/// every other pixel: a quarter of the error calls for about sixteen times the samples, and a
+/// blur's pixels reached the old cap before the old target.
+pub const SPREAD_SPP_FACTOR: u32 = 4;
+
 /// Largest contrast (8-bit levels) between a pixel's centre sample and its 8 neighbours'
 /// for the pixel to be flat and keep its centre sample, if all nine hit the same surface.
 /// Smooth shading changes by about a level from pixel to pixel; a shadow or highlight edge,
