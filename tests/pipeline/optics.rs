@@ -137,6 +137,12 @@ fn bad_radii_cones_apertures_and_focus_targets_are_located() {
         e.contains("shot.ron:3:24: error: 'sun' is no spot light"),
         "{e}"
     );
+    // A spot points at its line's target: `look_at` is refused, saying where the aim lives.
+    let e = refused("(target: \"lamp\", look_at: Point((1, 0, 0))),");
+    assert!(
+        e.contains("shot.ron:3:27: error: 'lamp' is a light: `look_at` aims shapes, composites and cameras; a point light shines every way, and a spot points at the target of its `define light` line"),
+        "{e}"
+    );
     // Each half-angle in range, but the inner passes the outer (30°) after half a second.
     let e = refused("(target: \"lamp\", inner: [(at: 0, value: 10), (at: 1, value: 50)]),");
     assert!(

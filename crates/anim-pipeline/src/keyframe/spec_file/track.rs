@@ -734,7 +734,7 @@ impl Checker<'_> {
             for (channel, keyed) in keyed_channels(spec) {
                 if keyed && !fits(kind, channel) && channel != "roll" {
                     let why = if kind == TargetKind::Light && channel == "look_at" {
-                        format!("'{target}' is a point light, which shines every way: it has nothing to aim")
+                        format!("'{target}' is a light: `look_at` aims shapes, composites and cameras; a point light shines every way, and a spot points at the target of its `define light` line, which turns with the light's own transforms")
                     } else {
                         format!(
                             "'{target}' is a {}: `{channel}` can only be keyed on {}",
