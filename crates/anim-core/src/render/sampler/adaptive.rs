@@ -412,10 +412,14 @@ impl Adaptive<'_> {
         (x, y): (usize, usize),
         n: u32,
     ) -> Option<(f32, u32)> {
+        // Asked first, before the neighbourhood is read: most pixels end here.
+        if n == 0 || n > MOTION_MIN_SAMPLES {
+            return None;
+        }
         // The first pass's contrast around a pixel that motion touches (levels).
         let refinement = first.refinement(x, y).filter(|r| r.moving)?;
         let (error, max_spp) = goal(refinement, self.error, self.max_spp);
-        if n == 0 || n > MOTION_MIN_SAMPLES || n >= max_spp {
+        if n >= max_spp {
             return None;
         }
         let (w, h) = self.frame.size;
