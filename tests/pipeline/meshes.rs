@@ -3,7 +3,7 @@
 //! current directory), never over a file of the user's, and left alone when unchanged.
 
 use super::frames::triangle_obj;
-use assert_cmd::Command;
+use crate::common::{anim, run_in};
 use std::path::Path;
 use std::time::{Duration, SystemTime};
 
@@ -31,14 +31,12 @@ fn mesh_project(root: &Path) {
 
 /// `anim ARGS` run in `cwd`; its stderr, after checking that it succeeded.
 fn run_ok(cwd: &Path, args: &[&Path]) -> String {
-    let done = Command::cargo_bin("anim")
-        .expect("binary")
-        .current_dir(cwd)
-        .args(args)
-        .output()
-        .expect("run");
-    let said = String::from_utf8_lossy(&done.stderr).into_owned();
-    assert!(done.status.success(), "{args:?}: {said}");
+    let args: Vec<&str> = args
+        .iter()
+        .map(|a| a.to_str().expect("a UTF-8 path"))
+        .collect();
+    let (code, said) = run_in(cwd, &args);
+    assert_eq!(code, 0, "{args:?}: {said}");
     said
 }
 
@@ -212,8 +210,7 @@ fn a_mesh_path_the_frames_cannot_spell_is_an_error_that_leaves_nothing() {
     let dir = tempfile::tempdir().expect("tempdir");
     let project = dir.path().join("two words");
     mesh_project(&project);
-    let done = Command::cargo_bin("anim")
-        .expect("binary")
+    let done = anim()
         .arg("generate")
         .arg(project.join("specs/spin.ron"))
         .arg("-o")
